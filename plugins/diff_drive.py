@@ -1,0 +1,198 @@
+"""diff_drive: a differential drive like gazebo_ros_diff_drive / gz-sim DiffDrive.
+
+Subscribes `cmd_vel` (geometry_msgs/Twist); drives the two wheel joints with MuJoCo velocity actuators
+(torque-limited, with an optional wheel acceleration limit); publishes `odom` (nav_msgs/Odometry) and the
+odom -> base transform on `tf`. Odometry comes from the wheel encoders (integrated joint angles, so it
+drifts when wheels slip, as on a real robot) or from the world (the true pose, as Gazebo's
+`odometrySource: world`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+import mujoco
+import numpy as np
+from pydantic import Field, PositiveFloat
+
+from plugins._common import odometry
+from runner import msgs
+from runner.geometry import quat_to_yaw, yaw_to_quat
+from runner.plugin import BuildContext, Plugin, PluginConfigError, RatedParams, Topic
+
+
+_ROUND = {
+    int(mujoco.mjtGeom.mjGEOM_CYLINDER),
+    int(mujoco.mjtGeom.mjGEOM_SPHERE),
+    int(mujoco.mjtGeom.mjGEOM_ELLIPSOID),
+    int(mujoco.mjtGeom.mjGEOM_CAPSULE),
+}
+
+
+class DiffDriveParams(RatedParams):
+    rate: float = Field(50.0, gt=0, description="Control and odometry rate, sim Hz.")
+    left_joint: str = Field("left_wheel_joint", description="Left wheel joint.")
+    right_joint: str = Field("right_wheel_joint", description="Right wheel joint.")
+    wheel_separation: PositiveFloat | None = Field(
+        None, description="Distance between the wheels, metres (default: measured from the model)."
+    )
+    wheel_radius: PositiveFloat | None = Field(
+        None, description="Wheel radius, metres (default: from the wheel's collision geometry)."
+    )
+    max_wheel_torque: PositiveFloat = Field(20.0, description="Torque limit of each wheel, N·m.")
+    max_wheel_acceleration: float = Field(
+        0.0, ge=0, description="Wheel acceleration limit, rad/s² (0: none)."
+    )
+    gain: PositiveFloat | None = Field(
+        None,
+        description="Velocity servo gain of the wheel actuators, N·m per rad/s (default: from the robot's "
+        "mass and wheel inertia, for a 5-step time constant; too stiff a servo makes the robot hop).",
+    )
+    cmd_topic: str = Field("cmd_vel", description="Command topic (geometry_msgs/Twist).")
+    odom_topic: str = Field("odom", description="Odometry topic (nav_msgs/Odometry).")
+    tf_topic: str = Field("tf", description="TF topic (tf2_msgs/TFMessage).")
+    publish_odom: bool = Field(True, description="Publish odometry.")
+    publish_tf: bool = Field(True, description="Publish the odom -> base transform.")
+    odom_frame: str = Field("odom", description="Odometry frame (namespaced: <ns>/odom).")
+    base_frame: str | None = Field(None, description="Base frame (default: the root link, namespaced).")
+    odometry_source: Literal["encoders", "world"] = Field(
+        "encoders", description="Integrate wheel encoders, or report the true pose."
+    )
+    cmd_timeout: float = Field(0.0, ge=0, description="Stop when no command came for this long, s (0: never).")
+
+
+class DiffDrive(Plugin):
+    Params = DiffDriveParams
+    params: DiffDriveParams
+
+    @classmethod
+    def build(cls, params: DiffDriveParams, ctx: BuildContext, name: str) -> list[Topic]:
+        for side, jname in (("left", params.left_joint), ("right", params.right_joint)):
+            joint = ctx.joint(jname, f"{side}_joint")
+            if joint.type != mujoco.mjtJoint.mjJNT_HINGE:
+                raise PluginConfigError(f"wheel joint {jname!r} is not revolute/continuous", f"{side}_joint")
+            act = ctx.spec.add_actuator(name=f"{name}/{side}", target=jname, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+            act.set_to_velocity(kv=params.gain or 1.0)  # the automatic gain is set in setup()
+            act.forcelimited = True
+            act.forcerange = [-params.max_wheel_torque, params.max_wheel_torque]
+        topics = [Topic(params.cmd_topic, "geometry_msgs/msg/Twist", "sub")]
+        if params.publish_odom:
+            topics.append(Topic(params.odom_topic, "nav_msgs/msg/Odometry", "pub", params.rate))
+        if params.publish_tf:
+            topics.append(Topic(params.tf_topic, "tf2_msgs/msg/TFMessage", "pub", params.rate))
+        return topics
+
+    def setup(self) -> None:
+        p = self.params
+        m, d = self.ctx.model, self.ctx.data
+        r = self.ctx.robot
+        self.act = [r.actuator_id(f"{self.name}/left"), r.actuator_id(f"{self.name}/right")]
+        joints = [r.joint_id(p.left_joint), r.joint_id(p.right_joint)]
+        self.qadr = [int(m.jnt_qposadr[j]) for j in joints]
+        self.vadr = [int(m.jnt_dofadr[j]) for j in joints]
+        wheel_bodies = [int(m.jnt_bodyid[j]) for j in joints]
+        self.sep = p.wheel_separation or float(np.linalg.norm(d.xpos[wheel_bodies[0]] - d.xpos[wheel_bodies[1]]))
+        self.radius = p.wheel_radius or _wheel_radius(m, wheel_bodies[0])
+        self.base = r.root_body
+        if p.gain is None:
+            kv = _auto_gain(m, r.body_ids, wheel_bodies[0], self.radius)
+            for a in self.act:
+                m.actuator_gainprm[a, 0] = kv
+                m.actuator_biasprm[a, 2] = -kv
+        self.base_frame = p.base_frame or r.frame(r.root_link)
+        self.odom_frame = r.frame(p.odom_frame)
+        self.cmd = (0.0, 0.0)
+        self.cmd_time = 0
+        self.target = np.zeros(2)
+        self.ctrl = np.zeros(2)
+        self.dt = 1.0 / p.rate
+        # encoder odometry state
+        self.x = self.y = self.yaw = 0.0
+        self.last_q = np.array([d.qpos[a] for a in self.qadr])
+        self.ctx.subscribe(p.cmd_topic, "geometry_msgs/msg/Twist", self._on_cmd)
+        self.odom_pub = self.ctx.publisher(p.odom_topic, "nav_msgs/msg/Odometry") if p.publish_odom else None
+        self.tf_pub = self.ctx.publisher(p.tf_topic, "tf2_msgs/msg/TFMessage") if p.publish_tf else None
+
+    def _on_cmd(self, msg: object, stamp_ns: int) -> None:
+        self.cmd = (float(msg.linear.x), float(msg.angular.z))  # type: ignore[attr-defined]
+        self.cmd_time = stamp_ns
+
+    def before_step(self, now_ns: int) -> None:
+        p = self.params
+        v, w = self.cmd
+        if p.cmd_timeout and now_ns - self.cmd_time > p.cmd_timeout * 1e9:
+            v, w = 0.0, 0.0
+        half = w * self.sep / 2.0
+        self.target[:] = ((v - half) / self.radius, (v + half) / self.radius)
+        if p.max_wheel_acceleration > 0:
+            step = p.max_wheel_acceleration * self.dt
+            self.ctrl += np.clip(self.target - self.ctrl, -step, step)
+        else:
+            self.ctrl[:] = self.target
+        d = self.ctx.data
+        d.ctrl[self.act[0]] = self.ctrl[0]
+        d.ctrl[self.act[1]] = self.ctrl[1]
+
+    def after_step(self, now_ns: int) -> None:
+        d = self.ctx.data
+        wl, wr = d.qvel[self.vadr[0]], d.qvel[self.vadr[1]]
+        v = self.radius * (wl + wr) / 2.0
+        w = self.radius * (wr - wl) / self.sep
+        if self.params.odometry_source == "encoders":
+            q = np.array([d.qpos[a] for a in self.qadr])
+            dl, dr = (q - self.last_q) * self.radius
+            self.last_q = q
+            ds, dyaw = (dl + dr) / 2.0, (dr - dl) / self.sep
+            mid = self.yaw + dyaw / 2.0
+            self.x += ds * math.cos(mid)
+            self.y += ds * math.sin(mid)
+            self.yaw += dyaw
+            pos = (self.x, self.y, 0.0)
+            quat = yaw_to_quat(self.yaw)
+        else:
+            pos = d.xpos[self.base]
+            quat = d.xquat[self.base]
+            self.yaw = quat_to_yaw(quat)
+        if self.odom_pub:
+            self.odom_pub.publish(
+                odometry(now_ns, self.odom_frame, self.base_frame, pos, quat, (v, 0.0, 0.0), (0.0, 0.0, w)),
+                now_ns,
+            )
+        if self.tf_pub:
+            T = msgs.T
+            tf = T["geometry_msgs/msg/TransformStamped"](
+                header=msgs.header(now_ns, self.odom_frame),
+                child_frame_id=self.base_frame,
+                transform=T["geometry_msgs/msg/Transform"](
+                    translation=T["geometry_msgs/msg/Vector3"](x=float(pos[0]), y=float(pos[1]), z=float(pos[2])),
+                    rotation=T["geometry_msgs/msg/Quaternion"](
+                        x=float(quat[1]), y=float(quat[2]), z=float(quat[3]), w=float(quat[0])
+                    ),
+                ),
+            )
+            self.tf_pub.publish(T["tf2_msgs/msg/TFMessage"](transforms=[tf]), now_ns)
+
+
+def _wheel_radius(m: mujoco.MjModel, body: int) -> float:
+    """Radius of the wheel's collision geometry (cylinder/sphere/ellipsoid), else its bounding radius."""
+    best = 0.0
+    for g in range(m.ngeom):
+        if int(m.geom_bodyid[g]) != body or (m.geom_contype[g] == 0 and m.geom_conaffinity[g] == 0):
+            continue
+        if int(m.geom_type[g]) in _ROUND:
+            best = max(best, float(m.geom_size[g][0]))
+        else:
+            best = max(best, float(m.geom_rbound[g]))
+    if best <= 0:
+        raise ValueError("cannot find the wheel radius from the model; set `wheel_radius`")
+    return best
+
+
+def _auto_gain(m: mujoco.MjModel, robot_bodies: set[int], wheel: int, radius: float) -> float:
+    """A servo gain giving a time constant of 5 physics steps (at least 10 ms) for the inertia one wheel
+    sees: its own inertia plus half the robot's mass at the rim."""
+    mass = float(sum(m.body_mass[b] for b in robot_bodies))
+    inertia = float(max(m.body_inertia[wheel])) + mass / 2.0 * radius**2
+    tau = max(5.0 * float(m.opt.timestep), 0.01)
+    return inertia / tau

@@ -1,0 +1,61 @@
+"""joint_states: positions, velocities and efforts of a robot's joints -> sensor_msgs/JointState.
+
+Joint names are the URDF names (as robot_state_publisher expects), not the namespaced MuJoCo names.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+from pydantic import Field
+
+from runner import msgs
+from runner.plugin import BuildContext, Plugin, PluginConfigError, RatedParams, Topic
+
+_MOVABLE = {int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)}
+
+
+class JointStatesParams(RatedParams):
+    rate: float = Field(50.0, gt=0, description="Publish rate, sim Hz.")
+    topic: str = Field("joint_states", description="Topic, relative to the robot's namespace.")
+    joints: list[str] | None = Field(None, description="Joints to publish (default: every revolute/prismatic).")
+
+
+class JointStates(Plugin):
+    Params = JointStatesParams
+    params: JointStatesParams
+
+    @classmethod
+    def build(cls, params: JointStatesParams, ctx: BuildContext, name: str) -> list[Topic]:
+        for i, j in enumerate(params.joints or []):
+            joint = ctx.joint(j, f"joints[{i}]")
+            if int(joint.type) not in _MOVABLE:
+                raise PluginConfigError(f"joint {j!r} is not revolute or prismatic", f"joints[{i}]")
+        return [Topic(params.topic, "sensor_msgs/msg/JointState", "pub", params.rate)]
+
+    def setup(self) -> None:
+        m = self.ctx.model
+        r = self.ctx.robot
+        if self.params.joints is not None:
+            ids = [r.joint_id(j) for j in self.params.joints]
+        else:
+            ids = [
+                j for j in range(m.njnt)
+                if int(m.jnt_bodyid[j]) in r.body_ids and int(m.jnt_type[j]) in _MOVABLE
+            ]
+        self.names = [m.joint(j).name.removeprefix(r.prefix) for j in ids]
+        self.qadr = np.array([m.jnt_qposadr[j] for j in ids], dtype=np.int64)
+        self.vadr = np.array([m.jnt_dofadr[j] for j in ids], dtype=np.int64)
+        self.pub = self.ctx.publisher(self.params.topic, "sensor_msgs/msg/JointState")
+        self.JointState = msgs.T["sensor_msgs/msg/JointState"]
+
+    def after_step(self, now_ns: int) -> None:
+        d = self.ctx.data
+        msg = self.JointState(
+            header=msgs.header(now_ns, ""),
+            name=self.names,
+            position=d.qpos[self.qadr].astype(np.float64),
+            velocity=d.qvel[self.vadr].astype(np.float64),
+            effort=d.qfrc_actuator[self.vadr].astype(np.float64),
+        )
+        self.pub.publish(msg, now_ns)

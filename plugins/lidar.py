@@ -1,0 +1,133 @@
+"""lidar: a planar laser scanner -> sensor_msgs/LaserScan, ray-cast with `mujoco.mj_multiRay`.
+
+Like Gazebo's ray sensor: `samples` beams from `min_angle` to `max_angle` (inclusive), returns outside
+`[range_min, range_max]` are +inf (no return) or -inf (too close), gaussian noise, optional range
+resolution. The robot's own geoms and visual-only geoms are never hit.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+from pydantic import Field, PositiveFloat, PositiveInt, model_validator
+
+from plugins._common import MountPose, add_site, pick_link
+from runner import msgs
+from runner.plugin import BuildContext, Plugin, RatedParams, Topic
+
+_EPS = 1e-4
+
+
+class LidarParams(RatedParams):
+    link: str | None = Field(
+        None, description="Link the scanner is mounted on (default: a link named like lidar/laser/scan)."
+    )
+    pose: MountPose = Field(default_factory=MountPose, description="Mount pose relative to the link.")
+    topic: str = Field("scan", description="Topic, relative to the robot's namespace.")
+    frame_id: str | None = Field(None, description="Frame id in the header (default: <ns>/<link>).")
+    samples: PositiveInt = Field(360, description="Beams per scan.")
+    min_angle: float = Field(-math.pi, ge=-2 * math.pi, le=2 * math.pi, description="First beam angle, rad.")
+    max_angle: float = Field(math.pi, ge=-2 * math.pi, le=2 * math.pi, description="Last beam angle, rad.")
+    range_min: float = Field(0.12, ge=0, description="Closest valid return, metres.")
+    range_max: PositiveFloat = Field(12.0, description="Farthest valid return, metres.")
+    resolution: float = Field(0.0, ge=0, description="Range quantization step, metres (0: none).")
+    noise_stddev: float = Field(0.0, ge=0, description="Gaussian noise on each range, metres.")
+
+    @model_validator(mode="after")
+    def _angles(self) -> LidarParams:
+        if self.max_angle < self.min_angle:
+            raise ValueError(f"max_angle ({self.max_angle}) is below min_angle ({self.min_angle})")
+        if self.range_max <= self.range_min:
+            raise ValueError(f"range_max ({self.range_max}) must exceed range_min ({self.range_min})")
+        return self
+
+
+class Lidar(Plugin):
+    Params = LidarParams
+    params: LidarParams
+
+    @classmethod
+    def build(cls, params: LidarParams, ctx: BuildContext, name: str) -> list[Topic]:
+        link = pick_link(ctx, params.link, ("lidar", "laser", "scan"))
+        add_site(ctx, link, name, params.pose)
+        return [Topic(params.topic, "sensor_msgs/msg/LaserScan", "pub", params.rate)]
+
+    def setup(self) -> None:
+        p = self.params
+        ctx = self.ctx
+        m = ctx.model
+        self.site = ctx.robot.site_id(f"{self.name}_site")
+        self.body = int(m.site_bodyid[self.site])
+        link = m.body(self.body).name.removeprefix(ctx.robot.prefix)
+        self.frame_id = p.frame_id or ctx.robot.frame(link)
+        n = p.samples
+        self.angles = np.linspace(p.min_angle, p.max_angle, n) if n > 1 else np.array([p.min_angle])
+        self.increment = float(self.angles[1] - self.angles[0]) if n > 1 else 0.0
+        self.local = np.stack([np.cos(self.angles), np.sin(self.angles), np.zeros(n)])  # 3 x n
+        self.geomid = np.zeros(n, dtype=np.int32)
+        self.dist = np.zeros(n, dtype=np.float64)
+        # Rays skip the robot's own geoms and visual-only geoms (URDF visuals are group 1, no contacts).
+        skip = np.zeros(m.ngeom, dtype=bool)
+        skip[ctx.robot.geom_ids] = True
+        skip |= (m.geom_contype == 0) & (m.geom_conaffinity == 0)
+        self.skip = skip
+        self.geomgroup = np.array([1, 0, 1, 1, 1, 1], dtype=np.uint8)
+        self.pub = ctx.publisher(p.topic, "sensor_msgs/msg/LaserScan")
+        self.LaserScan = msgs.T["sensor_msgs/msg/LaserScan"]
+        self.empty = np.zeros(0, dtype=np.float32)
+
+    def scan(self) -> np.ndarray:
+        """Distances along each beam (inf where nothing is hit within range_max)."""
+        m, d = self.ctx.model, self.ctx.data
+        p = self.params
+        origin = d.site_xpos[self.site].copy()
+        rot = d.site_xmat[self.site].reshape(3, 3)
+        vec = (rot @ self.local).T.copy()  # n x 3
+        mujoco.mj_multiRay(
+            m, d, origin, vec.reshape(-1), self.geomgroup, 1, self.body,
+            self.geomid, self.dist, None, len(self.dist), p.range_max,
+        )
+        dist = self.dist.copy()
+        redo = np.nonzero((self.geomid >= 0) & self.skip[np.maximum(self.geomid, 0)])[0]
+        if len(redo):
+            gid = np.zeros(1, dtype=np.int32)
+            for i in redo:
+                travelled = float(dist[i])
+                while True:
+                    start = origin + vec[i] * (travelled + _EPS)
+                    dd = mujoco.mj_ray(m, d, start, vec[i], self.geomgroup, 1, self.body, gid)
+                    if dd < 0:
+                        dist[i] = -1.0
+                        break
+                    travelled += dd + _EPS
+                    if not self.skip[gid[0]]:
+                        dist[i] = travelled
+                        break
+        dist[dist < 0] = np.inf
+        return dist
+
+    def after_step(self, now_ns: int) -> None:
+        p = self.params
+        ranges = self.scan()
+        finite = np.isfinite(ranges)
+        if p.noise_stddev > 0:
+            ranges[finite] += self.ctx.rng.normal(0.0, p.noise_stddev, int(finite.sum()))
+        if p.resolution > 0:
+            ranges[finite] = np.round(ranges[finite] / p.resolution) * p.resolution
+        ranges[finite & (ranges > p.range_max)] = np.inf
+        ranges[finite & (ranges < p.range_min)] = -np.inf
+        msg = self.LaserScan(
+            header=msgs.header(now_ns, self.frame_id),
+            angle_min=p.min_angle,
+            angle_max=p.max_angle,
+            angle_increment=self.increment,
+            time_increment=0.0,
+            scan_time=1.0 / p.rate,
+            range_min=p.range_min,
+            range_max=p.range_max,
+            ranges=ranges.astype(np.float32),
+            intensities=self.empty,
+        )
+        self.pub.publish(msg, now_ns)

@@ -1,0 +1,313 @@
+"""compile: Scenario -> RunPlan. The one place where files on disk become a model.
+
+Everything that touches disk or other formats happens here, and fails early with the line in the
+scenario that caused it: xacro, URDF, plugin parameters, message data in the timeline, record paths.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import mujoco
+
+from runner import msgs
+from runner.compile.packages import PackageMap
+from runner.compile.urdf import DescriptionError, RobotModel, urdf_to_model
+from runner.compile.xacro_expand import XacroError, expand
+from runner.errors import Location, Problem, ScenarioError
+from runner.geometry import rpy_to_quat
+from runner.loader import Document, PathKey
+from runner.plan import PluginPlan, RecordPlan, RobotPlan, RunPlan, TimelinePlan, TopicPlan, topic_key
+from runner.plugin import BuildContext, PluginConfigError
+from runner.registry import PluginLookupError, load
+from runner.schema import Robot, Scenario, WorldModel
+from runner.validate import validate_model
+
+_GEOM = {
+    "box": mujoco.mjtGeom.mjGEOM_BOX,
+    "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
+    "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
+}
+_INTEGRATOR = {
+    "euler": mujoco.mjtIntegrator.mjINT_EULER,
+    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+    "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
+    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+}
+
+
+def compile_plan(sc: Scenario, doc: Document, *, record_path: str | None = None) -> RunPlan:
+    base = doc.base_dir
+    packages = PackageMap.for_scenario(base, {k: (base / v) for k, v in sc.packages.items()})
+    for name, folder in packages.explicit.items():
+        if not folder.is_dir():
+            raise ScenarioError(
+                Problem(
+                    f"package folder {str(folder)!r} does not exist",
+                    doc.locate(("packages", name)),
+                    ("packages", name),
+                    hint="paths are relative to the scenario's folder",
+                )
+            )
+
+    world = _world_spec(sc)
+    robots: list[RobotPlan] = []
+    for i, robot in enumerate(sc.robots):
+        model = _robot_model(robot, i, doc, packages)
+        plugins = _build_plugins(sc, robot, i, model, doc)
+        pos = robot.pose.xyz
+        frame = world.worldbody.add_frame(pos=list(pos), quat=list(rpy_to_quat(robot.pose.rpy)))
+        prefix = f"{robot.ns}/"
+        world.attach(model.spec, prefix=prefix, frame=frame)
+        robots.append(
+            RobotPlan(
+                name=robot.name,
+                namespace=robot.ns,
+                prefix=prefix,
+                root=model.root,
+                fixed=robot.fixed,
+                description_file=str(_description_path(robot, base)),
+                links=model.links,
+                joints=model.joints,
+                plugins=plugins,
+            )
+        )
+
+    try:
+        world.compile()
+    except ValueError as e:
+        raise ScenarioError(
+            Problem(f"MuJoCo cannot compile the world: {e}", doc.locate(("robots",)), ("robots",))
+        ) from None
+    mjcf = world.to_xml()
+
+    timeline = [_timeline_entry(sc, i, doc) for i in range(len(sc.timeline))]
+    timeline.sort(key=lambda ev: ev.t_ns)
+
+    rec = sc.record
+    if record_path is not None:
+        path = Path(record_path)
+    elif rec.path is not None:
+        path = base / rec.path
+    else:
+        path = Path("runs") / f"{sc.name}.mcap"
+    record = RecordPlan(
+        enabled=rec.enabled,
+        path=str(path),
+        include=[_full_expr(sc.name, e) for e in rec.include],
+        exclude=[_full_expr(sc.name, e) for e in rec.exclude],
+    )
+    _check_key_exprs(record, doc)
+
+    phys = sc.world.physics
+    return RunPlan(
+        name=sc.name,
+        scenario_file=str(doc.file) if doc.file else None,
+        duration_ns=round(sc.duration * 1e9),
+        rate=sc.rate,
+        seed=sc.seed,
+        step_ns=round(phys.timestep * 1e9),
+        clock_rate=sc.world.clock_rate,
+        mjcf=mjcf,
+        robots=robots,
+        timeline=timeline,
+        record=record,
+    )
+
+
+# ------------------------------------------------------------------------------------------------ world
+def _world_spec(sc: Scenario) -> mujoco.MjSpec:
+    spec = mujoco.MjSpec()
+    spec.modelname = sc.name
+    phys = sc.world.physics
+    spec.option.timestep = phys.timestep
+    spec.option.gravity = list(phys.gravity)
+    spec.option.integrator = _INTEGRATOR[phys.integrator]
+    spec.visual.global_.offwidth = 1280
+    spec.visual.global_.offheight = 960
+    spec.worldbody.add_light(name="sun", pos=[0, 0, 10], dir=[0.2, 0.1, -1], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL)
+    ground = sc.world.ground
+    if ground.enabled:
+        spec.worldbody.add_geom(
+            name="ground",
+            type=mujoco.mjtGeom.mjGEOM_PLANE,
+            size=[0, 0, 0.05],
+            rgba=list(ground.rgba),
+            friction=[ground.friction, 0.005, 0.0001],
+        )
+    for m in sc.world.models:
+        _add_model(spec, m)
+    return spec
+
+
+def _add_model(spec: mujoco.MjSpec, m: WorldModel) -> None:
+    quat = list(rpy_to_quat(m.pose.rpy))
+    if m.shape == "box":
+        size = [s / 2 for s in m.size]
+    elif m.shape == "cylinder":
+        size = [m.size[0], m.size[1] / 2, 0]
+    else:
+        size = [m.size[0], 0, 0]
+    geom_kw: dict[str, Any] = {
+        "name": m.name,
+        "type": _GEOM[m.shape],
+        "size": size,
+        "rgba": list(m.rgba),
+        "friction": [m.friction, 0.005, 0.0001],
+    }
+    if m.static:
+        spec.worldbody.add_geom(pos=list(m.pose.xyz), quat=quat, **geom_kw)
+        return
+    body = spec.worldbody.add_body(name=m.name, pos=list(m.pose.xyz), quat=quat)
+    body.add_freejoint(name=f"{m.name}/root")
+    geom_kw["mass"] = m.mass or 1.0
+    body.add_geom(**geom_kw)
+
+
+# ------------------------------------------------------------------------------------------------ robots
+def _description_path(robot: Robot, base: Path) -> Path:
+    return (base / robot.desc.file).resolve()
+
+
+def _robot_model(robot: Robot, i: int, doc: Document, packages: PackageMap) -> RobotModel:
+    desc_path: PathKey = ("robots", i, "description")
+    if isinstance(robot.description, str):
+        file_path: PathKey = desc_path
+    else:
+        file_path = (*desc_path, "file")
+    path = _description_path(robot, doc.base_dir)
+    if not path.is_file():
+        raise ScenarioError(
+            Problem(
+                "robot description file not found",
+                doc.locate(file_path),
+                file_path,
+                expected="a URDF or xacro file (relative to the scenario's folder)",
+                found=str(path),
+            )
+        )
+    try:
+        if path.suffix == ".xacro" or path.name.endswith(".urdf.xacro"):
+            args = {k: _xacro_str(v) for k, v in robot.desc.args.items()}
+            urdf = expand(path, args, packages)
+        else:
+            if robot.desc.args:
+                raise ScenarioError(
+                    Problem(
+                        "`args` are given but the description is not a xacro file",
+                        doc.locate((*desc_path, "args")),
+                        (*desc_path, "args"),
+                        hint="xacro arguments apply to .xacro files only",
+                    )
+                )
+            urdf = path.read_text(encoding="utf-8")
+        return urdf_to_model(urdf, path, packages, fixed=robot.fixed)
+    except (XacroError, DescriptionError) as e:
+        where = Location(e.file, e.line) if e.file else doc.locate(file_path)
+        hint = e.hint
+        problems = [Problem(str(e), where, hint=hint)]
+        if e.file != doc.file:
+            problems.append(
+                Problem(
+                    f"while loading robot {robot.name!r}",
+                    doc.locate(file_path),
+                    file_path,
+                )
+            )
+        raise ScenarioError(problems) from None
+
+
+def _xacro_str(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    return str(v)
+
+
+def _build_plugins(sc: Scenario, robot: Robot, i: int, model: RobotModel, doc: Document) -> list[PluginPlan]:
+    plans: list[PluginPlan] = []
+    ctx = BuildContext(spec=model.spec, robot=robot.name, namespace=robot.ns, root=model.root)
+    for k, entry in enumerate(robot.plugins):
+        here: PathKey = ("robots", i, "plugins", k)
+        try:
+            cls = load(entry.type)
+        except PluginLookupError as e:
+            raise ScenarioError(
+                Problem(str(e), doc.locate((*here, "type")), (*here, "type"), hint=e.hint)
+            ) from None
+        params = validate_model(cls.Params, entry.params, doc, (*here, "params"))
+        name = entry.name or entry.type
+        try:
+            topics = cls.build(params, ctx, name)
+        except PluginConfigError as e:
+            where: PathKey = (*here, "params", e.param) if e.param else here
+            raise ScenarioError(Problem(str(e), doc.locate(where), where, hint=e.hint)) from None
+        rate = cls.rate_of(params)
+        plans.append(
+            PluginPlan(
+                type=entry.type,
+                name=name,
+                params=params.model_dump(mode="json"),
+                rate=rate,
+                topics=[
+                    TopicPlan(
+                        key=topic_key(sc.name, robot.ns, t.name),
+                        type=t.type,
+                        rate=t.rate,
+                        direction=t.direction,
+                        owner=f"{robot.ns}/{name}",
+                    )
+                    for t in topics
+                ],
+            )
+        )
+    return plans
+
+
+# ---------------------------------------------------------------------------------------------- timeline
+def _timeline_entry(sc: Scenario, i: int, doc: Document) -> TimelinePlan:
+    ev = sc.timeline[i]
+    here: PathKey = ("timeline", i)
+    type_name = msgs.normalize_type(ev.type)
+    if not msgs.is_known(type_name):
+        close = msgs.similar_types(ev.type)
+        raise ScenarioError(
+            Problem(
+                f"unknown message type {ev.type!r}",
+                doc.locate((*here, "type")),
+                (*here, "type"),
+                expected="a ROS 2 message type such as geometry_msgs/msg/Twist",
+                hint=f"did you mean {close[0]!r}?" if close else None,
+            )
+        )
+    try:
+        msgs.from_data(type_name, ev.data)
+    except msgs.MessageDataError as e:
+        where: PathKey = (*here, "data", *e.path)
+        raise ScenarioError(Problem(str(e), doc.locate(where), where, hint=e.hint)) from None
+    topic = ev.topic
+    key = f"{sc.name}/{topic.lstrip('/')}"
+    return TimelinePlan(t_ns=round(ev.t * 1e9), key=key, type=type_name, data=ev.data)
+
+
+def _full_expr(run: str, expr: str) -> str:
+    return f"{run}/{expr.lstrip('/')}"
+
+
+def _check_key_exprs(record: RecordPlan, doc: Document) -> None:
+    import zenoh
+
+    for field_name, exprs in (("include", record.include), ("exclude", record.exclude)):
+        for j, e in enumerate(exprs):
+            try:
+                zenoh.KeyExpr(e)
+            except Exception:
+                where: PathKey = ("record", field_name, j)
+                raise ScenarioError(
+                    Problem(
+                        f"{e!r} is not a valid key expression",
+                        doc.locate(where),
+                        where,
+                        hint="use chunks separated by '/', '*' for one chunk and '**' for any number",
+                    )
+                ) from None

@@ -1,0 +1,80 @@
+"""One root for every error a user can cause.
+
+A `ScenarioError` says where (file, line, column), what (the path in the scenario, e.g.
+`robots[1].plugins[0].params.samples`), what was expected, what was found, and a hint. The CLI prints
+these and exits 1; any other exception is a bug and keeps its traceback.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+
+@dataclass(frozen=True)
+class Location:
+    file: Path | None = None
+    line: int | None = None  # 1-based
+    column: int | None = None  # 1-based
+
+    def __str__(self) -> str:
+        parts = [str(self.file) if self.file else "<scenario>"]
+        if self.line is not None:
+            parts.append(str(self.line))
+            if self.column is not None:
+                parts.append(str(self.column))
+        return ":".join(parts)
+
+
+def format_path(path: Sequence[str | int]) -> str:
+    """`("robots", 1, "plugins", 0, "rate")` -> `robots[1].plugins[0].rate`."""
+    out = ""
+    for part in path:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += f".{part}" if out else str(part)
+    return out or "<document>"
+
+
+@dataclass
+class Problem:
+    """One thing wrong with the input."""
+
+    message: str
+    location: Location = field(default_factory=Location)
+    path: tuple[str | int, ...] = ()
+    expected: str | None = None
+    found: str | None = None
+    hint: str | None = None
+
+    def render(self) -> str:
+        head = f"{self.location}: "
+        if self.path:
+            head += f"{format_path(self.path)}: "
+        lines = [head + self.message]
+        if self.expected is not None:
+            lines.append(f"  expected: {self.expected}")
+        if self.found is not None:
+            lines.append(f"  found:    {self.found}")
+        if self.hint:
+            lines.append(f"  hint:     {self.hint}")
+        return "\n".join(lines)
+
+
+class ScenarioError(Exception):
+    """A user mistake in a scenario or in a file it refers to. Holds one or more problems."""
+
+    def __init__(self, problems: Problem | Iterable[Problem]):
+        self.problems = [problems] if isinstance(problems, Problem) else list(problems)
+        super().__init__(self.render())
+
+    def render(self) -> str:
+        n = len(self.problems)
+        body = "\n".join(p.render() for p in self.problems)
+        return body if n == 1 else f"{n} problems:\n{body}"
+
+
+class RunError(Exception):
+    """The run could not go on (a process died, a network endpoint could not be opened...)."""

@@ -1,0 +1,92 @@
+"""RunPlan: everything a world process needs, as plain serialisable data.
+
+Made by `runner.compile.compile_plan`; handed to child processes (or other hosts) as JSON.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+from pydantic import BaseModel
+
+
+class TopicPlan(BaseModel):
+    key: str  # full Zenoh key, e.g. two_robots/r1/scan
+    type: str  # ROS 2 type, e.g. sensor_msgs/msg/LaserScan
+    rate: float | None = None  # sim Hz, when known
+    direction: Literal["pub", "sub"] = "pub"
+    owner: str = ""  # e.g. r1/lidar
+
+
+class PluginPlan(BaseModel):
+    type: str
+    name: str
+    params: dict[str, Any]
+    rate: float | None
+    topics: list[TopicPlan] = []
+
+
+class RobotPlan(BaseModel):
+    name: str
+    namespace: str
+    prefix: str  # MuJoCo name prefix, e.g. "r1/"
+    root: str  # root link name (un-prefixed)
+    fixed: bool
+    description_file: str
+    links: list[str]
+    joints: list[str]
+    plugins: list[PluginPlan]
+
+
+class TimelinePlan(BaseModel):
+    t_ns: int
+    key: str
+    type: str
+    data: dict[str, Any]
+
+
+class RecordPlan(BaseModel):
+    enabled: bool
+    path: str
+    include: list[str]  # full key expressions
+    exclude: list[str]
+
+
+class RunPlan(BaseModel):
+    name: str
+    scenario_file: str | None
+    duration_ns: int
+    rate: Literal["realtime", "max"] | float
+    seed: int
+    step_ns: int
+    clock_rate: float
+    mjcf: str
+    robots: list[RobotPlan]
+    timeline: list[TimelinePlan]
+    record: RecordPlan
+
+    @property
+    def clock_key(self) -> str:
+        return f"{self.name}/clock"
+
+    def topics(self) -> list[TopicPlan]:
+        out = [TopicPlan(key=self.clock_key, type="rosgraph_msgs/msg/Clock", rate=self.clock_rate, owner="world")]
+        seen = {self.clock_key}
+        for r in self.robots:
+            for p in r.plugins:
+                for t in p.topics:
+                    if (t.key, t.direction) not in seen:
+                        out.append(t)
+                        seen.add((t.key, t.direction))
+        for ev in self.timeline:
+            if ev.key not in seen:
+                out.append(TopicPlan(key=ev.key, type=ev.type, direction="pub", owner="timeline"))
+                seen.add(ev.key)
+        return out
+
+
+def topic_key(run: str, namespace: str, topic: str) -> str:
+    """`scan` in namespace r1 -> `run/r1/scan`; `/clock` (absolute) -> `run/clock`."""
+    if topic.startswith("/"):
+        return f"{run}{topic}"
+    return f"{run}/{namespace}/{topic}" if namespace else f"{run}/{topic}"

@@ -1,0 +1,161 @@
+"""The plugin API: what a built-in or third-party plugin implements.
+
+A plugin is a class with a `Params` pydantic model and fixed-name hooks:
+
+- `build(params, ctx)` (classmethod, compile time): add what the plugin needs to the robot's MuJoCo
+  model (actuators, sites, sensors) and declare the topics it publishes and subscribes;
+- `setup()`, `before_step(now_ns)`, `after_step(now_ns)`, `close()` (run time, in the world process).
+  `before_step`/`after_step` are called at the plugin's `rate` (sim Hz; every physics step if it has
+  none). Hooks that a class does not override are never called.
+
+Plugins never touch Zenoh: they publish and subscribe through `ctx.publisher(...)`/`ctx.subscribe(...)`.
+Built-ins are registered in the `scenario.plugins` entry-point group, as a third-party package would be.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
+
+import mujoco
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, PositiveFloat
+
+if TYPE_CHECKING:
+    from runner.sim.world import RobotHandle
+
+
+class PluginParams(BaseModel):
+    """Base of every plugin's `Params`: unknown keys are errors."""
+
+    model_config = ConfigDict(extra="forbid")
+
+
+class RatedParams(PluginParams):
+    rate: PositiveFloat = Field(10.0, description="How often the plugin runs and publishes, in sim Hz.")
+
+
+class PluginConfigError(Exception):
+    """A plugin's parameters do not fit the robot (e.g. a `link` that the URDF does not have).
+    `param` names the parameter, so the error can point at its line in the scenario."""
+
+    def __init__(self, message: str, param: str | None = None, hint: str | None = None):
+        super().__init__(message)
+        self.param = param
+        self.hint = hint
+
+
+@dataclass(frozen=True)
+class Topic:
+    """A topic a plugin uses. `name` is relative to the robot's namespace unless it starts with '/'."""
+
+    name: str
+    type: str
+    direction: Literal["pub", "sub"] = "pub"
+    rate: float | None = None
+
+
+@dataclass
+class BuildContext:
+    """What `Plugin.build` sees: the robot's own MjSpec (names as in its URDF) before it is placed."""
+
+    spec: mujoco.MjSpec
+    robot: str
+    namespace: str
+    root: str
+
+    @property
+    def links(self) -> list[str]:
+        return [b.name for b in self.spec.bodies if b.name and b.name != "world"]
+
+    @property
+    def joints(self) -> list[str]:
+        return [j.name for j in self.spec.joints if j.name]
+
+    def body(self, name: str, param: str = "link") -> Any:
+        body = self.spec.body(name) if name else None
+        if body is None:
+            raise PluginConfigError(
+                f"robot {self.robot!r} has no link {name!r}", param, hint="links: " + ", ".join(self.links)
+            )
+        return body
+
+    def joint(self, name: str, param: str) -> Any:
+        joint = self.spec.joint(name) if name else None
+        if joint is None:
+            movable = [j.name for j in self.spec.joints if j.name and j.type != mujoco.mjtJoint.mjJNT_FREE]
+            raise PluginConfigError(
+                f"robot {self.robot!r} has no joint {name!r}", param, hint="joints: " + ", ".join(movable)
+            )
+        return joint
+
+
+class Publisher:
+    """Publishes one topic. Made by `RuntimeContext.publisher`; messages are rosbags message objects."""
+
+    def __init__(self, key: str, type_name: str, send: Callable[[Any, int], None]):
+        self.key = key
+        self.type = type_name
+        self._send = send
+
+    def publish(self, msg: Any, stamp_ns: int) -> None:
+        self._send(msg, stamp_ns)
+
+
+@dataclass
+class RuntimeContext:
+    """What a plugin sees at run time."""
+
+    model: mujoco.MjModel
+    data: mujoco.MjData
+    robot: RobotHandle
+    rng: np.random.Generator
+    run: str
+    _make_publisher: Callable[[str, str], Publisher] = field(repr=False)
+    _subscribe: Callable[[str, str, Callable[[Any, int], None]], None] = field(repr=False)
+
+    def publisher(self, topic: str, type_name: str) -> Publisher:
+        return self._make_publisher(topic, type_name)
+
+    def subscribe(self, topic: str, type_name: str, callback: Callable[[Any, int], None]) -> None:
+        """`callback(msg, stamp_ns)` is called in the sim loop, between physics steps."""
+        self._subscribe(topic, type_name, callback)
+
+
+class Plugin:
+    """Base class of every plugin. Subclasses set `Params` and override the hooks they need."""
+
+    Params: ClassVar[type[PluginParams]] = PluginParams
+    type_name: ClassVar[str] = ""
+
+    def __init__(self, params: PluginParams, ctx: RuntimeContext, name: str):
+        self.params = params
+        self.ctx = ctx
+        self.name = name
+
+    @classmethod
+    def build(cls, params: Any, ctx: BuildContext, name: str) -> list[Topic]:
+        """Compile time: change the robot's model, return the topics used."""
+        return []
+
+    @classmethod
+    def rate_of(cls, params: PluginParams) -> float | None:
+        rate = getattr(params, "rate", None)
+        return float(rate) if rate else None
+
+    def setup(self) -> None:
+        """Run time, once, before the first step."""
+
+    def before_step(self, now_ns: int) -> None:
+        """Act on the model before physics advances (controllers, commands)."""
+
+    def after_step(self, now_ns: int) -> None:
+        """Read the model after physics reached `now_ns` (sensors) and publish."""
+
+    def close(self) -> None:
+        """Run time, once, at the end."""
+
+
+def overrides(obj: Plugin, hook: str) -> bool:
+    return getattr(type(obj), hook) is not getattr(Plugin, hook)

@@ -1,0 +1,63 @@
+"""Plugins are found through the `scenario.plugins` entry-point group, loaded lazily, once.
+
+A name registered twice is an error; a plugin that fails to import is reported only when a scenario
+uses it.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from importlib.metadata import EntryPoint, entry_points
+
+from runner.plugin import Plugin
+
+GROUP = "scenario.plugins"
+
+
+class PluginLookupError(Exception):
+    def __init__(self, message: str, hint: str | None = None):
+        super().__init__(message)
+        self.hint = hint
+
+
+@cache
+def _entry_points() -> dict[str, list[EntryPoint]]:
+    found: dict[str, list[EntryPoint]] = {}
+    for ep in entry_points(group=GROUP):
+        found.setdefault(ep.name, []).append(ep)
+    return found
+
+
+def available() -> list[str]:
+    return sorted(_entry_points())
+
+
+@cache
+def load(name: str) -> type[Plugin]:
+    eps = _entry_points().get(name)
+    if not eps:
+        import difflib
+
+        close = difflib.get_close_matches(name, available(), n=1)
+        hint = f"did you mean {close[0]!r}? " if close else ""
+        raise PluginLookupError(
+            f"unknown plugin type {name!r}",
+            hint=hint + "installed plugins: " + ", ".join(available()),
+        )
+    distinct = {ep.value for ep in eps}
+    if len(distinct) > 1:
+        raise PluginLookupError(
+            f"plugin type {name!r} is registered more than once: " + ", ".join(sorted(distinct)),
+            hint="uninstall one of the packages that provide it",
+        )
+    try:
+        cls = eps[0].load()
+    except Exception as e:  # a broken third-party plugin: report it, only now that it is used
+        raise PluginLookupError(
+            f"plugin {name!r} ({eps[0].value}) failed to import: {type(e).__name__}: {e}",
+            hint="fix or reinstall the package that provides it",
+        ) from None
+    if not (isinstance(cls, type) and issubclass(cls, Plugin)):
+        raise PluginLookupError(f"{eps[0].value} is not a runner.plugin.Plugin subclass")
+    cls.type_name = name
+    return cls

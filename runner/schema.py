@@ -1,0 +1,221 @@
+"""The scenario file format (v1): the single source of truth.
+
+Pydantic models with `extra="forbid"` and a description on every field. `schemas/scenario.schema.json`
+is generated from `Scenario` (`scenario schema`); a test fails when the committed copy is stale.
+No I/O happens here: files named in a scenario are read by the compile pass.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, NonNegativeFloat, PositiveFloat, field_validator
+
+SCHEMA_VERSION = 1
+
+RUN_NAME_RE = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.\-]*$")
+# ROS 2 style names (so that the same names work over rmw_zenoh later); nested namespaces allowed.
+NAMESPACE_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*(/[A-Za-z][A-Za-z0-9_]*)*$")
+TOPIC_RE = re.compile(r"^/?[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*$")
+
+
+class Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", populate_by_name=False)
+
+
+Vec3 = Annotated[tuple[float, float, float], Field(description="[x, y, z]")]
+Rgba = Annotated[
+    tuple[float, float, float, float],
+    Field(description="[red, green, blue, alpha], each 0..1"),
+]
+RunName = Annotated[
+    str,
+    Field(
+        pattern=RUN_NAME_RE.pattern,
+        description="Letters, digits, '_', '-', '.'; the first chunk of every Zenoh key of the run.",
+    ),
+]
+Namespace = Annotated[
+    str,
+    Field(
+        pattern=NAMESPACE_RE.pattern,
+        description="A ROS-style name: letters, digits, '_' (may be nested with '/', e.g. 'fleet/r1').",
+    ),
+]
+Rate = Annotated[
+    Literal["realtime", "max"] | PositiveFloat,
+    Field(
+        description="Pacing against wall time: 'realtime', 'max' (as fast as possible) "
+        "or a real-time factor (2 = twice as fast as real time)."
+    ),
+]
+
+
+class Pose(Strict):
+    """A pose: position and roll-pitch-yaw (radians, fixed axes X then Y then Z, as in URDF)."""
+
+    xyz: Vec3 = Field((0.0, 0.0, 0.0), description="Position in metres.")
+    rpy: Vec3 = Field((0.0, 0.0, 0.0), description="Roll, pitch, yaw in radians.")
+
+
+class Physics(Strict):
+    timestep: PositiveFloat = Field(0.002, le=0.1, description="Physics step in seconds.")
+    gravity: Vec3 = Field((0.0, 0.0, -9.81), description="Gravity in m/s².")
+    integrator: Literal["euler", "implicitfast", "implicit", "rk4"] = Field(
+        "implicitfast", description="MuJoCo integrator; implicitfast is stable with velocity actuators."
+    )
+
+
+class Ground(Strict):
+    enabled: bool = Field(True, description="Add an infinite ground plane at z = 0.")
+    friction: PositiveFloat = Field(1.0, description="Sliding friction coefficient of the ground.")
+    rgba: Rgba = Field((0.55, 0.57, 0.6, 1.0), description="Colour of the ground.")
+
+
+class WorldModel(Strict):
+    """A primitive shape in the world: a wall, an obstacle, a box to push."""
+
+    name: Namespace = Field(description="Unique name of the model (its body is named after it).")
+    shape: Literal["box", "cylinder", "sphere"] = Field(description="Primitive shape.")
+    size: list[PositiveFloat] = Field(
+        description="box: [x, y, z] full lengths; cylinder: [radius, length]; sphere: [radius] (metres).",
+    )
+    pose: Pose = Field(default_factory=Pose, description="Pose of the shape's centre in the world.")
+    rgba: Rgba = Field((0.7, 0.7, 0.7, 1.0), description="Colour.")
+    static: bool = Field(True, description="A static model never moves; otherwise it is free and has `mass`.")
+    mass: PositiveFloat | None = Field(None, description="Mass in kg of a non-static model (default 1).")
+    friction: PositiveFloat = Field(1.0, description="Sliding friction coefficient.")
+
+    @field_validator("size")
+    @classmethod
+    def _size_len(cls, v: list[float], info: Any) -> list[float]:
+        need = {"box": 3, "cylinder": 2, "sphere": 1}.get(info.data.get("shape", ""), None)
+        if need is not None and len(v) != need:
+            shape = info.data["shape"]
+            form = {"box": "[x, y, z]", "cylinder": "[radius, length]", "sphere": "[radius]"}[shape]
+            raise ValueError(f"a {shape} needs {need} number(s) {form}, found {len(v)}")
+        return v
+
+
+class World(Strict):
+    physics: Physics = Field(default_factory=Physics, description="Physics settings.")
+    ground: Ground = Field(default_factory=Ground, description="The ground plane.")
+    models: list[WorldModel] = Field(default_factory=list, description="Primitive models in the world.")
+    clock_rate: PositiveFloat = Field(
+        100.0, description="How often sim time is published on `<run>/clock`, in sim Hz."
+    )
+
+
+XacroArg = str | int | float | bool
+
+
+class Description(Strict):
+    """Where a robot comes from."""
+
+    file: str = Field(
+        description="A URDF (.urdf) or xacro (.xacro, .urdf.xacro) file, relative to the scenario's folder."
+    )
+    args: dict[str, XacroArg] = Field(
+        default_factory=dict, description="xacro arguments (`$(arg name)`), as `name: value`."
+    )
+
+
+class PluginEntry(Strict):
+    """A plugin attached to a robot: `{type: lidar, params: {...}}`."""
+
+    type: str = Field(description="Plugin type, e.g. diff_drive, lidar, imu, joint_states, ground_truth.")
+    name: str | None = Field(None, description="Instance name (default: the type); unique per robot.")
+    params: dict[str, Any] = Field(
+        default_factory=dict, description="Parameters, checked against the plugin's own model at compile."
+    )
+
+
+class Robot(Strict):
+    name: Namespace = Field(description="Unique robot name.")
+    namespace: Namespace | None = Field(
+        None, description="Namespace of its topics and frames (default: the name): `<run>/<ns>/scan`."
+    )
+    description: Description | str = Field(
+        description="The robot's URDF/xacro file, or `{file: ..., args: {...}}` to pass xacro arguments."
+    )
+    pose: Pose = Field(default_factory=Pose, description="Spawn pose of the robot's root link.")
+    fixed: bool = Field(
+        False, description="Weld the root link to the world (an arm on a table) instead of a free base."
+    )
+    plugins: list[PluginEntry] = Field(default_factory=list, description="Plugins of this robot.")
+
+    @property
+    def ns(self) -> str:
+        return self.namespace or self.name
+
+    @property
+    def desc(self) -> Description:
+        return self.description if isinstance(self.description, Description) else Description(
+            file=self.description
+        )
+
+
+class TimelineEntry(Strict):
+    """At sim time `t`, publish a message on a topic of the run."""
+
+    t: NonNegativeFloat = Field(description="Sim time in seconds.")
+    topic: str = Field(
+        pattern=TOPIC_RE.pattern,
+        description="Topic inside the run's key space, e.g. `r1/cmd_vel` (-> `<run>/r1/cmd_vel`).",
+    )
+    type: str = Field(description="ROS 2 message type, e.g. `geometry_msgs/msg/Twist`.")
+    data: dict[str, Any] = Field(
+        default_factory=dict, description="Message fields as YAML; omitted fields are zero."
+    )
+
+
+class Record(Strict):
+    enabled: bool = Field(True, description="Record the run to MCAP.")
+    path: str | None = Field(
+        None,
+        description="MCAP file to write, relative to the scenario's folder (default: `runs/<name>.mcap` "
+        "in the current folder).",
+    )
+    include: list[str] = Field(
+        default_factory=lambda: ["**"],
+        description="Zenoh key expressions relative to the run (`*/scan`, `r1/**`) of topics to record.",
+    )
+    exclude: list[str] = Field(default_factory=list, description="Key expressions of topics not to record.")
+
+
+class Scenario(Strict):
+    """A robot-simulation scenario: a world, robots with plugins, a timeline, a recording."""
+
+    model_config = ConfigDict(
+        extra="forbid",
+        json_schema_extra={"$schema": "https://json-schema.org/draft/2020-12/schema"},
+        title="Scenario",
+    )
+
+    version: Literal[1] = Field(1, description="Scenario format version.")
+    name: RunName = Field(description="Run name: the first chunk of every key, e.g. `two_robots/r1/scan`.")
+    description: str = Field("", description="Free text.")
+    duration: PositiveFloat = Field(10.0, description="Sim seconds to run.")
+    rate: Rate = "realtime"
+    seed: int = Field(0, description="Seed of every random number (sensor noise...).")
+    packages: dict[str, str] = Field(
+        default_factory=dict,
+        description="ROS packages by name -> folder (relative to the scenario), for `$(find pkg)` and "
+        "`package://pkg/...`. Folders with a package.xml beside the scenario are found without this.",
+    )
+    world: World = Field(default_factory=World, description="Physics, ground and primitive models.")
+    robots: list[Robot] = Field(default_factory=list, description="Robots and their plugins.")
+    timeline: list[TimelineEntry] = Field(default_factory=list, description="Messages to publish at sim times.")
+    record: Record = Field(default_factory=Record, description="What to record, and where.")
+
+    @field_validator("rate", mode="before")
+    @classmethod
+    def _rate(cls, v: Any) -> Any:
+        if v in ("realtime", "max"):
+            return v
+        if isinstance(v, bool) or not isinstance(v, int | float) or v <= 0:
+            raise ValueError(
+                "rate must be 'realtime', 'max' or a positive real-time factor (e.g. 2.0)"
+            )
+        return float(v)

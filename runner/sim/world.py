@@ -1,0 +1,292 @@
+"""The world: steps MuJoCo, runs plugin hooks at their rates, applies the timeline, paces against wall time.
+
+Time is integer nanoseconds of sim time, counted in whole physics steps (`now = steps * step_ns`), so
+rates and timeline entries land on exact steps and a run is repeatable.
+
+At each boundary time `t` where something is due, in this order:
+  1. `after_step` hooks due at t (sensors read the state at t and publish);
+  2. timeline entries with time <= t (published, and delivered to local subscribers at once);
+  3. messages from other processes that arrived since the last boundary (delivered in arrival order);
+  4. `before_step` hooks due at t (controllers act on the commands);
+  5. the clock, if due;
+then MuJoCo steps (`mj_step(..., nstep=n)`) straight to the next boundary.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import queue
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from runner import msgs
+from runner.plan import RobotPlan, RunPlan, topic_key
+from runner.plugin import Plugin, Publisher, RuntimeContext, overrides
+from runner.registry import load
+from runner.transport import Bus, meta_key, pack_attachment
+
+# Without anything due, the loop still stops this often (sim time) to take input and check for a stop.
+MAX_BATCH_NS = 10_000_000
+
+
+class RobotHandle:
+    """A robot inside the compiled world: its MuJoCo ids and its names (prefixed and namespaced)."""
+
+    def __init__(self, model: mujoco.MjModel, plan: RobotPlan):
+        self.model = model
+        self.name = plan.name
+        self.namespace = plan.namespace
+        self.prefix = plan.prefix
+        self.plan = plan
+        self.root_link = plan.root
+        self.root_body = self.body_id(plan.root)
+        self.body_ids = {
+            b for b in range(model.nbody) if (model.body(b).name or "").startswith(self.prefix)
+        }
+        self.geom_ids = np.array(
+            [g for g in range(model.ngeom) if int(model.geom_bodyid[g]) in self.body_ids], dtype=np.int32
+        )
+        free = self._id(mujoco.mjtObj.mjOBJ_JOINT, "root", required=False)
+        self.free_joint = free if free >= 0 else None
+
+    def _id(self, kind: mujoco.mjtObj, name: str, required: bool = True) -> int:
+        i = mujoco.mj_name2id(self.model, kind, self.prefix + name)
+        if i < 0 and required:
+            raise KeyError(f"{kind.name} {self.prefix + name!r} not in the model")
+        return i
+
+    def body_id(self, link: str) -> int:
+        return self._id(mujoco.mjtObj.mjOBJ_BODY, link)
+
+    def joint_id(self, name: str) -> int:
+        return self._id(mujoco.mjtObj.mjOBJ_JOINT, name)
+
+    def site_id(self, name: str) -> int:
+        return self._id(mujoco.mjtObj.mjOBJ_SITE, name)
+
+    def actuator_id(self, name: str) -> int:
+        return self._id(mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+
+    def sensor_slice(self, name: str) -> slice:
+        i = self._id(mujoco.mjtObj.mjOBJ_SENSOR, name)
+        adr = int(self.model.sensor_adr[i])
+        return slice(adr, adr + int(self.model.sensor_dim[i]))
+
+    def frame(self, link: str) -> str:
+        """The TF frame id of a link: `<ns>/<link>`."""
+        return f"{self.namespace}/{link}"
+
+
+@dataclass
+class _Hook:
+    fn: Callable[[int], None]
+    period_ns: int  # 0: every step
+    next_ns: int = 0
+
+
+@dataclass
+class _Outgoing:
+    key: str
+    type: str
+    send: Callable[[bytes, bytes], None]
+    seq: int = 0
+
+
+@dataclass
+class WorldStats:
+    steps: int = 0
+    sim_ns: int = 0
+    wall_s: float = 0.0
+    published: dict[str, int] = field(default_factory=dict)
+
+
+class World:
+    def __init__(self, plan: RunPlan, bus: Bus):
+        self.plan = plan
+        self.bus = bus
+        self.model = mujoco.MjModel.from_xml_string(plan.mjcf)
+        self.data = mujoco.MjData(self.model)
+        mujoco.mj_forward(self.model, self.data)
+        self.step_ns = plan.step_ns
+        self.now_ns = 0
+        self.rng = np.random.default_rng(plan.seed)
+        self._out: dict[str, _Outgoing] = {}
+        self._local: dict[str, list[tuple[str, Callable[[Any, int], None]]]] = {}
+        self._remote_subscribed: set[str] = set()
+        self._inbox: queue.SimpleQueue[tuple[str, bytes, bytes | None]] = queue.SimpleQueue()
+        self.robots = [RobotHandle(self.model, r) for r in plan.robots]
+        self.plugins: list[Plugin] = []
+        self._before: list[_Hook] = []
+        self._after: list[_Hook] = []
+        for handle in self.robots:
+            for pp in handle.plan.plugins:
+                cls = load(pp.type)
+                params = cls.Params.model_validate(pp.params)
+                ctx = RuntimeContext(
+                    model=self.model,
+                    data=self.data,
+                    robot=handle,
+                    rng=np.random.default_rng([plan.seed, len(self.plugins)]),
+                    run=plan.name,
+                    _make_publisher=self._publisher_factory(handle.namespace),
+                    _subscribe=self._subscriber_factory(handle.namespace),
+                )
+                plugin = cls(params, ctx, pp.name)
+                self.plugins.append(plugin)
+                period = 0 if not pp.rate else round(1e9 / pp.rate)
+                if overrides(plugin, "before_step"):
+                    self._before.append(_Hook(plugin.before_step, period))
+                if overrides(plugin, "after_step"):
+                    self._after.append(_Hook(plugin.after_step, period))
+        self._clock = self._make_publisher(plan.clock_key, "rosgraph_msgs/msg/Clock")
+        self._clock_hook = _Hook(self._publish_clock, round(1e9 / plan.clock_rate))
+        self._timeline = [
+            (ev.t_ns, ev.key, ev.type, msgs.from_data(ev.type, ev.data)) for ev in plan.timeline
+        ]
+        self._timeline_i = 0
+        for plugin in self.plugins:
+            plugin.setup()
+
+    # ------------------------------------------------------------------------------------- pub / sub
+    def _make_publisher(self, key: str, type_name: str) -> _Outgoing:
+        out = self._out.get(key)
+        if out is None:
+            out = _Outgoing(key, type_name, self.bus.publisher(key, type_name))
+            self._out[key] = out
+        elif out.type != type_name:
+            raise ValueError(f"{key} is published as {out.type} and as {type_name}")
+        return out
+
+    def publish(self, out: _Outgoing, msg: Any, stamp_ns: int) -> None:
+        payload = msgs.encode(msg, out.type)
+        out.send(payload, pack_attachment(out.seq, stamp_ns))
+        out.seq += 1
+        for _type, cb in self._local.get(out.key, ()):
+            cb(msg, stamp_ns)
+
+    def _publisher_factory(self, namespace: str) -> Callable[[str, str], Publisher]:
+        def make(topic: str, type_name: str) -> Publisher:
+            type_name = msgs.normalize_type(type_name)
+            out = self._make_publisher(topic_key(self.plan.name, namespace, topic), type_name)
+            return Publisher(out.key, type_name, lambda msg, stamp: self.publish(out, msg, stamp))
+
+        return make
+
+    def _subscriber_factory(self, namespace: str) -> Callable[[str, str, Callable[[Any, int], None]], None]:
+        def subscribe(topic: str, type_name: str, callback: Callable[[Any, int], None]) -> None:
+            key = topic_key(self.plan.name, namespace, topic)
+            self._local.setdefault(key, []).append((msgs.normalize_type(type_name), callback))
+            if key not in self._remote_subscribed:
+                self._remote_subscribed.add(key)
+                self.bus.subscribe(key, lambda k, p, a: self._inbox.put((k, p, a)))
+
+        return subscribe
+
+    def _drain_inbox(self) -> None:
+        while True:
+            try:
+                key, payload, _att = self._inbox.get_nowait()
+            except queue.Empty:
+                return
+            for type_name, cb in self._local.get(key, ()):
+                try:
+                    msg = msgs.decode(payload, type_name)
+                except Exception:
+                    continue  # not a message of the subscribed type; a foreign publisher's mistake
+                cb(msg, self.now_ns)
+
+    # ------------------------------------------------------------------------------------------- loop
+    def _boundary(self) -> None:
+        now = self.now_ns
+        for h in self._after:
+            if now >= h.next_ns:
+                h.fn(now)
+                h.next_ns = _next_due(h, now)
+        while self._timeline_i < len(self._timeline) and self._timeline[self._timeline_i][0] <= now:
+            _t, key, type_name, msg = self._timeline[self._timeline_i]
+            self.publish(self._make_publisher(key, type_name), msg, now)
+            self._timeline_i += 1
+        self._drain_inbox()
+        for h in self._before:
+            if now >= h.next_ns:
+                h.fn(now)
+                h.next_ns = _next_due(h, now)
+        clock = self._clock_hook
+        if now >= clock.next_ns:
+            clock.fn(now)
+            clock.next_ns = _next_due(clock, now)
+
+    def _publish_clock(self, now: int) -> None:
+        self.publish(self._clock, msgs.T["rosgraph_msgs/msg/Clock"](clock=msgs.time_msg(now)), now)
+
+    def _next_boundary(self, end_ns: int) -> int:
+        nxt = min(end_ns, self.now_ns + MAX_BATCH_NS, self._clock_hook.next_ns)
+        for h in self._after:
+            nxt = min(nxt, h.next_ns)
+        for h in self._before:
+            nxt = min(nxt, h.next_ns)
+        if self._timeline_i < len(self._timeline):
+            nxt = min(nxt, self._timeline[self._timeline_i][0])
+        return nxt
+
+    def run(
+        self,
+        should_stop: Callable[[], bool] = lambda: False,
+        on_progress: Callable[[int], None] | None = None,
+    ) -> WorldStats:
+        plan = self.plan
+        end_ns = plan.duration_ns
+        factor = {"realtime": 1.0, "max": None}.get(plan.rate, plan.rate)  # type: ignore[arg-type]
+        wall0 = time.perf_counter()
+        next_check = wall0
+        steps = 0
+        while True:
+            self._boundary()
+            if self.now_ns >= end_ns:
+                break
+            target = self._next_boundary(end_ns)
+            n = max(1, math.ceil((target - self.now_ns) / self.step_ns))
+            mujoco.mj_step(self.model, self.data, nstep=n)
+            steps += n
+            self.now_ns += n * self.step_ns
+            wall = time.perf_counter()
+            if factor is not None:
+                ahead = self.now_ns / 1e9 / factor - (wall - wall0)
+                if ahead > 0:
+                    time.sleep(ahead)
+                    wall = time.perf_counter()
+            if wall >= next_check:
+                next_check = wall + 0.05
+                if on_progress:
+                    on_progress(self.now_ns)
+                if should_stop():
+                    break
+        for plugin in self.plugins:
+            plugin.close()
+        return WorldStats(
+            steps=steps,
+            sim_ns=self.now_ns,
+            wall_s=time.perf_counter() - wall0,
+            published={k: o.seq for k, o in self._out.items()},
+        )
+
+    def announce_end(self, stats: WorldStats, reason: str) -> None:
+        """Tell the recorder how many messages each topic carried, so it knows when it has them all."""
+        payload = json.dumps(
+            {"reason": reason, "sim_ns": stats.sim_ns, "steps": stats.steps, "wall_s": stats.wall_s,
+             "published": stats.published}
+        ).encode()
+        self.bus.put_meta(meta_key(self.plan.name, "world", "end"), payload)
+
+
+def _next_due(h: _Hook, now: int) -> int:
+    if h.period_ns == 0:
+        return now + 1
+    nxt = h.next_ns + h.period_ns
+    return nxt if nxt > now else (now // h.period_ns + 1) * h.period_ns

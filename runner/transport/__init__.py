@@ -1,0 +1,150 @@
+"""Zenoh: session configuration, the wire format of our samples, and the `Bus` the world publishes on.
+
+Wire format of every sample the simulation publishes:
+- key: `<run>/<ns>/<topic>` (or `<run>/clock`); run metadata under `<run>/@meta/...` (a verbatim chunk,
+  so `<run>/**` never matches it);
+- payload: the CDR encoding of a ROS 2 message;
+- encoding: `application/cdr;<ros type>` (e.g. `application/cdr;sensor_msgs/msg/LaserScan`);
+- attachment: 16 bytes, little-endian `uint64 sequence number, int64 sim time in ns`.
+"""
+
+from __future__ import annotations
+
+import json
+import socket
+import struct
+from collections.abc import Callable, Sequence
+from typing import Any, Protocol
+
+import zenoh
+
+ATTACHMENT = struct.Struct("<Qq")
+META = "@meta"
+
+
+def pack_attachment(seq: int, stamp_ns: int) -> bytes:
+    return ATTACHMENT.pack(seq, stamp_ns)
+
+
+def unpack_attachment(data: bytes | None) -> tuple[int, int] | None:
+    if data is None or len(data) != ATTACHMENT.size:
+        return None
+    return ATTACHMENT.unpack(data)
+
+
+def encoding_for(type_name: str) -> zenoh.Encoding:
+    return zenoh.Encoding.APPLICATION_CDR.with_schema(type_name)
+
+
+def type_from_encoding(encoding: Any) -> str | None:
+    text = str(encoding)
+    if text.startswith("application/cdr;"):
+        return text.split(";", 1)[1] or None
+    return None
+
+
+def meta_key(run: str, *parts: str) -> str:
+    return "/".join((run, META, *parts))
+
+
+def free_port(host: str = "127.0.0.1") -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind((host, 0))
+        return int(s.getsockname()[1])
+
+
+def make_config(
+    mode: str,
+    *,
+    listen: Sequence[str] = (),
+    connect: Sequence[str] = (),
+) -> zenoh.Config:
+    """A Zenoh config with multicast scouting off: peers find each other only through explicit endpoints."""
+    conf = zenoh.Config()
+    conf.insert_json5("mode", json.dumps(mode))
+    conf.insert_json5("scouting/multicast/enabled", "false")
+    conf.insert_json5("scouting/delay", "0")
+    if listen:
+        conf.insert_json5("listen/endpoints", json.dumps(list(listen)))
+    if connect:
+        conf.insert_json5("connect/endpoints", json.dumps(list(connect)))
+    if mode == "client":
+        # A client started a moment before its router keeps retrying instead of failing at once.
+        conf.insert_json5("connect/timeout_ms", "10000")
+    return conf
+
+
+class Bus(Protocol):
+    """What the world process publishes on and listens to. `ZenohBus` in runs; `MemoryBus` in unit tests."""
+
+    def publisher(self, key: str, type_name: str) -> Callable[[bytes, bytes], None]: ...
+
+    def subscribe(self, key: str, callback: Callable[[str, bytes, bytes | None], None]) -> None: ...
+
+    def put_meta(self, key: str, payload: bytes) -> None: ...
+
+
+class ZenohBus:
+    def __init__(self, session: zenoh.Session):
+        self.session = session
+        self._keep: list[Any] = []
+
+    def publisher(self, key: str, type_name: str) -> Callable[[bytes, bytes], None]:
+        pub = self.session.declare_publisher(
+            key,
+            encoding=encoding_for(type_name),
+            congestion_control=zenoh.CongestionControl.BLOCK,
+            reliability=zenoh.Reliability.RELIABLE,
+        )
+        self._keep.append(pub)
+
+        def send(payload: bytes, attachment: bytes) -> None:
+            pub.put(payload, attachment=attachment)
+
+        return send
+
+    def subscribe(self, key: str, callback: Callable[[str, bytes, bytes | None], None]) -> None:
+        def on_sample(sample: zenoh.Sample) -> None:
+            att = sample.attachment
+            callback(str(sample.key_expr), sample.payload.to_bytes(), att.to_bytes() if att else None)
+
+        # REMOTE only: what this process publishes is delivered to its own plugins directly, in order.
+        self._keep.append(
+            self.session.declare_subscriber(key, on_sample, allowed_origin=zenoh.Locality.REMOTE)
+        )
+
+    def put_meta(self, key: str, payload: bytes) -> None:
+        self.session.put(key, payload, congestion_control=zenoh.CongestionControl.BLOCK)
+
+    def undeclare_all(self) -> None:
+        for ent in self._keep:
+            try:
+                ent.undeclare()
+            except Exception:
+                pass
+        self._keep.clear()
+
+
+class MemoryBus:
+    """An in-process bus for unit tests of logic: keeps what was published, lets a test inject input."""
+
+    def __init__(self) -> None:
+        self.sent: list[tuple[str, str, bytes, bytes]] = []
+        self.meta: list[tuple[str, bytes]] = []
+        self._subs: dict[str, list[Callable[[str, bytes, bytes | None], None]]] = {}
+
+    def publisher(self, key: str, type_name: str) -> Callable[[bytes, bytes], None]:
+        def send(payload: bytes, attachment: bytes) -> None:
+            self.sent.append((key, type_name, payload, attachment))
+
+        return send
+
+    def subscribe(self, key: str, callback: Callable[[str, bytes, bytes | None], None]) -> None:
+        self._subs.setdefault(key, []).append(callback)
+
+    def put_meta(self, key: str, payload: bytes) -> None:
+        self.meta.append((key, payload))
+
+    def inject(self, key: str, payload: bytes, attachment: bytes | None = None) -> None:
+        for cb in self._subs.get(key, []):
+            cb(key, payload, attachment)
