@@ -34,7 +34,9 @@ def add_site(ctx: BuildContext, link: str, name: str, pose: MountPose) -> str:
     body = ctx.body(link)
     site_name = f"{name}_site"
     if ctx.spec.site(site_name) is not None:
-        raise PluginConfigError(f"a site named {site_name!r} already exists", hint="give the plugin a `name:`")
+        raise PluginConfigError(
+            f"a site named {site_name!r} already exists", hint="give the plugin a `name:`"
+        )
     body.add_site(
         name=site_name,
         pos=list(pose.xyz),

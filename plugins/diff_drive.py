@@ -21,7 +21,7 @@ from runner import msgs
 from runner.geometry import quat_to_yaw, yaw_to_quat
 from runner.plugin import BuildContext, Plugin, PluginConfigError, RatedParams, Topic
 
-
+_INTEGRAL_TIME_S = 0.2
 _ROUND = {
     int(mujoco.mjtGeom.mjGEOM_CYLINDER),
     int(mujoco.mjtGeom.mjGEOM_SPHERE),
@@ -59,7 +59,9 @@ class DiffDriveParams(RatedParams):
     odometry_source: Literal["encoders", "world"] = Field(
         "encoders", description="Integrate wheel encoders, or report the true pose."
     )
-    cmd_timeout: float = Field(0.0, ge=0, description="Stop when no command came for this long, s (0: never).")
+    cmd_timeout: float = Field(
+        0.0, ge=0, description="Stop when no command came for this long, s (0: never)."
+    )
 
 
 class DiffDrive(Plugin):
@@ -72,7 +74,9 @@ class DiffDrive(Plugin):
             joint = ctx.joint(jname, f"{side}_joint")
             if joint.type != mujoco.mjtJoint.mjJNT_HINGE:
                 raise PluginConfigError(f"wheel joint {jname!r} is not revolute/continuous", f"{side}_joint")
-            act = ctx.spec.add_actuator(name=f"{name}/{side}", target=jname, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+            act = ctx.spec.add_actuator(
+                name=f"{name}/{side}", target=jname, trntype=mujoco.mjtTrn.mjTRN_JOINT
+            )
             act.set_to_velocity(kv=params.gain or 1.0)  # the automatic gain is set in setup()
             act.forcelimited = True
             act.forcerange = [-params.max_wheel_torque, params.max_wheel_torque]
@@ -92,7 +96,9 @@ class DiffDrive(Plugin):
         self.qadr = [int(m.jnt_qposadr[j]) for j in joints]
         self.vadr = [int(m.jnt_dofadr[j]) for j in joints]
         wheel_bodies = [int(m.jnt_bodyid[j]) for j in joints]
-        self.sep = p.wheel_separation or float(np.linalg.norm(d.xpos[wheel_bodies[0]] - d.xpos[wheel_bodies[1]]))
+        self.sep = p.wheel_separation or float(
+            np.linalg.norm(d.xpos[wheel_bodies[0]] - d.xpos[wheel_bodies[1]])
+        )
         self.radius = p.wheel_radius or _wheel_radius(m, wheel_bodies[0])
         self.base = r.root_body
         if p.gain is None:
@@ -106,10 +112,15 @@ class DiffDrive(Plugin):
         self.cmd_time = 0
         self.target = np.zeros(2)
         self.ctrl = np.zeros(2)
+        # Integral of the wheel-speed error: a velocity servo alone lags under load (tyre scrub when
+        # turning, slopes); Gazebo's diff drive holds the commanded wheel speed up to the torque limit.
+        self.integral = np.zeros(2)
+        self.integral_max = 0.0
         self.dt = 1.0 / p.rate
         # encoder odometry state
         self.x = self.y = self.yaw = 0.0
         self.last_q = np.array([d.qpos[a] for a in self.qadr])
+        self.integral_max = p.max_wheel_torque / float(m.actuator_gainprm[self.act[0], 0])
         self.ctx.subscribe(p.cmd_topic, "geometry_msgs/msg/Twist", self._on_cmd)
         self.odom_pub = self.ctx.publisher(p.odom_topic, "nav_msgs/msg/Odometry") if p.publish_odom else None
         self.tf_pub = self.ctx.publisher(p.tf_topic, "tf2_msgs/msg/TFMessage") if p.publish_tf else None
@@ -131,8 +142,11 @@ class DiffDrive(Plugin):
         else:
             self.ctrl[:] = self.target
         d = self.ctx.data
-        d.ctrl[self.act[0]] = self.ctrl[0]
-        d.ctrl[self.act[1]] = self.ctrl[1]
+        speed = np.array([d.qvel[self.vadr[0]], d.qvel[self.vadr[1]]])
+        self.integral += (self.ctrl - speed) * (self.dt / _INTEGRAL_TIME_S)
+        np.clip(self.integral, -self.integral_max, self.integral_max, out=self.integral)
+        d.ctrl[self.act[0]] = self.ctrl[0] + self.integral[0]
+        d.ctrl[self.act[1]] = self.ctrl[1] + self.integral[1]
 
     def after_step(self, now_ns: int) -> None:
         d = self.ctx.data
@@ -165,7 +179,9 @@ class DiffDrive(Plugin):
                 header=msgs.header(now_ns, self.odom_frame),
                 child_frame_id=self.base_frame,
                 transform=T["geometry_msgs/msg/Transform"](
-                    translation=T["geometry_msgs/msg/Vector3"](x=float(pos[0]), y=float(pos[1]), z=float(pos[2])),
+                    translation=T["geometry_msgs/msg/Vector3"](
+                        x=float(pos[0]), y=float(pos[1]), z=float(pos[2])
+                    ),
                     rotation=T["geometry_msgs/msg/Quaternion"](
                         x=float(quat[1]), y=float(quat[2]), z=float(quat[3]), w=float(quat[0])
                     ),

@@ -43,8 +43,14 @@ class GroundTruth(Plugin):
         m, d = self.ctx.model, self.ctx.data
         mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, self.body, self.vel, 0)
         self.pub.publish(
-            odometry(now_ns, self.params.frame_id, self.child, d.xpos[self.body], d.xquat[self.body],
-                     self.vel[3:], self.vel[:3]),
+            odometry(
+                now_ns,
+                self.params.frame_id,
+                self.child,
+                d.xpos[self.body],
+                d.xquat[self.body],
+                self.vel[3:],
+                self.vel[:3],
+            ),
             now_ns,
         )
-

@@ -17,7 +17,9 @@ from runner.plugin import BuildContext, Plugin, RatedParams, Topic
 
 class ImuParams(RatedParams):
     rate: float = Field(100.0, gt=0, description="Publish rate, sim Hz.")
-    link: str | None = Field(None, description="Link of the IMU (default: a link named like imu, else the root).")
+    link: str | None = Field(
+        None, description="Link of the IMU (default: a link named like imu, else the root)."
+    )
     pose: MountPose = Field(default_factory=MountPose, description="Mount pose relative to the link.")
     topic: str = Field("imu", description="Topic, relative to the robot's namespace.")
     frame_id: str | None = Field(None, description="Frame id in the header (default: <ns>/<link>).")
@@ -55,7 +57,9 @@ class Imu(Plugin):
         self.pub = self.ctx.publisher(p.topic, "sensor_msgs/msg/Imu")
         T = msgs.T
         self.Imu, self.Quat, self.Vec = (
-            T["sensor_msgs/msg/Imu"], T["geometry_msgs/msg/Quaternion"], T["geometry_msgs/msg/Vector3"],
+            T["sensor_msgs/msg/Imu"],
+            T["geometry_msgs/msg/Quaternion"],
+            T["geometry_msgs/msg/Vector3"],
         )
         self.cov_o = np.eye(3).reshape(-1) * p.orientation_stddev**2
         self.cov_w = np.eye(3).reshape(-1) * p.angular_velocity_stddev**2

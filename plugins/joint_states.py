@@ -18,7 +18,9 @@ _MOVABLE = {int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)}
 class JointStatesParams(RatedParams):
     rate: float = Field(50.0, gt=0, description="Publish rate, sim Hz.")
     topic: str = Field("joint_states", description="Topic, relative to the robot's namespace.")
-    joints: list[str] | None = Field(None, description="Joints to publish (default: every revolute/prismatic).")
+    joints: list[str] | None = Field(
+        None, description="Joints to publish (default: every revolute/prismatic)."
+    )
 
 
 class JointStates(Plugin):
@@ -40,7 +42,8 @@ class JointStates(Plugin):
             ids = [r.joint_id(j) for j in self.params.joints]
         else:
             ids = [
-                j for j in range(m.njnt)
+                j
+                for j in range(m.njnt)
                 if int(m.jnt_bodyid[j]) in r.body_ids and int(m.jnt_type[j]) in _MOVABLE
             ]
         self.names = [m.joint(j).name.removeprefix(r.prefix) for j in ids]

@@ -86,8 +86,18 @@ class Lidar(Plugin):
         rot = d.site_xmat[self.site].reshape(3, 3)
         vec = (rot @ self.local).T.copy()  # n x 3
         mujoco.mj_multiRay(
-            m, d, origin, vec.reshape(-1), self.geomgroup, 1, self.body,
-            self.geomid, self.dist, None, len(self.dist), p.range_max,
+            m,
+            d,
+            origin,
+            vec.reshape(-1),
+            self.geomgroup,
+            1,
+            self.body,
+            self.geomid,
+            self.dist,
+            None,
+            len(self.dist),
+            p.range_max,
         )
         dist = self.dist.copy()
         redo = np.nonzero((self.geomid >= 0) & self.skip[np.maximum(self.geomid, 0)])[0]

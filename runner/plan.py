@@ -70,7 +70,9 @@ class RunPlan(BaseModel):
         return f"{self.name}/clock"
 
     def topics(self) -> list[TopicPlan]:
-        out = [TopicPlan(key=self.clock_key, type="rosgraph_msgs/msg/Clock", rate=self.clock_rate, owner="world")]
+        out = [
+            TopicPlan(key=self.clock_key, type="rosgraph_msgs/msg/Clock", rate=self.clock_rate, owner="world")
+        ]
         seen = {self.clock_key}
         for r in self.robots:
             for p in r.plugins:

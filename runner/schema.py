@@ -90,7 +90,7 @@ class WorldModel(Strict):
     @field_validator("size")
     @classmethod
     def _size_len(cls, v: list[float], info: Any) -> list[float]:
-        need = {"box": 3, "cylinder": 2, "sphere": 1}.get(info.data.get("shape", ""), None)
+        need = {"box": 3, "cylinder": 2, "sphere": 1}.get(info.data.get("shape", ""))
         if need is not None and len(v) != need:
             shape = info.data["shape"]
             form = {"box": "[x, y, z]", "cylinder": "[radius, length]", "sphere": "[radius]"}[shape]
@@ -151,8 +151,10 @@ class Robot(Strict):
 
     @property
     def desc(self) -> Description:
-        return self.description if isinstance(self.description, Description) else Description(
-            file=self.description
+        return (
+            self.description
+            if isinstance(self.description, Description)
+            else Description(file=self.description)
         )
 
 
@@ -206,7 +208,9 @@ class Scenario(Strict):
     )
     world: World = Field(default_factory=World, description="Physics, ground and primitive models.")
     robots: list[Robot] = Field(default_factory=list, description="Robots and their plugins.")
-    timeline: list[TimelineEntry] = Field(default_factory=list, description="Messages to publish at sim times.")
+    timeline: list[TimelineEntry] = Field(
+        default_factory=list, description="Messages to publish at sim times."
+    )
     record: Record = Field(default_factory=Record, description="What to record, and where.")
 
     @field_validator("rate", mode="before")
@@ -215,7 +219,5 @@ class Scenario(Strict):
         if v in ("realtime", "max"):
             return v
         if isinstance(v, bool) or not isinstance(v, int | float) or v <= 0:
-            raise ValueError(
-                "rate must be 'realtime', 'max' or a positive real-time factor (e.g. 2.0)"
-            )
+            raise ValueError("rate must be 'realtime', 'max' or a positive real-time factor (e.g. 2.0)")
         return float(v)

@@ -27,10 +27,9 @@ def _resolve(data: Any, loc: tuple[Any, ...], about_keys: bool) -> tuple[PathKey
     missing = False
     for i, el in enumerate(loc):
         last = i == len(loc) - 1
-        if isinstance(cur, dict) and el in cur:
-            path.append(el)
-            cur = cur[el]
-        elif isinstance(cur, list) and isinstance(el, int) and 0 <= el < len(cur):
+        in_dict = isinstance(cur, dict) and el in cur
+        in_list = isinstance(cur, list) and isinstance(el, int) and 0 <= el < len(cur)
+        if in_dict or in_list:
             path.append(el)
             cur = cur[el]
         elif last and about_keys and isinstance(cur, dict) and isinstance(el, str):
@@ -115,7 +114,7 @@ def problems_from_validation(
             errs = specific
         elif len(errs) > 1:
             words = sorted({_TYPE_WORDS.get(x[0]["type"], x[0]["type"]) for x in errs})
-            e0, value, _ = errs[0]
+            _e0, value, _ = errs[0]
             problems.append(
                 Problem(
                     "wrong type",
@@ -166,9 +165,7 @@ def _problem(
             hint=f"add `{key}:` ({desc})" if desc else f"add `{key}:`",
         )
     if kind == "value_error":
-        return Problem(
-            msg.removeprefix("Value error, "), doc.locate(full), full, found=_short(value)
-        )
+        return Problem(msg.removeprefix("Value error, "), doc.locate(full), full, found=_short(value))
     expected = msg.removeprefix("Input should be ") if msg.startswith("Input should be ") else None
     if expected:
         expected = expected.split(", unable to parse")[0]
@@ -176,9 +173,7 @@ def _problem(
     return Problem(msg, doc.locate(full), full, found=_short(value))
 
 
-def validate_model(
-    model: type[M], data: Any, doc: Document, prefix: PathKey = ()
-) -> M:
+def validate_model(model: type[M], data: Any, doc: Document, prefix: PathKey = ()) -> M:
     try:
         return model.model_validate(data)
     except ValidationError as err:

@@ -126,7 +126,9 @@ def _world_spec(sc: Scenario) -> mujoco.MjSpec:
     spec.option.integrator = _INTEGRATOR[phys.integrator]
     spec.visual.global_.offwidth = 1280
     spec.visual.global_.offheight = 960
-    spec.worldbody.add_light(name="sun", pos=[0, 0, 10], dir=[0.2, 0.1, -1], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL)
+    spec.worldbody.add_light(
+        name="sun", pos=[0, 0, 10], dir=[0.2, 0.1, -1], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL
+    )
     ground = sc.world.ground
     if ground.enabled:
         spec.worldbody.add_geom(

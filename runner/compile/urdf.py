@@ -86,9 +86,7 @@ def _check_structure(root: ET.Element, file: Path | None) -> str:
     return str(roots[0])
 
 
-def urdf_to_model(
-    urdf: str, file: Path | None, packages: PackageMap, *, fixed: bool = False
-) -> RobotModel:
+def urdf_to_model(urdf: str, file: Path | None, packages: PackageMap, *, fixed: bool = False) -> RobotModel:
     base_dir = file.parent if file else Path.cwd()
     try:
         root = ET.fromstring(urdf)

@@ -44,7 +44,8 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> str:
                 f"package {pkg!r} not found (asked by $(find {pkg}))",
                 Path(xacro.filestack[-1]) if getattr(xacro, "filestack", None) else path,
                 hint="add it under `packages:` in the scenario, or put its folder (with a package.xml) "
-                "beside the scenario or on SCENARIO_PACKAGE_PATH; searched: " + ", ".join(packages.searched()),
+                "beside the scenario or on SCENARIO_PACKAGE_PATH; searched: "
+                + ", ".join(packages.searched()),
             )
         return str(root)
 
@@ -60,8 +61,11 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> str:
         except MissingPackage:
             raise
         except xml.parsers.expat.ExpatError as e:
-            raise XacroError(f"not well-formed XML: {xml.parsers.expat.errors.messages.get(e.code, e)}",
-                             _current_file(path), e.lineno) from None
+            raise XacroError(
+                f"not well-formed XML: {xml.parsers.expat.errors.messages.get(e.code, e)}",
+                _current_file(path),
+                e.lineno,
+            ) from None
         except Exception as e:
             cause = e.__cause__ or e.__context__
             if isinstance(cause, MissingPackage):

@@ -14,7 +14,6 @@ then MuJoCo steps (`mj_step(..., nstep=n)`) straight to the next boundary.
 
 from __future__ import annotations
 
-import json
 import math
 import queue
 import time
@@ -29,7 +28,7 @@ from runner import msgs
 from runner.plan import RobotPlan, RunPlan, topic_key
 from runner.plugin import Plugin, Publisher, RuntimeContext, overrides
 from runner.registry import load
-from runner.transport import Bus, meta_key, pack_attachment
+from runner.transport import Bus, pack_attachment
 
 # Without anything due, the loop still stops this often (sim time) to take input and check for a stop.
 MAX_BATCH_NS = 10_000_000
@@ -46,9 +45,7 @@ class RobotHandle:
         self.plan = plan
         self.root_link = plan.root
         self.root_body = self.body_id(plan.root)
-        self.body_ids = {
-            b for b in range(model.nbody) if (model.body(b).name or "").startswith(self.prefix)
-        }
+        self.body_ids = {b for b in range(model.nbody) if (model.body(b).name or "").startswith(self.prefix)}
         self.geom_ids = np.array(
             [g for g in range(model.ngeom) if int(model.geom_bodyid[g]) in self.body_ids], dtype=np.int32
         )
@@ -275,14 +272,6 @@ class World:
             wall_s=time.perf_counter() - wall0,
             published={k: o.seq for k, o in self._out.items()},
         )
-
-    def announce_end(self, stats: WorldStats, reason: str) -> None:
-        """Tell the recorder how many messages each topic carried, so it knows when it has them all."""
-        payload = json.dumps(
-            {"reason": reason, "sim_ns": stats.sim_ns, "steps": stats.steps, "wall_s": stats.wall_s,
-             "published": stats.published}
-        ).encode()
-        self.bus.put_meta(meta_key(self.plan.name, "world", "end"), payload)
 
 
 def _next_due(h: _Hook, now: int) -> int:

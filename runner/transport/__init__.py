@@ -10,6 +10,7 @@ Wire format of every sample the simulation publishes:
 
 from __future__ import annotations
 
+import contextlib
 import json
 import socket
 import struct
@@ -81,8 +82,6 @@ class Bus(Protocol):
 
     def subscribe(self, key: str, callback: Callable[[str, bytes, bytes | None], None]) -> None: ...
 
-    def put_meta(self, key: str, payload: bytes) -> None: ...
-
 
 class ZenohBus:
     def __init__(self, session: zenoh.Session):
@@ -113,15 +112,10 @@ class ZenohBus:
             self.session.declare_subscriber(key, on_sample, allowed_origin=zenoh.Locality.REMOTE)
         )
 
-    def put_meta(self, key: str, payload: bytes) -> None:
-        self.session.put(key, payload, congestion_control=zenoh.CongestionControl.BLOCK)
-
     def undeclare_all(self) -> None:
         for ent in self._keep:
-            try:
+            with contextlib.suppress(Exception):
                 ent.undeclare()
-            except Exception:
-                pass
         self._keep.clear()
 
 
@@ -130,7 +124,6 @@ class MemoryBus:
 
     def __init__(self) -> None:
         self.sent: list[tuple[str, str, bytes, bytes]] = []
-        self.meta: list[tuple[str, bytes]] = []
         self._subs: dict[str, list[Callable[[str, bytes, bytes | None], None]]] = {}
 
     def publisher(self, key: str, type_name: str) -> Callable[[bytes, bytes], None]:
@@ -141,9 +134,6 @@ class MemoryBus:
 
     def subscribe(self, key: str, callback: Callable[[str, bytes, bytes | None], None]) -> None:
         self._subs.setdefault(key, []).append(callback)
-
-    def put_meta(self, key: str, payload: bytes) -> None:
-        self.meta.append((key, payload))
 
     def inject(self, key: str, payload: bytes, attachment: bytes | None = None) -> None:
         for cb in self._subs.get(key, []):

@@ -1,0 +1,210 @@
+"""launch: host the run's Zenoh router, record, start the world process, and shut down in order.
+
+The runner process holds the embedded Zenoh router (a Python session in router mode: no zenohd needed)
+and the recorder. The world is a separate OS process that connects to the router as a client. On the
+end of the run, a failure or Ctrl-C: the world is stopped (SIGINT, then SIGKILL after a grace period),
+the recorder waits for the messages the world says it published, and the MCAP file is finished.
+"""
+
+from __future__ import annotations
+
+import collections
+import contextlib
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import zenoh
+
+from runner.errors import RunError
+from runner.plan import RunPlan
+from runner.record import Recorder, TopicStats
+from runner.transport import free_port, make_config, meta_key, unpack_attachment
+
+STOP_GRACE_S = 1.2  # after SIGINT, how long the world gets before SIGKILL
+DRAIN_TIMEOUT_S = 3.0  # how long the recorder waits for messages still in flight at the end
+START_TIMEOUT_S = 30.0
+
+
+@dataclass
+class RunResult:
+    reason: str  # completed | interrupted | failed
+    sim_ns: int
+    wall_s: float
+    mcap: Path | None
+    topics: list[TopicStats] = field(default_factory=list)
+    published: dict[str, int] = field(default_factory=dict)
+    error: str | None = None
+    endpoints: list[str] = field(default_factory=list)
+
+    @property
+    def exit_code(self) -> int:
+        return {"completed": 0, "interrupted": 130}.get(self.reason, 1)
+
+    @property
+    def lost(self) -> dict[str, int]:
+        """Messages published but not recorded, per topic (only topics that were recorded)."""
+        got = {t.key: t.count for t in self.topics}
+        return {k: n - got[k] for k, n in self.published.items() if k in got and n > got[k]}
+
+
+class _StderrTail(threading.Thread):
+    """Forwards a child's stderr and keeps its last lines for the error report."""
+
+    def __init__(self, stream: Any, prefix: str):
+        super().__init__(daemon=True)
+        self.stream = stream
+        self.prefix = prefix
+        self.lines: collections.deque[str] = collections.deque(maxlen=30)
+
+    def run(self) -> None:
+        for raw in iter(self.stream.readline, b""):
+            line = raw.decode(errors="replace").rstrip()
+            self.lines.append(line)
+            print(f"{self.prefix}{line}", file=sys.stderr, flush=True)
+
+
+def run_plan(
+    plan: RunPlan,
+    *,
+    listen: Sequence[str] = (),
+    connect: Sequence[str] = (),
+    on_progress: Callable[[int, float], None] | None = None,
+) -> RunResult:
+    listen = list(listen) or [f"tcp/127.0.0.1:{free_port()}"]
+    conf = make_config("router", listen=listen, connect=connect)
+    try:
+        session = zenoh.open(conf)
+    except zenoh.ZError as e:
+        raise RunError(f"cannot open the Zenoh network on {', '.join(listen)}: {e}") from None
+
+    recorder: Recorder | None = None
+    latest = {"ns": 0}
+    end_info: dict[str, Any] = {}
+    ended = threading.Event()
+    ready = threading.Event()
+    subs: list[Any] = []
+    child: subprocess.Popen[bytes] | None = None
+    reason = "completed"
+    error: str | None = None
+    wall0 = time.perf_counter()
+    plan_file = None
+    try:
+        if plan.record.enabled:
+            recorder = Recorder(Path(plan.record.path), plan.record.include, plan.record.exclude)
+            subs.append(session.declare_subscriber(f"{plan.name}/**", recorder.on_sample))
+        else:
+
+            def on_clock(sample: zenoh.Sample) -> None:
+                att = sample.attachment
+                parsed = unpack_attachment(att.to_bytes()) if att is not None else None
+                if parsed:
+                    latest["ns"] = parsed[1]
+
+            subs.append(session.declare_subscriber(plan.clock_key, on_clock))
+
+        def on_meta(sample: zenoh.Sample) -> None:
+            key = str(sample.key_expr)
+            if key.endswith("/world/end"):
+                end_info.update(json.loads(sample.payload.to_bytes()))
+                ended.set()
+            elif key.endswith("/world/ready"):
+                ready.set()
+
+        subs.append(session.declare_subscriber(meta_key(plan.name, "**"), on_meta))
+
+        with tempfile.NamedTemporaryFile("w", suffix=".plan.json", delete=False) as f:
+            f.write(plan.model_dump_json())
+            plan_file = f.name
+        cmd = [sys.executable, "-m", "runner.sim", plan_file, "--connect", _connectable(listen[0])]
+        # A session of its own: a terminal's Ctrl-C reaches only us, and we stop the world in order.
+        child = subprocess.Popen(cmd, stderr=subprocess.PIPE, start_new_session=True)
+        tail = _StderrTail(child.stderr, "[world] ")
+        tail.start()
+        wall0 = time.perf_counter()
+        try:
+            while child.poll() is None:
+                time.sleep(0.05)
+                if on_progress is not None:
+                    sim_ns = recorder.latest_ns if recorder else latest["ns"]
+                    on_progress(sim_ns, time.perf_counter() - wall0)
+                if not ready.is_set() and time.perf_counter() - wall0 > START_TIMEOUT_S:
+                    raise RunError(f"the world process did not start within {START_TIMEOUT_S:.0f} s")
+        except KeyboardInterrupt:
+            reason = "interrupted"
+            _stop(child)
+        tail.join(timeout=1.0)
+        if child.returncode not in (0, 130) and reason != "interrupted":
+            reason = "failed"
+            last = "\n".join(f"  | {ln}" for ln in list(tail.lines)[-12:])
+            error = f"the world process exited with code {child.returncode}" + (f":\n{last}" if last else "")
+        if recorder is not None:
+            try:
+                _drain(recorder, ended, end_info)
+            except KeyboardInterrupt:
+                reason = "interrupted"
+    except KeyboardInterrupt:
+        reason = "interrupted"
+        if child is not None and child.poll() is None:
+            _stop(child)
+    finally:
+        if child is not None and child.poll() is None:
+            child.kill()
+        for s in subs:
+            with contextlib.suppress(Exception):
+                s.undeclare()
+        if recorder is not None:
+            recorder.close()
+        session.close()
+        if plan_file:
+            os.unlink(plan_file)
+
+    sim_ns = int(end_info.get("sim_ns", recorder.latest_ns if recorder else latest["ns"]))
+    return RunResult(
+        reason=reason,
+        sim_ns=sim_ns,
+        wall_s=float(end_info.get("wall_s", time.perf_counter() - wall0)),
+        mcap=Path(plan.record.path) if recorder else None,
+        topics=recorder.stats() if recorder else [],
+        published=dict(end_info.get("published", {})),
+        error=error,
+        endpoints=listen,
+    )
+
+
+def _connectable(endpoint: str) -> str:
+    """A listen endpoint on all interfaces is reached through loopback from this host."""
+    return endpoint.replace("0.0.0.0", "127.0.0.1").replace("[::]", "[::1]")
+
+
+def _stop(child: subprocess.Popen[bytes]) -> None:
+    try:
+        child.send_signal(signal.SIGINT)
+        child.wait(timeout=STOP_GRACE_S)
+    except subprocess.TimeoutExpired:
+        child.kill()
+        child.wait()
+    except ProcessLookupError:
+        pass
+
+
+def _drain(recorder: Recorder, ended: threading.Event, end_info: dict[str, Any]) -> None:
+    """Wait until the recorder holds every message the world says it published (or a timeout)."""
+    if not ended.wait(timeout=0.5):
+        return
+    published: dict[str, int] = end_info.get("published", {})
+    deadline = time.monotonic() + DRAIN_TIMEOUT_S
+    while time.monotonic() < deadline:
+        got = recorder.counts()
+        if all(got.get(k, 0) >= n for k, n in published.items() if recorder.wanted(k)):
+            return
+        time.sleep(0.01)

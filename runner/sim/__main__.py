@@ -1,0 +1,83 @@
+"""The world process: `python -m runner.sim PLAN.json --connect ENDPOINT`.
+
+Started by `scenario run` (one per world). Joins the run's Zenoh network as a client, steps the world,
+and on the end of the run, a SIGINT/SIGTERM, or the death of its parent, announces how many messages it
+published on each topic and exits.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import signal
+import sys
+import time
+from pathlib import Path
+
+import zenoh
+
+from runner.plan import RunPlan
+from runner.sim.world import World
+from runner.transport import ZenohBus, make_config, meta_key
+
+READY_TIMEOUT_S = 10.0
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m runner.sim")
+    ap.add_argument("plan", type=Path)
+    ap.add_argument("--connect", action="append", default=[], help="Zenoh endpoint of the run's router")
+    args = ap.parse_args(argv)
+
+    plan = RunPlan.model_validate_json(args.plan.read_text())
+    stop = {"signal": None}
+
+    def on_signal(signum: int, _frame: object) -> None:
+        stop["signal"] = signum
+
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+    parent = os.getppid()
+
+    def should_stop() -> bool:
+        return stop["signal"] is not None or os.getppid() != parent
+
+    with zenoh.open(make_config("client", connect=args.connect)) as session:
+        bus = ZenohBus(session)
+        try:
+            end_pub = session.declare_publisher(
+                meta_key(plan.name, "world", "end"), congestion_control=zenoh.CongestionControl.BLOCK
+            )
+            # Start only once the runner listens, so that nothing published is missed by the recorder.
+            deadline = time.monotonic() + READY_TIMEOUT_S
+            while not end_pub.matching_status.matching:
+                if time.monotonic() > deadline:
+                    print("world: the runner is not listening; giving up", file=sys.stderr)
+                    return 1
+                if should_stop():
+                    return 130
+                time.sleep(0.005)
+            world = World(plan, bus)
+            session.put(meta_key(plan.name, "world", "ready"), b"{}")
+            stats = world.run(should_stop=should_stop)
+            reason = "completed" if stats.sim_ns >= plan.duration_ns else "stopped"
+            end_pub.put(
+                json.dumps(
+                    {
+                        "reason": reason,
+                        "sim_ns": stats.sim_ns,
+                        "steps": stats.steps,
+                        "wall_s": stats.wall_s,
+                        "published": stats.published,
+                    }
+                ).encode()
+            )
+            end_pub.undeclare()
+        finally:
+            bus.undeclare_all()
+    return 0 if stop["signal"] is None else 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

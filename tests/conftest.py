@@ -1,0 +1,53 @@
+"""Shared test helpers: inline scenarios, the real CLI in a subprocess, MCAP reading."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+SCENARIOS = REPO / "scenarios"
+DIFFBOT = SCENARIOS / "robots" / "diffbot.urdf.xacro"
+
+
+@pytest.fixture
+def write_scenario(tmp_path: Path):
+    """Write an inline scenario (dedented); `{diffbot}` is replaced by the project's robot file."""
+
+    def write(text: str, name: str = "scenario.yaml") -> Path:
+        path = tmp_path / name
+        path.write_text(textwrap.dedent(text).replace("{diffbot}", str(DIFFBOT)).lstrip())
+        return path
+
+    return write
+
+
+def scenario_cmd(*args: str) -> list[str]:
+    return [sys.executable, "-m", "runner.cli", *args]
+
+
+def run_cli(*args: str, timeout: float = 60, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    return subprocess.run(
+        scenario_cmd(*args), capture_output=True, text=True, timeout=timeout, cwd=cwd or REPO, env=env
+    )
+
+
+def read_mcap(path: Path) -> list[tuple[str, str, int, Any]]:
+    """(topic, type, log_time, decoded message) for every message, decoded by mcap_ros2 (an independent
+    decoder of the ros2msg/CDR format, not ours)."""
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+
+    out = []
+    with open(path, "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        for schema, channel, message, decoded in reader.iter_decoded_messages():
+            out.append((channel.topic, schema.name, message.log_time, decoded))
+    return out

@@ -1,0 +1,37 @@
+"""In-process helpers: compile an inline scenario and step its world on a MemoryBus (real MuJoCo)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from runner import msgs
+from runner.compile import compile_plan
+from runner.loader import load_file
+from runner.plan import RunPlan
+from runner.sim.world import World
+from runner.transport import MemoryBus, unpack_attachment
+from runner.validate import validate_scenario
+
+
+def plan_of(path: Path) -> RunPlan:
+    doc = load_file(path)
+    return compile_plan(validate_scenario(doc), doc)
+
+
+def simulate(path: Path) -> tuple[World, MemoryBus]:
+    bus = MemoryBus()
+    world = World(plan_of(path), bus)
+    world.run()
+    return world, bus
+
+
+def messages(bus: MemoryBus, key_suffix: str) -> list[tuple[int, Any]]:
+    """(sim time ns, decoded message) of everything published on keys ending with `key_suffix`."""
+    out = []
+    for key, type_name, payload, att in bus.sent:
+        if key.endswith(key_suffix):
+            parsed = unpack_attachment(att)
+            assert parsed is not None
+            out.append((parsed[1], msgs.decode(payload, type_name)))
+    return out

@@ -1,0 +1,83 @@
+from __future__ import annotations
+
+import mujoco
+
+from tests.helpers import plan_of
+
+TWO = """
+name: t
+robots:
+  - name: r1
+    description: {file: "{diffbot}", args: {color: "1 0 0 1"}}
+    pose: {xyz: [0, 0, 0.06]}
+    plugins: [{type: diff_drive}, {type: lidar}, {type: imu}]
+  - name: r2
+    description: {file: "{diffbot}", args: {color: "0 0 1 1"}}
+    pose: {xyz: [1, 0, 0.06], rpy: [0, 0, 1.5707963]}
+    plugins: [{type: diff_drive}, {type: lidar}, {type: imu}]
+  - name: arm
+    fixed: true
+    description: "{diffbot}"
+    pose: {xyz: [3, 0, 0.5]}
+world:
+  models:
+    - {name: wall, shape: box, size: [0.1, 4, 0.5], pose: {xyz: [2, 0, 0.25]}}
+    - {name: ball, shape: sphere, size: [0.1], static: false, mass: 0.2, pose: {xyz: [0, 2, 0.1]}}
+"""
+
+
+def test_same_robot_file_twice_gets_namespaced_names(write_scenario):
+    plan = plan_of(write_scenario(TWO))
+    model = mujoco.MjModel.from_xml_string(plan.mjcf)
+    names = [model.body(i).name for i in range(model.nbody)]
+    assert "r1/base_link" in names and "r2/base_link" in names and "arm/base_link" in names
+    assert len(names) == len(set(names))
+    joints = [model.joint(i).name for i in range(model.njnt)]
+    assert {"r1/left_wheel_joint", "r2/left_wheel_joint", "r1/root", "r2/root"} <= set(joints)
+    assert "arm/root" not in joints  # a fixed robot is welded to the world
+    acts = [model.actuator(i).name for i in range(model.nu)]
+    assert acts == ["r1/diff_drive/left", "r1/diff_drive/right", "r2/diff_drive/left", "r2/diff_drive/right"]
+    # wheels are driven by velocity servos
+    assert all(model.actuator_biasprm[i][2] < 0 for i in range(model.nu))
+    # the free ball has a free joint; the static wall does not
+    assert "ball/root" in joints
+    assert [s.name for s in plan.robots] == ["r1", "r2", "arm"]
+
+
+def test_spawn_pose_and_fixed_links_kept(write_scenario):
+    plan = plan_of(write_scenario(TWO))
+    model = mujoco.MjModel.from_xml_string(plan.mjcf)
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    r2 = model.body("r2/base_link").id
+    assert abs(data.xpos[r2][0] - 1.0) < 1e-9
+    # yaw of 90 degrees: the robot's x axis points along world y
+    assert abs(data.xmat[r2].reshape(3, 3)[1, 0] - 1.0) < 1e-6
+    # fusestatic is off: fixed-joint links stay bodies a sensor can be mounted on
+    assert model.body("r1/lidar_link").id > 0 and model.body("r1/imu_link").id > 0
+
+
+def test_topics_are_namespaced_under_the_run(write_scenario):
+    plan = plan_of(write_scenario(TWO))
+    keys = {(t.key, t.type, t.direction) for t in plan.topics()}
+    assert ("t/r1/scan", "sensor_msgs/msg/LaserScan", "pub") in keys
+    assert ("t/r2/cmd_vel", "geometry_msgs/msg/Twist", "sub") in keys
+    assert ("t/clock", "rosgraph_msgs/msg/Clock", "pub") in keys
+
+
+def test_plan_round_trips_as_json(write_scenario):
+    from runner.plan import RunPlan
+
+    plan = plan_of(write_scenario(TWO))
+    again = RunPlan.model_validate_json(plan.model_dump_json())
+    assert again == plan
+    mujoco.MjModel.from_xml_string(again.mjcf)
+
+
+def test_gazebo_mu_reaches_the_caster(write_scenario):
+    plan = plan_of(write_scenario(TWO))
+    model = mujoco.MjModel.from_xml_string(plan.mjcf)
+    caster = model.body("r1/caster").id
+    geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] == caster and model.geom_contype[g]]
+    assert geoms and all(model.geom_friction[g][0] == 0 for g in geoms)
+    assert all(model.geom_priority[g] > 0 for g in geoms)

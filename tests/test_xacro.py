@@ -1,0 +1,55 @@
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from runner.compile.packages import PackageMap
+from runner.compile.xacro_expand import MissingPackage, expand
+
+
+def _package(root: Path, name: str) -> Path:
+    pkg = root / "src" / name
+    (pkg / "urdf").mkdir(parents=True)
+    (pkg / "package.xml").write_text(f"<package format='3'><name>{name}</name></package>")
+    return pkg
+
+
+def test_find_resolves_through_package_xml_without_ros(tmp_path: Path):
+    pkg = _package(tmp_path, "my_robot_description")
+    (pkg / "urdf" / "parts.xacro").write_text(
+        '<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="w" value="0.25"/></robot>'
+    )
+    main = pkg / "urdf" / "robot.urdf.xacro"
+    main.write_text(
+        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:arg name="prefix" default="x_"/>'
+        '<xacro:include filename="$(find my_robot_description)/urdf/parts.xacro"/>'
+        '<link name="$(arg prefix)base">'
+        '<visual><geometry><box size="${w} ${w*2} 1"/></geometry></visual></link>'
+        "</robot>"
+    )
+    urdf = expand(main, {"prefix": "p_"}, PackageMap.for_scenario(tmp_path))
+    assert 'name="p_base"' in urdf
+    assert 'size="0.25 0.5 1"' in urdf
+
+
+def test_missing_package_names_it_and_where_we_looked(tmp_path: Path):
+    main = tmp_path / "r.xacro"
+    main.write_text(
+        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:include filename="$(find ghost_pkg)/x.xacro"/></robot>'
+    )
+    with pytest.raises(MissingPackage) as e:
+        expand(main, {}, PackageMap.for_scenario(tmp_path))
+    assert "ghost_pkg" in str(e.value)
+    assert str(tmp_path) in (e.value.hint or "")
+
+
+def test_explicit_package_map_wins(tmp_path: Path):
+    _package(tmp_path, "dup")
+    other = tmp_path / "elsewhere"
+    other.mkdir()
+    pm = PackageMap.for_scenario(tmp_path, {"dup": other})
+    assert pm.find("dup") == other
+    assert pm.find("nope") is None
