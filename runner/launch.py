@@ -92,6 +92,7 @@ def run_plan(
     end_info: dict[str, Any] = {}
     ended = threading.Event()
     ready = threading.Event()
+    started = {"at": 0.0}
     subs: list[Any] = []
     child: subprocess.Popen[bytes] | None = None
     reason = "completed"
@@ -118,6 +119,7 @@ def run_plan(
                 end_info.update(json.loads(sample.payload.to_bytes()))
                 ended.set()
             elif key.endswith("/world/ready"):
+                started["at"] = time.perf_counter()
                 ready.set()
 
         subs.append(session.declare_subscriber(meta_key(plan.name, "**"), on_meta))
@@ -134,9 +136,9 @@ def run_plan(
         try:
             while child.poll() is None:
                 time.sleep(0.05)
-                if on_progress is not None:
+                if on_progress is not None and ready.is_set():
                     sim_ns = recorder.latest_ns if recorder else latest["ns"]
-                    on_progress(sim_ns, time.perf_counter() - wall0)
+                    on_progress(sim_ns, time.perf_counter() - started["at"])
                 if not ready.is_set() and time.perf_counter() - wall0 > START_TIMEOUT_S:
                     raise RunError(f"the world process did not start within {START_TIMEOUT_S:.0f} s")
         except KeyboardInterrupt:
