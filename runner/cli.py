@@ -166,10 +166,13 @@ def run(
             sim = sim_ns / 1e9
             progress.update(task, completed=sim, sim=sim, rtf=sim / wall_s if wall_s > 0 else 0.0)
 
+    from runner.transport import free_port
+
+    endpoints = list(listen or []) or [f"tcp/127.0.0.1:{free_port()}"]
     if not quiet:
-        err.print(f"running {plan.name} ({total:g} s sim) ...", markup=False)
+        err.print(f"running {plan.name} ({total:g} s sim), Zenoh on {', '.join(endpoints)}", markup=False)
     try:
-        result = run_plan(plan, listen=listen or (), connect=connect or (), on_progress=on_progress)
+        result = run_plan(plan, listen=endpoints, connect=connect or (), on_progress=on_progress)
     except RunError as e:
         raise _fail(e) from None
     finally:

@@ -101,7 +101,10 @@ def run_plan(
     plan_file = None
     try:
         if plan.record.enabled:
-            recorder = Recorder(Path(plan.record.path), plan.record.include, plan.record.exclude)
+            try:
+                recorder = Recorder(Path(plan.record.path), plan.record.include, plan.record.exclude)
+            except OSError as e:
+                raise RunError(f"cannot write the recording {plan.record.path}: {e.strerror}") from None
             subs.append(session.declare_subscriber(f"{plan.name}/**", recorder.on_sample))
         else:
 

@@ -216,3 +216,63 @@ def test_ctrl_c_exits_fast_and_leaves_a_readable_recording(tmp_path: Path):
     scans = [t for topic, _, t, _ in messages if topic == "two_robots/r1/scan"]
     # everything up to the cut: the scan count matches the sim time reached (10 Hz)
     assert abs(len(scans) - (clock[-1] / 1e8 + 1)) <= 2
+
+
+def _children(pid: int) -> list[int]:
+    out = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                status = (entry / "status").read_text()
+            except OSError:
+                continue
+            ppid = next((ln.split()[1] for ln in status.splitlines() if ln.startswith("PPid:")), None)
+            if ppid == str(pid):
+                out.append(int(entry.name))
+    return out
+
+
+@pytest.mark.timeout(60)
+def test_a_dead_world_process_fails_the_run_and_keeps_the_recording(tmp_path: Path):
+    mcap = tmp_path / "crash.mcap"
+    proc = subprocess.Popen(
+        scenario_cmd(
+            "run",
+            str(SCENARIOS / "two_robots.yaml"),
+            "--rate",
+            "realtime",
+            "--duration",
+            "120",
+            "--record",
+            str(mcap),
+        ),
+        cwd=REPO,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline and (not mcap.exists() or mcap.stat().st_size < 200_000):
+            time.sleep(0.1)
+        children = _children(proc.pid)
+        assert len(children) == 1
+        os.kill(children[0], signal.SIGKILL)
+        out, err = proc.communicate(timeout=10)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 1
+    assert "world process exited with code -9" in err
+    assert "Traceback" not in err
+    assert "failed" in out
+    assert any(topic == "two_robots/r1/scan" for topic, _, _, _ in read_mcap(mcap))
+
+
+@pytest.mark.timeout(30)
+def test_unwritable_recording_is_a_clear_error(tmp_path: Path):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    proc = run_cli("run", str(SCENARIOS / "two_robots.yaml"), "--record", str(blocker / "x.mcap"))
+    assert proc.returncode == 1
+    assert "cannot write the recording" in proc.stderr and "Traceback" not in proc.stderr
