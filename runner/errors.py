@@ -76,5 +76,16 @@ class ScenarioError(Exception):
         return body if n == 1 else f"{n} problems:\n{body}"
 
 
+class SourceError(Exception):
+    """A mistake inside a file a scenario refers to (xacro, URDF, mesh): where it is, and a hint.
+    The compile pass turns it into a `ScenarioError` that also names the scenario line that loaded it."""
+
+    def __init__(self, message: str, file: Path | None, line: int | None = None, hint: str | None = None):
+        super().__init__(message)
+        self.file = file
+        self.line = line
+        self.hint = hint
+
+
 class RunError(Exception):
     """The run could not go on (a process died, a network endpoint could not be opened...)."""

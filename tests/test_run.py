@@ -174,19 +174,11 @@ def test_separate_process_receives_scans_and_drives_the_robot(write_scenario, tm
     assert math.hypot(last["ext/r2/ground_truth"].x, last["ext/r2/ground_truth"].y - 2) < 0.01
 
 
-@pytest.mark.timeout(60)
-def test_ctrl_c_exits_fast_and_leaves_a_readable_recording(tmp_path: Path):
-    mcap = tmp_path / "cut.mcap"
+def _start_long_run(mcap: Path) -> subprocess.Popen[str]:
+    """The demo at real time for 120 s, returned once its recording holds a few sim seconds."""
     proc = subprocess.Popen(
         scenario_cmd(
-            "run",
-            str(SCENARIOS / "two_robots.yaml"),
-            "--rate",
-            "realtime",
-            "--duration",
-            "120",
-            "--record",
-            str(mcap),
+            "run", str(SCENARIOS / "two_robots.yaml"), "--rate=realtime", "--duration=120", f"--record={mcap}"
         ),
         cwd=REPO,
         stdout=subprocess.PIPE,
@@ -194,10 +186,19 @@ def test_ctrl_c_exits_fast_and_leaves_a_readable_recording(tmp_path: Path):
         text=True,
         env=dict(os.environ, PYTHONUNBUFFERED="1"),
     )
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline and (not mcap.exists() or mcap.stat().st_size < 200_000):
+        if proc.poll() is not None:
+            break
+        time.sleep(0.1)
+    return proc
+
+
+@pytest.mark.timeout(60)
+def test_ctrl_c_exits_fast_and_leaves_a_readable_recording(tmp_path: Path):
+    mcap = tmp_path / "cut.mcap"
+    proc = _start_long_run(mcap)
     try:
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline and (not mcap.exists() or mcap.stat().st_size < 200_000):
-            time.sleep(0.1)
         time.sleep(0.5)
         t0 = time.monotonic()
         proc.send_signal(signal.SIGINT)
@@ -235,26 +236,8 @@ def _children(pid: int) -> list[int]:
 @pytest.mark.timeout(60)
 def test_a_dead_world_process_fails_the_run_and_keeps_the_recording(tmp_path: Path):
     mcap = tmp_path / "crash.mcap"
-    proc = subprocess.Popen(
-        scenario_cmd(
-            "run",
-            str(SCENARIOS / "two_robots.yaml"),
-            "--rate",
-            "realtime",
-            "--duration",
-            "120",
-            "--record",
-            str(mcap),
-        ),
-        cwd=REPO,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    proc = _start_long_run(mcap)
     try:
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline and (not mcap.exists() or mcap.stat().st_size < 200_000):
-            time.sleep(0.1)
         children = _children(proc.pid)
         assert len(children) == 1
         os.kill(children[0], signal.SIGKILL)

@@ -13,9 +13,9 @@ import mujoco
 
 from runner import msgs
 from runner.compile.packages import PackageMap
-from runner.compile.urdf import DescriptionError, RobotModel, urdf_to_model
-from runner.compile.xacro_expand import XacroError, expand
-from runner.errors import Location, Problem, ScenarioError
+from runner.compile.urdf import RobotModel, urdf_to_model
+from runner.compile.xacro_expand import expand
+from runner.errors import Location, Problem, ScenarioError, SourceError
 from runner.geometry import rpy_to_quat
 from runner.loader import Document, PathKey
 from runner.plan import PluginPlan, RecordPlan, RobotPlan, RunPlan, TimelinePlan, TopicPlan, topic_key
@@ -205,7 +205,7 @@ def _robot_model(robot: Robot, i: int, doc: Document, packages: PackageMap) -> R
                 )
             urdf = path.read_text(encoding="utf-8")
         return urdf_to_model(urdf, path, packages, fixed=robot.fixed)
-    except (XacroError, DescriptionError) as e:
+    except SourceError as e:
         where = Location(e.file, e.line) if e.file else doc.locate(file_path)
         hint = e.hint
         problems = [Problem(str(e), where, hint=hint)]

@@ -16,14 +16,11 @@ from pathlib import Path
 import mujoco
 
 from runner.compile.packages import PackageMap, resolve_uri
+from runner.errors import SourceError
 
 
-class DescriptionError(Exception):
-    def __init__(self, message: str, file: Path | None, line: int | None = None, hint: str | None = None):
-        super().__init__(message)
-        self.file = file
-        self.line = line
-        self.hint = hint
+class DescriptionError(SourceError):
+    """The URDF itself is wrong."""
 
 
 @dataclass

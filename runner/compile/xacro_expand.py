@@ -17,14 +17,11 @@ import xacro
 import xacro.substitution_args as _sa
 
 from runner.compile.packages import PackageMap
+from runner.errors import SourceError
 
 
-class XacroError(Exception):
-    def __init__(self, message: str, file: Path | None, line: int | None = None, hint: str | None = None):
-        super().__init__(message)
-        self.file = file
-        self.line = line
-        self.hint = hint
+class XacroError(SourceError):
+    """xacro could not expand the file."""
 
 
 class MissingPackage(XacroError):
