@@ -76,6 +76,37 @@ class ScenarioError(Exception):
         return body if n == 1 else f"{n} problems:\n{body}"
 
 
+@dataclass(frozen=True)
+class Notice:
+    """A warning: something in an input that we read but do not act on (never fatal, never silent)."""
+
+    message: str
+    location: Location = field(default_factory=Location)
+
+    def render(self) -> str:
+        return f"{self.location}: {self.message}"
+
+
+class Notices:
+    """Collects warnings during compile; each distinct (message, file) is kept once."""
+
+    def __init__(self) -> None:
+        self.items: list[Notice] = []
+        self._seen: set[tuple[str, str]] = set()
+
+    def add(self, message: str, file: Path | None = None, line: int | None = None) -> None:
+        key = (message, str(file))
+        if key not in self._seen:
+            self._seen.add(key)
+            self.items.append(Notice(message, Location(file, line)))
+
+    def __iter__(self):  # type: ignore[no-untyped-def]
+        return iter(self.items)
+
+    def __len__(self) -> int:
+        return len(self.items)
+
+
 class SourceError(Exception):
     """A mistake inside a file a scenario refers to (xacro, URDF, mesh): where it is, and a hint.
     The compile pass turns it into a `ScenarioError` that also names the scenario line that loaded it."""

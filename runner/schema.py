@@ -99,6 +99,11 @@ class WorldModel(Strict):
 
 
 class World(Strict):
+    sdf: str | None = Field(
+        None,
+        description="An SDF (1.4-1.9) or Gazebo .world file to load, relative to the scenario's folder; "
+        "`models` are added to it.",
+    )
     physics: Physics = Field(default_factory=Physics, description="Physics settings.")
     ground: Ground = Field(default_factory=Ground, description="The ground plane.")
     models: list[WorldModel] = Field(default_factory=list, description="Primitive models in the world.")
@@ -143,7 +148,14 @@ class Robot(Strict):
     fixed: bool = Field(
         False, description="Weld the root link to the world (an arm on a table) instead of a free base."
     )
-    plugins: list[PluginEntry] = Field(default_factory=list, description="Plugins of this robot.")
+    plugins: list[PluginEntry] = Field(
+        default_factory=list,
+        description="Plugins of this robot. They add to the sensors and plugins its description declares in "
+        "<gazebo> tags, and replace those of the same name (or type).",
+    )
+    plugins_from_description: bool = Field(
+        True, description="Use the plugins and sensors declared in the description's <gazebo> tags."
+    )
 
     @property
     def ns(self) -> str:
