@@ -103,6 +103,20 @@ def validate(
             f"to t={plan.timeline[-1].t_ns / 1e9:g} s"
         )
     out.print(f"record: {plan.record.path if plan.record.enabled else 'off'}")
+    _print_notices(plan.notices, verbose=True)
+
+
+def _print_notices(notices: list[str], verbose: bool) -> None:
+    if not notices:
+        return
+    if not verbose:
+        err.print(
+            f"{len(notices)} warning(s) about the descriptions: `scenario validate` lists them", markup=False
+        )
+        return
+    err.print(f"{len(notices)} warning(s): read from the descriptions but not acted on", markup=False)
+    for text in notices:
+        err.print("warning: " + text, markup=False, style="yellow")
 
 
 @app.command()
@@ -167,6 +181,9 @@ def run(
             progress.update(task, completed=sim, sim=sim, rtf=sim / wall_s if wall_s > 0 else 0.0)
 
     from runner.transport import free_port
+
+    if not quiet:
+        _print_notices(plan.notices, verbose=False)
 
     endpoints = list(listen or []) or [f"tcp/127.0.0.1:{free_port()}"]
     if not quiet:

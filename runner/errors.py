@@ -82,9 +82,11 @@ class Notice:
 
     message: str
     location: Location = field(default_factory=Location)
+    hint: str | None = None
 
     def render(self) -> str:
-        return f"{self.location}: {self.message}"
+        text = f"{self.location}: {self.message}"
+        return text + (f"\n  hint:     {self.hint}" if self.hint else "")
 
 
 class Notices:
@@ -94,11 +96,13 @@ class Notices:
         self.items: list[Notice] = []
         self._seen: set[tuple[str, str]] = set()
 
-    def add(self, message: str, file: Path | None = None, line: int | None = None) -> None:
+    def add(
+        self, message: str, file: Path | None = None, line: int | None = None, hint: str | None = None
+    ) -> None:
         key = (message, str(file))
         if key not in self._seen:
             self._seen.add(key)
-            self.items.append(Notice(message, Location(file, line)))
+            self.items.append(Notice(message, Location(file, line), hint))
 
     def __iter__(self):  # type: ignore[no-untyped-def]
         return iter(self.items)

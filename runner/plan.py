@@ -64,6 +64,7 @@ class RunPlan(BaseModel):
     robots: list[RobotPlan]
     timeline: list[TimelinePlan]
     record: RecordPlan
+    notices: list[str] = []  # warnings from compile: tags read but not acted on
 
     @property
     def clock_key(self) -> str:

@@ -29,7 +29,9 @@ def test_find_resolves_through_package_xml_without_ros(tmp_path: Path):
         '<visual><geometry><box size="${w} ${w*2} 1"/></geometry></visual></link>'
         "</robot>"
     )
-    urdf = expand(main, {"prefix": "p_"}, PackageMap.for_scenario(tmp_path))
+    result = expand(main, {"prefix": "p_"}, PackageMap.for_scenario(tmp_path))
+    urdf = result.urdf
+    assert result.sources == [main, pkg / "urdf" / "parts.xacro"]
     assert 'name="p_base"' in urdf
     assert 'size="0.25 0.5 1"' in urdf
 

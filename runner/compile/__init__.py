@@ -6,16 +6,19 @@ scenario that caused it: xacro, URDF, plugin parameters, message data in the tim
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import mujoco
+from pydantic import ValidationError
 
 from runner import msgs
+from runner.compile.gazebo import DescribedPlugin
 from runner.compile.packages import PackageMap
 from runner.compile.urdf import RobotModel, urdf_to_model
 from runner.compile.xacro_expand import expand
-from runner.errors import Location, Problem, ScenarioError, SourceError
+from runner.errors import Location, Notices, Problem, ScenarioError, SourceError
 from runner.geometry import rpy_to_quat
 from runner.loader import Document, PathKey
 from runner.plan import PluginPlan, RecordPlan, RobotPlan, RunPlan, TimelinePlan, TopicPlan, topic_key
@@ -37,7 +40,10 @@ _INTEGRATOR = {
 }
 
 
-def compile_plan(sc: Scenario, doc: Document, *, record_path: str | None = None) -> RunPlan:
+def compile_plan(
+    sc: Scenario, doc: Document, *, record_path: str | None = None, notices: Notices | None = None
+) -> RunPlan:
+    notices = notices if notices is not None else Notices()
     base = doc.base_dir
     packages = PackageMap.for_scenario(base, {k: (base / v) for k, v in sc.packages.items()})
     for name, folder in packages.explicit.items():
@@ -54,8 +60,9 @@ def compile_plan(sc: Scenario, doc: Document, *, record_path: str | None = None)
     world = _world_spec(sc)
     robots: list[RobotPlan] = []
     for i, robot in enumerate(sc.robots):
-        model = _robot_model(robot, i, doc, packages)
+        model = _robot_model(robot, i, doc, packages, notices, sc.world.physics.timestep)
         plugins = _build_plugins(sc, robot, i, model, doc)
+        _add_transmissions(model, notices)
         pos = robot.pose.xyz
         frame = world.worldbody.add_frame(pos=list(pos), quat=list(rpy_to_quat(robot.pose.rpy)))
         prefix = f"{robot.ns}/"
@@ -113,6 +120,7 @@ def compile_plan(sc: Scenario, doc: Document, *, record_path: str | None = None)
         robots=robots,
         timeline=timeline,
         record=record,
+        notices=[n.render() for n in notices],
     )
 
 
@@ -172,7 +180,9 @@ def _description_path(robot: Robot, base: Path) -> Path:
     return (base / robot.desc.file).resolve()
 
 
-def _robot_model(robot: Robot, i: int, doc: Document, packages: PackageMap) -> RobotModel:
+def _robot_model(
+    robot: Robot, i: int, doc: Document, packages: PackageMap, notices: Notices, timestep: float
+) -> RobotModel:
     desc_path: PathKey = ("robots", i, "description")
     if isinstance(robot.description, str):
         file_path: PathKey = desc_path
@@ -192,7 +202,18 @@ def _robot_model(robot: Robot, i: int, doc: Document, packages: PackageMap) -> R
     try:
         if path.suffix == ".xacro" or path.name.endswith(".urdf.xacro"):
             args = {k: _xacro_str(v) for k, v in robot.desc.args.items()}
-            urdf = expand(path, args, packages)
+            result = expand(path, args, packages)
+            return urdf_to_model(
+                result.urdf,
+                path,
+                packages,
+                fixed=robot.fixed,
+                namespace=robot.ns,
+                notices=notices,
+                sources=result.sources,
+                expanded=True,
+                timestep=timestep,
+            )
         else:
             if robot.desc.args:
                 raise ScenarioError(
@@ -204,7 +225,15 @@ def _robot_model(robot: Robot, i: int, doc: Document, packages: PackageMap) -> R
                     )
                 )
             urdf = path.read_text(encoding="utf-8")
-        return urdf_to_model(urdf, path, packages, fixed=robot.fixed)
+            return urdf_to_model(
+                urdf,
+                path,
+                packages,
+                fixed=robot.fixed,
+                namespace=robot.ns,
+                notices=notices,
+                timestep=timestep,
+            )
     except SourceError as e:
         where = Location(e.file, e.line) if e.file else doc.locate(file_path)
         hint = e.hint
@@ -226,29 +255,79 @@ def _xacro_str(v: Any) -> str:
     return str(v)
 
 
+@dataclass
+class _Entry:
+    """One plugin to build: from the scenario, from the description, or both merged."""
+
+    type: str
+    name: str
+    params: dict[str, Any]
+    scenario_index: int | None = None  # index in robots[i].plugins, when the scenario names it
+    scenario_keys: frozenset[str] = frozenset()  # params the scenario set (the rest came from the file)
+    source: DescribedPlugin | None = None
+
+
+def _plugin_entries(robot: Robot, model: RobotModel) -> list[_Entry]:
+    """The description's plugins, with the scenario's added, or merged in by name (or by type when the
+    description has exactly one of that type): the scenario's params win."""
+    entries: list[_Entry] = []
+    if robot.plugins_from_description:
+        entries = [_Entry(d.type, d.name, dict(d.params), source=d) for d in model.gazebo.plugins]
+    for k, p in enumerate(robot.plugins):
+        target = None
+        if p.name is not None:
+            target = next((e for e in entries if e.source and e.name == p.name), None)
+        else:
+            same = [e for e in entries if e.source and e.type == p.type and e.scenario_index is None]
+            target = same[0] if len(same) == 1 else None
+        if target is not None and target.type == p.type:
+            target.params.update(p.params)
+            target.scenario_index = k
+            target.scenario_keys = frozenset(p.params)
+        else:
+            entries.append(_Entry(p.type, p.name or p.type, dict(p.params), k, frozenset(p.params)))
+    return entries
+
+
 def _build_plugins(sc: Scenario, robot: Robot, i: int, model: RobotModel, doc: Document) -> list[PluginPlan]:
     plans: list[PluginPlan] = []
     ctx = BuildContext(spec=model.spec, robot=robot.name, namespace=robot.ns, root=model.root)
-    for k, entry in enumerate(robot.plugins):
-        here: PathKey = ("robots", i, "plugins", k)
+    names: set[str] = set()
+    for entry in _plugin_entries(robot, model):
+        here: PathKey = ("robots", i, "plugins", entry.scenario_index or 0)
+        src = entry.source
+
+        def fail(message: str, param: str | None, hint: str | None, entry: _Entry = entry) -> ScenarioError:
+            return _plugin_error(entry, here, doc, robot, i, message, param, hint)  # noqa: B023
+
+        if entry.name in names:
+            raise fail(f"two plugins named {entry.name!r}", None, "give one of them another `name:`")
+        names.add(entry.name)
         try:
             cls = load(entry.type)
         except PluginLookupError as e:
-            raise ScenarioError(
-                Problem(str(e), doc.locate((*here, "type")), (*here, "type"), hint=e.hint)
-            ) from None
-        params = validate_model(cls.Params, entry.params, doc, (*here, "params"))
-        name = entry.name or entry.type
+            if entry.scenario_index is not None and entry.source is None:
+                where = (*here, "type")
+                raise ScenarioError(Problem(str(e), doc.locate(where), where, hint=e.hint)) from None
+            raise fail(str(e), None, e.hint) from None
+        if src is None or entry.scenario_keys >= set(entry.params):
+            params = validate_model(cls.Params, entry.params, doc, (*here, "params"))
+        else:
+            try:
+                params = cls.Params.model_validate(entry.params)
+            except ValidationError as e:
+                err = e.errors(include_url=False)[0]
+                param = ".".join(str(x) for x in err["loc"]) or None
+                raise fail(f"{err['msg']} (found {err.get('input')!r})", param, None) from None
         try:
-            topics = cls.build(params, ctx, name)
+            topics = cls.build(params, ctx, entry.name)
         except PluginConfigError as e:
-            where: PathKey = (*here, "params", e.param) if e.param else here
-            raise ScenarioError(Problem(str(e), doc.locate(where), where, hint=e.hint)) from None
+            raise fail(str(e), e.param, e.hint) from None
         rate = cls.rate_of(params)
         plans.append(
             PluginPlan(
                 type=entry.type,
-                name=name,
+                name=entry.name,
                 params=params.model_dump(mode="json"),
                 rate=rate,
                 topics=[
@@ -257,13 +336,71 @@ def _build_plugins(sc: Scenario, robot: Robot, i: int, model: RobotModel, doc: D
                         type=t.type,
                         rate=t.rate,
                         direction=t.direction,
-                        owner=f"{robot.ns}/{name}",
+                        owner=f"{robot.ns}/{entry.name}",
                     )
                     for t in topics
                 ],
             )
         )
     return plans
+
+
+def _plugin_error(
+    entry: _Entry,
+    here: PathKey,
+    doc: Document,
+    robot: Robot,
+    i: int,
+    message: str,
+    param: str | None,
+    hint: str | None,
+) -> ScenarioError:
+    """Point at the scenario when it set the parameter, else at the description's line."""
+    src = entry.source
+    if src is None or (entry.scenario_index is not None and (param is None or param in entry.scenario_keys)):
+        where: PathKey = (*here, "params", param) if param else here
+        return ScenarioError(Problem(message, doc.locate(where), where, hint=hint))
+    what = f"{entry.type} plugin {entry.name!r} from the description"
+    return ScenarioError(
+        [
+            Problem(
+                f"{what}: " + (f"{param}: " if param else "") + message,
+                Location(src.file, src.line),
+                hint=hint,
+            ),
+            Problem(f"while loading robot {robot.name!r}", doc.locate(("robots", i)), ("robots", i)),
+        ]
+    )
+
+
+def _add_transmissions(model: RobotModel, notices: Notices) -> None:
+    """`<transmission>` joints get an actuator, unless a plugin already drives them (a diff_drive's
+    wheels, a joint_controller's lift). Velocity -> velocity servo, position -> position servo,
+    effort -> motor; the mechanical reduction is the gear."""
+    spec = model.spec
+    driven = {a.target for a in spec.actuators}
+    for tr in model.transmissions:
+        joint = spec.joint(tr.joint)
+        if joint is None:
+            notices.add(f"a transmission names joint {tr.joint!r}, which the robot does not have")
+            continue
+        if tr.joint in driven:
+            continue
+        act = spec.add_actuator(
+            name=f"{tr.joint}/{tr.interface}", target=tr.joint, trntype=mujoco.mjtTrn.mjTRN_JOINT
+        )
+        if tr.interface == "velocity":
+            act.set_to_velocity(kv=1.0)
+        elif tr.interface == "position":
+            act.set_to_position(kp=100.0, kv=10.0)
+        else:
+            act.set_to_motor()
+        act.gear = [tr.reduction, 0, 0, 0, 0, 0]
+        frc = list(joint.actfrcrange)
+        if frc[1] > frc[0]:
+            act.forcelimited = True
+            act.forcerange = frc
+        driven.add(tr.joint)
 
 
 # ---------------------------------------------------------------------------------------------- timeline

@@ -2,25 +2,46 @@
 
 - `fusestatic`/`discardvisual` are off, so fixed-joint links (lidar_link, imu_link) stay bodies a sensor
   can be mounted on and visuals are kept (group 1, no collision);
-- mesh URIs (`package://`, `model://`, `file://`, relative) are rewritten to real paths;
-- `<gazebo reference="link">` friction (`mu1`/`mu2`) is applied to the link's collision geoms;
-- a mobile robot's root link gets a free joint.
+- mesh URIs (`package://`, `model://`, `file://`, relative) are rewritten to real paths; Collada (and other
+  formats MuJoCo cannot read) are converted to STL with trimesh;
+- `<gazebo>` tags are read (runner.compile.gazebo): materials, friction, contact stiffness, gravity, sensors
+  and plugins;
+- `<transmission>` (ROS 1 style) and `<ros2_control>` joints are collected so the compiler can give them
+  actuators;
+- a mobile robot's root link gets a free joint (`<gazebo><static>true` or `fixed: true` welds it).
 """
 
 from __future__ import annotations
 
-import xml.etree.ElementTree as ET
+import hashlib
+import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any, Literal
 
 import mujoco
+from lxml import etree
 
+from runner.compile.gazebo import GazeboInfo, parse, read_gazebo
 from runner.compile.packages import PackageMap, resolve_uri
-from runner.errors import SourceError
+from runner.errors import Notices, SourceError
+
+MUJOCO_MESH_FORMATS = {".stl", ".obj", ".msh"}
+# URDF visuals are geom group 1 (MuJoCo's import); collisions go to group 3, which cameras do not draw
+# (MuJoCo renders groups 0-2 by default), as in MuJoCo Menagerie models.
+COLLISION_GROUP = 3
 
 
 class DescriptionError(SourceError):
     """The URDF itself is wrong."""
+
+
+@dataclass
+class Transmission:
+    joint: str
+    interface: Literal["position", "velocity", "effort"]
+    reduction: float = 1.0
 
 
 @dataclass
@@ -30,37 +51,34 @@ class RobotModel:
     urdf: str
     links: list[str] = field(default_factory=list)
     joints: list[str] = field(default_factory=list)
+    gazebo: GazeboInfo = field(default_factory=GazeboInfo)
+    transmissions: list[Transmission] = field(default_factory=list)
 
 
 _JOINT_TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
 
 
-def _float(text: str | None, default: float | None = None) -> float | None:
-    try:
-        return float(text) if text is not None else default
-    except ValueError:
-        return default
-
-
-def _check_structure(root: ET.Element, file: Path | None) -> str:
+def _check_structure(root: Any, where: Any) -> str:
     """Checks MuJoCo would report badly or not at all; returns the root link's name."""
-    links = [el.get("name") for el in root.findall("link")]
-    if not links:
-        raise DescriptionError("the URDF has no <link>", file, hint="a robot needs at least one link")
-    for name in links:
+    link_els = root.findall("link")
+    if not link_els:
+        raise DescriptionError("the URDF has no <link>", *where(root), hint="a robot needs at least one link")
+    links: list[str] = []
+    for el in link_els:
+        name = el.get("name")
         if not name:
-            raise DescriptionError("a <link> has no name", file)
-    dupes = {n for n in links if links.count(n) > 1}
-    if dupes:
-        raise DescriptionError(f"link {sorted(dupes)[0]!r} is defined twice", file)
-    children: set[str] = set()
+            raise DescriptionError("a <link> has no name", *where(el))
+        if name in links:
+            raise DescriptionError(f"link {name!r} is defined twice", *where(el))
+        links.append(name)
+    children: dict[str, str] = {}
     for j in root.findall("joint"):
         jname = j.get("name") or "?"
         jtype = j.get("type")
         if jtype not in _JOINT_TYPES:
             raise DescriptionError(
                 f"joint {jname!r} has type {jtype!r}",
-                file,
+                *where(j),
                 hint="URDF joint types: " + ", ".join(sorted(_JOINT_TYPES)),
             )
         for tag in ("parent", "child"):
@@ -69,83 +87,234 @@ def _check_structure(root: ET.Element, file: Path | None) -> str:
             if ref not in links:
                 raise DescriptionError(
                     f"joint {jname!r} names {tag} link {ref!r}, which is not defined",
-                    file,
-                    hint="defined links: " + ", ".join(n for n in links if n),
+                    *where(j if el is None else el),
+                    hint="defined links: " + ", ".join(links),
                 )
-        children.add(j.find("child").get("link"))  # type: ignore[union-attr]
+        child = j.find("child").get("link")
+        if child in children:
+            raise DescriptionError(
+                f"link {child!r} is the child of two joints ({children[child]!r} and {jname!r})", *where(j)
+            )
+        children[child] = jname
+        if jtype not in ("fixed", "floating", "planar") and j.find("child") is not None:
+            link_el = next(e for e in link_els if e.get("name") == child)
+            mass = link_el.find("inertial/mass")
+            if mass is not None and float(mass.get("value", "1") or 0) <= 0:
+                raise DescriptionError(
+                    f"link {child!r} moves (joint {jname!r} is {jtype}) but has zero mass",
+                    *where(mass),
+                    hint="give it a positive <mass value=...> and an <inertia>",
+                )
     roots = [n for n in links if n not in children]
     if len(roots) != 1:
         raise DescriptionError(
-            f"the URDF must form one tree, found {len(roots)} root links: {', '.join(map(str, roots))}",
-            file,
+            f"the URDF must form one tree, found {len(roots)} root links: {', '.join(roots)}",
+            *where(root),
             hint="every link but one must be the child of a joint",
         )
-    return str(roots[0])
+    return roots[0]
 
 
-def urdf_to_model(urdf: str, file: Path | None, packages: PackageMap, *, fixed: bool = False) -> RobotModel:
+class _Where:
+    """file:line for an element: its own line in a URDF file; for xacro output, the xacro file."""
+
+    def __init__(self, file: Path | None, expanded: bool):
+        self.file = file
+        self.expanded = expanded
+
+    def __call__(self, el: Any) -> tuple[Path | None, int | None]:
+        return self.file, (None if self.expanded else el.sourceline)
+
+
+def urdf_to_model(
+    urdf: str,
+    file: Path | None,
+    packages: PackageMap,
+    *,
+    fixed: bool = False,
+    namespace: str = "robot",
+    notices: Notices | None = None,
+    sources: list[Path] | None = None,
+    expanded: bool = False,
+    timestep: float = 0.002,
+) -> RobotModel:
+    notices = notices if notices is not None else Notices()
     base_dir = file.parent if file else Path.cwd()
+    where = _Where(file, expanded)
     try:
-        root = ET.fromstring(urdf)
-    except ET.ParseError as e:
-        raise DescriptionError(f"not well-formed XML: {e}", file, e.position[0]) from None
+        root = parse(urdf)
+    except etree.XMLSyntaxError as e:
+        raise DescriptionError(
+            f"not well-formed XML: {e.msg}", file, None if expanded else e.lineno
+        ) from None
     if root.tag != "robot":
-        raise DescriptionError(f"the top element is <{root.tag}>, expected <robot>", file)
-    root_link = _check_structure(root, file)
+        raise DescriptionError(f"the top element is <{root.tag}>, expected <robot>", *where(root))
+    root_link = _check_structure(root, where)
 
-    # Meshes: rewrite every filename to an absolute path that exists.
     for mesh in root.iter("mesh"):
-        uri = mesh.get("filename", "")
-        path = resolve_uri(uri, packages, base_dir)
-        if path is None:
-            pkg = uri.split("/")[2] if "://" in uri else uri
-            raise DescriptionError(
-                f"mesh {uri!r}: package {pkg!r} not found",
-                file,
-                hint="add it under `packages:` in the scenario; searched: " + ", ".join(packages.searched()),
-            )
-        if not path.is_file():
-            raise DescriptionError(f"mesh {uri!r} not found (looked at {path})", file)
-        mesh.set("filename", str(path.resolve()))
+        if mesh.getparent() is not None and mesh.getparent().tag == "geometry":
+            _rewrite_mesh(mesh, packages, base_dir, where, notices)
 
-    # <gazebo reference="link"> friction; MuJoCo ignores <gazebo>, so we read it here.
-    friction: dict[str, float] = {}
-    for gz in root.findall("gazebo"):
-        ref = gz.get("reference")
-        if not ref:
-            continue
-        mu1 = _float(gz.findtext("mu1"))
-        mu2 = _float(gz.findtext("mu2"))
-        mus = [m for m in (mu1, mu2) if m is not None]
-        if mus:
-            friction[ref] = min(mus)
+    gazebo = read_gazebo(
+        root,
+        file,
+        sources=sources or ([file] if file else []),
+        expanded=expanded,
+        namespace=namespace,
+        notices=notices,
+    )
+    transmissions = _transmissions(root, where, notices)
 
     # MuJoCo's URDF defaults fuse fixed links away and drop visuals: turn both off.
     for old in root.findall("mujoco"):
         root.remove(old)
-    mj = ET.Element("mujoco")
-    ET.SubElement(mj, "compiler", {"discardvisual": "false", "fusestatic": "false", "strippath": "false"})
+    for tag in ("gazebo", "transmission", "ros2_control"):
+        for el in root.findall(tag):
+            root.remove(el)
+    mj = etree.Element("mujoco")
+    etree.SubElement(mj, "compiler", discardvisual="false", fusestatic="false", strippath="false")
     root.insert(0, mj)
-    text = ET.tostring(root, encoding="unicode")
+    text = etree.tostring(root, encoding="unicode")
     try:
         spec = mujoco.MjSpec.from_string(text)
     except ValueError as e:
         raise DescriptionError(f"MuJoCo cannot load this URDF: {e}", file) from None
 
-    for link, mu in friction.items():
-        body = spec.body(link)
-        if body is None:
-            continue
-        for geom in body.geoms:
-            if geom.contype or geom.conaffinity:
-                # MuJoCo takes the larger friction of two touching geoms, Gazebo the smaller: give the
-                # geom priority so that its own value is used (a caster's mu1=0 must stay 0).
-                geom.friction = [mu, geom.friction[1], geom.friction[2]]
-                geom.priority = 1
-
+    for geom in spec.geoms:
+        if geom.contype or geom.conaffinity:
+            geom.group = COLLISION_GROUP
+    _apply_link_props(spec, gazebo, timestep)
     body = spec.body(root_link)
-    if not fixed:
+    if not (fixed or gazebo.static):
         body.add_freejoint(name="root")
     links = [b.name for b in spec.bodies if b.name and b.name != "world"]
     joints = [j.name for j in spec.joints if j.name and j.name != "root"]
-    return RobotModel(spec, root_link, urdf, links, joints)
+    return RobotModel(spec, root_link, urdf, links, joints, gazebo, transmissions)
+
+
+def _apply_link_props(spec: mujoco.MjSpec, gazebo: GazeboInfo, timestep: float) -> None:
+    for link, props in gazebo.links.items():
+        body = spec.body(link)
+        if body is None:
+            continue
+        if props.gravity_off:
+            body.gravcomp = 1.0
+        for geom in body.geoms:
+            if props.rgba is not None:
+                geom.rgba = list(props.rgba)
+            if not (geom.contype or geom.conaffinity):
+                continue
+            if props.friction is not None:
+                # MuJoCo takes the larger friction of two touching geoms, Gazebo the smaller: give the
+                # geom priority so that its own value is used (a caster's mu1=0 must stay 0).
+                geom.friction = [props.friction, geom.friction[1], geom.friction[2]]
+                geom.priority = 1
+            if props.kp:
+                # ODE's kp (N/m) as a MuJoCo contact time constant for the link's own mass, never
+                # below 2 steps (MuJoCo's stability limit). MuJoCo's direct (-stiffness, -damping) form is
+                # per unit mass, not N/m: fed Gazebo's numbers, wheels lose traction.
+                mass = max(float(body.mass), 1e-3)
+                geom.solref = [max(2.0 * timestep, 2.0 * math.pi * math.sqrt(mass / props.kp)), 1.0]
+
+
+def _rewrite_mesh(mesh: Any, packages: PackageMap, base_dir: Path, where: Any, notices: Notices) -> None:
+    uri = mesh.get("filename", "")
+    path = resolve_uri(uri, packages, base_dir)
+    if path is None:
+        pkg = uri.split("/")[2] if "://" in uri else uri
+        raise DescriptionError(
+            f"mesh {uri!r}: package {pkg!r} not found",
+            *where(mesh),
+            hint="add it under `packages:` in the scenario; searched: " + ", ".join(packages.searched()),
+        )
+    if not path.is_file():
+        raise DescriptionError(
+            f"mesh {uri!r} not found (looked at {path})",
+            *where(mesh),
+            hint="check the file name and its case; package:// paths are relative to the package folder",
+        )
+    path = path.resolve()
+    if path.suffix.lower() not in MUJOCO_MESH_FORMATS:
+        path = _convert_mesh(path, mesh, where)
+    mesh.set("filename", str(path))
+
+
+def mesh_cache() -> Path:
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "scenario-runner" / "meshes"
+
+
+def _convert_mesh(path: Path, mesh: Any, where: Any) -> Path:
+    """Collada/PLY/... -> binary STL with trimesh, cached by content hash."""
+    data = path.read_bytes()
+    out = mesh_cache() / f"{hashlib.sha256(data).hexdigest()[:20]}.stl"
+    if out.is_file():
+        return out
+    try:
+        import trimesh
+
+        loaded = trimesh.load(path, force="mesh")
+        if loaded.is_empty:
+            raise ValueError("no triangles")
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = out.with_suffix(f".{os.getpid()}.tmp")
+        loaded.export(tmp, file_type="stl")
+        tmp.replace(out)
+    except Exception as e:
+        raise DescriptionError(
+            f"mesh {path.name}: cannot convert {path.suffix} to a format MuJoCo reads "
+            f"({type(e).__name__}: {e})",
+            *where(mesh),
+            hint="export it as STL or OBJ",
+        ) from None
+    return out
+
+
+_INTERFACES: dict[str, Literal["position", "velocity", "effort"]] = {
+    "position": "position",
+    "velocity": "velocity",
+    "effort": "effort",
+}
+
+
+def _interface(text: str | None) -> Literal["position", "velocity", "effort"] | None:
+    if not text:
+        return None
+    t = text.strip().split("/")[-1].lower()
+    for key, kind in _INTERFACES.items():
+        if t.startswith(key):
+            return kind
+    return None
+
+
+def _transmissions(root: Any, where: Any, notices: Notices) -> list[Transmission]:
+    out: list[Transmission] = []
+    for tr in root.findall("transmission"):
+        joint = tr.find("joint")
+        if joint is None or not joint.get("name"):
+            notices.add("a <transmission> without a <joint name=...> is ignored", *where(tr))
+            continue
+        kinds = [_interface(e.text) for e in tr.iter("hardwareInterface")]
+        kind = next((k for k in kinds if k), None)
+        if kind is None:
+            notices.add(
+                f"transmission of joint {joint.get('name')!r} has no velocity/position/effort "
+                "interface; ignored",
+                *where(tr),
+            )
+            continue
+        reduction = 1.0
+        red = tr.find("actuator/mechanicalReduction")
+        if red is not None and red.text:
+            try:
+                reduction = float(red.text)
+            except ValueError:
+                notices.add(f"mechanicalReduction {red.text!r} is not a number; 1 is used", *where(red))
+        out.append(Transmission(joint.get("name"), kind, reduction or 1.0))
+    for rc in root.findall("ros2_control"):
+        for joint in rc.findall("joint"):
+            names = [c.get("name") for c in joint.findall("command_interface")]
+            kind = next((_interface(n) for n in names if _interface(n)), None)
+            if kind and joint.get("name"):
+                out.append(Transmission(joint.get("name"), kind))
+    return out

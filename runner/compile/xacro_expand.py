@@ -11,6 +11,7 @@ import contextlib
 import io
 import threading
 import xml.parsers.expat
+from dataclasses import dataclass
 from pathlib import Path
 
 import xacro
@@ -31,8 +32,14 @@ class MissingPackage(XacroError):
 _lock = threading.Lock()
 
 
-def expand(path: Path, args: dict[str, str], packages: PackageMap) -> str:
-    """Run xacro on `path` with `args` (`$(arg name)`); return the URDF text."""
+@dataclass
+class Expanded:
+    urdf: str
+    sources: list[Path]  # the xacro file and every file it included, for pointing at lines
+
+
+def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
+    """Run xacro on `path` with `args` (`$(arg name)`); return the URDF text and the files it read."""
 
     def find(pkg: str) -> str:
         root = packages.find(pkg)
@@ -51,10 +58,12 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> str:
         _sa._eval_find = find
         _sa._eval_dict["find"] = find
         stderr = io.StringIO()
+        xacro.all_includes = []
         try:
             with contextlib.redirect_stderr(stderr):
                 doc = xacro.process_file(str(path), mappings={k: str(v) for k, v in args.items()})
-            return doc.toprettyxml(indent="  ")
+            sources = [path] + [Path(f) for f in dict.fromkeys(xacro.all_includes)]
+            return Expanded(doc.toprettyxml(indent="  "), sources)
         except MissingPackage:
             raise
         except xml.parsers.expat.ExpatError as e:

@@ -76,8 +76,9 @@ class RobotHandle:
         return slice(adr, adr + int(self.model.sensor_dim[i]))
 
     def frame(self, link: str) -> str:
-        """The TF frame id of a link: `<ns>/<link>`."""
-        return f"{self.namespace}/{link}"
+        """The TF frame id of a link: `<ns>/<link>` (a link already named `<ns>/...`, as xacro
+        `tf_prefix` descriptions do, is not prefixed twice)."""
+        return link if link.startswith(self.namespace + "/") else f"{self.namespace}/{link}"
 
 
 @dataclass
