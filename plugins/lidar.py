@@ -34,6 +34,14 @@ class LidarParams(RatedParams):
     range_max: PositiveFloat = Field(12.0, description="Farthest valid return, metres.")
     resolution: float = Field(0.0, ge=0, description="Range quantization step, metres (0: none).")
     noise_stddev: float = Field(0.0, ge=0, description="Gaussian noise on each range, metres.")
+    vertical_samples: PositiveInt = Field(
+        1, description="Beams per column; more than 1 makes a 3D lidar that also publishes a PointCloud2."
+    )
+    vertical_min_angle: float = Field(0.0, ge=-math.pi / 2, le=math.pi / 2, description="Lowest beam, rad.")
+    vertical_max_angle: float = Field(0.0, ge=-math.pi / 2, le=math.pi / 2, description="Highest beam, rad.")
+    points_topic: str | None = Field(
+        None, description="PointCloud2 topic of a 3D lidar (default: <topic>/points)."
+    )
 
     @model_validator(mode="after")
     def _angles(self) -> LidarParams:
@@ -41,6 +49,8 @@ class LidarParams(RatedParams):
             raise ValueError(f"max_angle ({self.max_angle}) is below min_angle ({self.min_angle})")
         if self.range_max <= self.range_min:
             raise ValueError(f"range_max ({self.range_max}) must exceed range_min ({self.range_min})")
+        if self.vertical_max_angle < self.vertical_min_angle:
+            raise ValueError("vertical_max_angle is below vertical_min_angle")
         return self
 
 
@@ -52,7 +62,11 @@ class Lidar(Plugin):
     def build(cls, params: LidarParams, ctx: BuildContext, name: str) -> list[Topic]:
         link = pick_link(ctx, params.link, ("lidar", "laser", "scan"))
         add_site(ctx, link, name, params.pose)
-        return [Topic(params.topic, "sensor_msgs/msg/LaserScan", "pub", params.rate)]
+        topics = [Topic(params.topic, "sensor_msgs/msg/LaserScan", "pub", params.rate)]
+        if params.vertical_samples > 1:
+            points = params.points_topic or f"{params.topic}/points"
+            topics.append(Topic(points, "sensor_msgs/msg/PointCloud2", "pub", params.rate))
+        return topics
 
     def setup(self) -> None:
         p = self.params
@@ -65,9 +79,25 @@ class Lidar(Plugin):
         n = p.samples
         self.angles = np.linspace(p.min_angle, p.max_angle, n) if n > 1 else np.array([p.min_angle])
         self.increment = float(self.angles[1] - self.angles[0]) if n > 1 else 0.0
-        self.local = np.stack([np.cos(self.angles), np.sin(self.angles), np.zeros(n)])  # 3 x n
-        self.geomid = np.zeros(n, dtype=np.int32)
-        self.dist = np.zeros(n, dtype=np.float64)
+        nv = p.vertical_samples
+        self.elevations = (
+            np.linspace(p.vertical_min_angle, p.vertical_max_angle, nv) if nv > 1 else np.array([0.0])
+        )
+        # Rays row by row (one row per elevation), the scan row is the one closest to horizontal.
+        el, az = np.meshgrid(self.elevations, self.angles, indexing="ij")
+        self.local = np.stack(
+            [(np.cos(el) * np.cos(az)).ravel(), (np.cos(el) * np.sin(az)).ravel(), np.sin(el).ravel()]
+        )  # 3 x (nv*n)
+        self.scan_row = int(np.argmin(np.abs(self.elevations)))
+        self.geomid = np.zeros(n * nv, dtype=np.int32)
+        self.dist = np.zeros(n * nv, dtype=np.float64)
+        if nv > 1:
+            self.points_pub = ctx.publisher(
+                p.points_topic or f"{p.topic}/points", "sensor_msgs/msg/PointCloud2"
+            )
+            field = msgs.T["sensor_msgs/msg/PointField"]
+            self.fields = [field(name=c, offset=4 * i, datatype=7, count=1) for i, c in enumerate("xyz")]
+            self.PointCloud2 = msgs.T["sensor_msgs/msg/PointCloud2"]
         # Rays skip the robot's own geoms and visual-only geoms (URDF visuals are group 1, no contacts).
         skip = np.zeros(m.ngeom, dtype=bool)
         skip[ctx.robot.geom_ids] = True
@@ -120,12 +150,17 @@ class Lidar(Plugin):
 
     def after_step(self, now_ns: int) -> None:
         p = self.params
-        ranges = self.scan()
-        finite = np.isfinite(ranges)
+        every = self.scan()
+        finite = np.isfinite(every)
         if p.noise_stddev > 0:
-            ranges[finite] += self.ctx.rng.normal(0.0, p.noise_stddev, int(finite.sum()))
+            every[finite] += self.ctx.rng.normal(0.0, p.noise_stddev, int(finite.sum()))
         if p.resolution > 0:
-            ranges[finite] = np.round(ranges[finite] / p.resolution) * p.resolution
+            every[finite] = np.round(every[finite] / p.resolution) * p.resolution
+        n = p.samples
+        if p.vertical_samples > 1:
+            self._publish_points(every, now_ns)
+        ranges = every[self.scan_row * n : (self.scan_row + 1) * n].copy()
+        finite = np.isfinite(ranges)
         ranges[finite & (ranges > p.range_max)] = np.inf
         ranges[finite & (ranges < p.range_min)] = -np.inf
         msg = self.LaserScan(
@@ -141,3 +176,23 @@ class Lidar(Plugin):
             intensities=self.empty,
         )
         self.pub.publish(msg, now_ns)
+
+    def _publish_points(self, ranges: np.ndarray, now_ns: int) -> None:
+        """A PointCloud2 (x, y, z float32, sensor frame, one row per elevation); NaN where no return."""
+        p = self.params
+        valid = np.isfinite(ranges) & (ranges >= p.range_min) & (ranges <= p.range_max)
+        r = np.where(valid, ranges, np.nan)
+        xyz = (self.local * r).T.astype(np.float32)  # (nv*n) x 3
+        n, nv = p.samples, p.vertical_samples
+        msg = self.PointCloud2(
+            header=msgs.header(now_ns, self.frame_id),
+            height=nv,
+            width=n,
+            fields=self.fields,
+            is_bigendian=False,
+            point_step=12,
+            row_step=12 * n,
+            data=np.frombuffer(xyz.tobytes(), dtype=np.uint8),
+            is_dense=bool(valid.all()),
+        )
+        self.points_pub.publish(msg, now_ns)

@@ -121,3 +121,20 @@ def test_joint_states_use_urdf_joint_names(write_scenario):
     assert list(js.name) == ["left_wheel_joint", "right_wheel_joint"]
     # 0.3 m/s on 0.05 m wheels for ~5 s: about 30 rad each
     assert 25 < js.position[0] < 32
+
+
+def test_3d_lidar_publishes_a_point_cloud_on_the_wall(write_scenario):
+    text = WALL.format(duration=0.2, noise=0.0).replace(
+        "range_max: 10,",
+        "range_max: 10, vertical_samples: 9, vertical_min_angle: 0.0, vertical_max_angle: 0.2,",
+    )
+    _, bus = simulate(write_scenario(text))
+    _, cloud = messages(bus, "r1/scan/points")[-1]
+    assert (cloud.height, cloud.width, cloud.point_step) == (9, 361, 12)
+    xyz = np.frombuffer(cloud.data.tobytes(), dtype=np.float32).reshape(9, 361, 3)
+    ahead = xyz[:, 180]  # azimuth 0, every elevation
+    assert np.allclose(ahead[:, 0], 2.0, atol=2e-3)  # all rows hit the wall 2 m ahead
+    assert np.allclose(ahead[:, 2], 2.0 * np.tan(np.linspace(0.0, 0.2, 9)), atol=3e-3)
+    assert np.isnan(xyz[4, 0]).all()  # behind: no return (the ground is below every beam)
+    _, scan = messages(bus, "r1/scan")[-1]  # the horizontal row is still a LaserScan
+    assert abs(scan.ranges[180] - 2.0) < 2e-3

@@ -20,6 +20,7 @@ from typing import Any
 
 from lxml import etree
 
+from runner.compile.locate import Locator
 from runner.compile.materials import gazebo_material
 from runner.errors import Notices
 
@@ -75,54 +76,6 @@ class GazeboInfo:
     plugins: list[DescribedPlugin] = field(default_factory=list)
     links: dict[str, LinkProps] = field(default_factory=dict)
     static: bool = False
-
-
-class _Where:
-    """file:line of an element: the URDF's own line, or for xacro output, the line in the xacro sources
-    that holds the element's most distinctive attribute."""
-
-    def __init__(self, file: Path | None, sources: list[Path], expanded: bool):
-        self.file = file
-        self.sources = sources
-        self.expanded = expanded
-        self._texts: dict[Path, list[str]] = {}
-
-    def __call__(self, el: Any) -> tuple[Path | None, int | None]:
-        if not self.expanded:
-            return self.file, el.sourceline
-        keys = ("filename", "name", "reference", "type")
-        needles = [f'{k}="{v}"' for k, v in el.attrib.items() if k in keys]
-        for needle in needles:
-            for src in self.sources:
-                line = self._find(src, needle, 0)
-                if line is not None:
-                    return src, line
-        # No distinctive attribute: the first such tag after the parent's line, in the parent's file.
-        parent = el.getparent()
-        if parent is not None:
-            file, start = self(parent)
-            if file is not None and start is not None:
-                line = self._find(file, f"<{el.tag}", start)
-                if line is not None:
-                    return file, line
-        for src in self.sources:
-            line = self._find(src, f"<{el.tag}", 0)
-            if line is not None:
-                return src, line
-        return self.file, None
-
-    def _find(self, src: Path, needle: str, start: int) -> int | None:
-        lines = self._texts.get(src)
-        if lines is None:
-            try:
-                lines = src.read_text(encoding="utf-8", errors="replace").splitlines()
-            except OSError:
-                lines = []
-            self._texts[src] = lines
-        for i in range(max(start - 1, 0), len(lines)):
-            if needle in lines[i]:
-                return i + 1
-        return None
 
 
 class _Reader:
@@ -210,7 +163,7 @@ class GazeboReader:
         notices: Notices,
     ):
         self.root = root
-        self.where = _Where(file, sources, expanded)
+        self.where = Locator(file, sources, expanded)
         self.namespace = namespace
         self.notices = notices
         self.info = GazeboInfo()

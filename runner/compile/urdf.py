@@ -24,6 +24,7 @@ import mujoco
 from lxml import etree
 
 from runner.compile.gazebo import GazeboInfo, parse, read_gazebo
+from runner.compile.locate import Locator
 from runner.compile.packages import PackageMap, resolve_uri
 from runner.errors import Notices, SourceError
 
@@ -115,17 +116,6 @@ def _check_structure(root: Any, where: Any) -> str:
     return roots[0]
 
 
-class _Where:
-    """file:line for an element: its own line in a URDF file; for xacro output, the xacro file."""
-
-    def __init__(self, file: Path | None, expanded: bool):
-        self.file = file
-        self.expanded = expanded
-
-    def __call__(self, el: Any) -> tuple[Path | None, int | None]:
-        return self.file, (None if self.expanded else el.sourceline)
-
-
 def urdf_to_model(
     urdf: str,
     file: Path | None,
@@ -140,7 +130,7 @@ def urdf_to_model(
 ) -> RobotModel:
     notices = notices if notices is not None else Notices()
     base_dir = file.parent if file else Path.cwd()
-    where = _Where(file, expanded)
+    where = Locator(file, sources or ([file] if file else []), expanded)
     try:
         root = parse(urdf)
     except etree.XMLSyntaxError as e:

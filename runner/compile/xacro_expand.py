@@ -44,9 +44,11 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
     def find(pkg: str) -> str:
         root = packages.find(pkg)
         if root is None:
+            asker = _current_file(path)
             raise MissingPackage(
                 f"package {pkg!r} not found (asked by $(find {pkg}))",
-                Path(xacro.filestack[-1]) if getattr(xacro, "filestack", None) else path,
+                asker,
+                _line_of(asker, f"$(find {pkg})"),
                 hint="add it under `packages:` in the scenario, or put its folder (with a package.xml) "
                 "beside the scenario or on SCENARIO_PACKAGE_PATH; searched: "
                 + ", ".join(packages.searched()),
@@ -71,6 +73,7 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
                 f"not well-formed XML: {xml.parsers.expat.errors.messages.get(e.code, e)}",
                 _current_file(path),
                 e.lineno,
+                hint="look for an unclosed tag, a stray '<' or '&'",
             ) from None
         except Exception as e:
             cause = e.__cause__ or e.__context__
@@ -82,6 +85,16 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
             _sa._eval_find, found = saved
             if found is not None:
                 _sa._eval_dict["find"] = found
+
+
+def _line_of(file: Path, needle: str) -> int | None:
+    try:
+        for i, line in enumerate(file.read_text(encoding="utf-8", errors="replace").splitlines()):
+            if needle in line:
+                return i + 1
+    except OSError:
+        pass
+    return None
 
 
 def _current_file(default: Path) -> Path:
