@@ -81,3 +81,38 @@ def test_gazebo_mu_reaches_the_caster(write_scenario):
     geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] == caster and model.geom_contype[g]]
     assert geoms and all(model.geom_friction[g][0] == 0 for g in geoms)
     assert all(model.geom_priority[g] > 0 for g in geoms)
+
+
+def test_world_from_an_sdf_file_with_yaml_models_added(write_scenario):
+    from tests.conftest import REPO
+
+    world = REPO / "tests" / "data" / "worlds" / "box_house.world"
+    plan = plan_of(
+        write_scenario(
+            f"""
+name: w
+world:
+  sdf: {world}
+  models:
+    - {{name: extra, shape: box, size: [0.2, 0.2, 0.2], pose: {{xyz: [1, 1, 0.1]}}}}
+robots:
+  - {{name: r1, description: "{{diffbot}}", pose: {{xyz: [0, 0, 0.06]}}}}
+"""
+        )
+    )
+    model = mujoco.MjModel.from_xml_string(plan.mjcf)
+    names = {model.geom(g).name for g in range(model.ngeom)}
+    assert "ground" in names and "extra" in names
+    assert any(n.startswith("box_a/") for n in names)
+    assert sum(1 for g in range(model.ngeom) if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_PLANE) == 1
+
+
+def test_missing_world_file_points_at_the_scenario_line(write_scenario):
+    import pytest
+
+    from runner.errors import ScenarioError
+
+    with pytest.raises(ScenarioError) as e:
+        plan_of(write_scenario("name: w\nworld:\n  sdf: nowhere.world\n"))
+    text = e.value.render()
+    assert "nowhere.world" in text and ":3:3: world.sdf" in text

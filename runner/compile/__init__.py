@@ -16,6 +16,7 @@ from pydantic import ValidationError
 from runner import msgs
 from runner.compile.gazebo import DescribedPlugin
 from runner.compile.packages import PackageMap
+from runner.compile.sdf import load_sdf_world
 from runner.compile.urdf import RobotModel, urdf_to_model
 from runner.compile.xacro_expand import expand
 from runner.errors import Location, Notices, Problem, ScenarioError, SourceError
@@ -57,7 +58,7 @@ def compile_plan(
                 )
             )
 
-    world = _world_spec(sc)
+    world, sdf_rate = _world_spec(sc, doc, packages, notices)
     robots: list[RobotPlan] = []
     for i, robot in enumerate(sc.robots):
         model = _robot_model(robot, i, doc, packages, notices, sc.world.physics.timestep)
@@ -107,14 +108,16 @@ def compile_plan(
     )
     _check_key_exprs(record, doc)
 
-    phys = sc.world.physics
+    rate = sc.rate
+    if sdf_rate and "rate" not in sc.model_fields_set:
+        rate = sdf_rate  # the world file's <real_time_factor>, unless the scenario sets `rate:`
     return RunPlan(
         name=sc.name,
         scenario_file=str(doc.file) if doc.file else None,
         duration_ns=round(sc.duration * 1e9),
-        rate=sc.rate,
+        rate=rate,
         seed=sc.seed,
-        step_ns=round(phys.timestep * 1e9),
+        step_ns=round(world.option.timestep * 1e9),
         clock_rate=sc.world.clock_rate,
         mjcf=mjcf,
         robots=robots,
@@ -125,7 +128,10 @@ def compile_plan(
 
 
 # ------------------------------------------------------------------------------------------------ world
-def _world_spec(sc: Scenario) -> mujoco.MjSpec:
+def _world_spec(
+    sc: Scenario, doc: Document, packages: PackageMap, notices: Notices
+) -> tuple[mujoco.MjSpec, float | None]:
+    """The world without robots, and the SDF's real-time factor if it gives one."""
     spec = mujoco.MjSpec()
     spec.modelname = sc.name
     phys = sc.world.physics
@@ -146,9 +152,31 @@ def _world_spec(sc: Scenario) -> mujoco.MjSpec:
             rgba=list(ground.rgba),
             friction=[ground.friction, 0.005, 0.0001],
         )
+    rate = _load_sdf(spec, sc, doc, packages, notices) if sc.world.sdf else None
     for m in sc.world.models:
         _add_model(spec, m)
-    return spec
+    return spec, rate
+
+
+def _load_sdf(
+    spec: mujoco.MjSpec, sc: Scenario, doc: Document, packages: PackageMap, notices: Notices
+) -> float | None:
+    assert sc.world.sdf is not None
+    try:
+        sdf = load_sdf_world(spec, doc.base_dir / sc.world.sdf, packages, notices)
+    except SourceError as e:
+        raise ScenarioError(
+            [
+                Problem(str(e), Location(e.file, e.line), hint=e.hint),
+                Problem("while loading the world file", doc.locate(("world", "sdf")), ("world", "sdf")),
+            ]
+        ) from None
+    explicit = sc.world.physics.model_fields_set  # the scenario's own values win over the file's
+    if sdf.timestep and "timestep" not in explicit:
+        spec.option.timestep = sdf.timestep
+    if sdf.gravity and "gravity" not in explicit:
+        spec.option.gravity = list(sdf.gravity)
+    return sdf.real_time_factor
 
 
 def _add_model(spec: mujoco.MjSpec, m: WorldModel) -> None:

@@ -55,6 +55,19 @@ GAZEBO_MATERIALS: dict[str, tuple[float, float, float, float]] = {
     "Gazebo/Chrome": (0.8, 0.8, 0.8, 1.0),
     "Gazebo/BuildingFrame": (0.9, 0.9, 0.9, 1.0),
     "Gazebo/Grid": (0.7, 0.7, 0.7, 1.0),
+    "Gazebo/WhiteGlow": (1.0, 1.0, 1.0, 1.0),
+    "Gazebo/LightGray": (0.8, 0.8, 0.8, 1.0),
+    "Gazebo/RedGlow": (1.0, 0.0, 0.0, 1.0),
+    "Gazebo/GreenGlow": (0.0, 1.0, 0.0, 1.0),
+    "Gazebo/BlueLaser": (0.0, 0.0, 1.0, 0.6),
+    "Gazebo/YellowGlow": (1.0, 1.0, 0.0, 1.0),
+    "Gazebo/YellowTransparent": (1.0, 1.0, 0.0, 0.5),
+    "Gazebo/PurpleGlow": (1.0, 0.0, 1.0, 1.0),
+    "Gazebo/TurquoiseGlow": (0.0, 1.0, 1.0, 1.0),
+    "Gazebo/GrassFloor": (0.3, 0.55, 0.2, 1.0),
+    "Gazebo/Asphalt": (0.25, 0.25, 0.25, 1.0),
+    "Gazebo/Pioneer2Body": (0.5, 0.0, 0.0, 1.0),
+    "Gazebo/PioneerBody": (0.5, 0.0, 0.0, 1.0),
 }
 
 
@@ -63,5 +76,7 @@ def gazebo_material(name: str) -> tuple[float, float, float, float] | None:
     name = name.strip()
     if name in GAZEBO_MATERIALS:
         return GAZEBO_MATERIALS[name]
-    lower = {k.lower(): v for k, v in GAZEBO_MATERIALS.items()}
-    return lower.get(name.lower())
+    return _LOWER.get(name.lower())
+
+
+_LOWER = {k.lower(): v for k, v in GAZEBO_MATERIALS.items()}
