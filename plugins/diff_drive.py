@@ -5,12 +5,16 @@ Subscribes `cmd_vel` (geometry_msgs/Twist); drives the two wheel joints with MuJ
 odom -> base transform on `tf`. Odometry comes from the wheel encoders (integrated joint angles, so it
 drifts when wheels slip, as on a real robot) or from the world (the true pose, as Gazebo's
 `odometrySource: world`).
+
+The implementation (`WheelDrive`) drives any number of wheel joints per side; `skid_steer` is the same
+drive with lists of joints (plugins/skid_steer.py).
 """
 
 from __future__ import annotations
 
 import math
-from typing import Literal
+from collections.abc import Sequence
+from typing import Any, ClassVar, Literal
 
 import mujoco
 import numpy as np
@@ -30,10 +34,10 @@ _ROUND = {
 }
 
 
-class DiffDriveParams(RatedParams):
+class WheelDriveParams(RatedParams):
+    """Parameters shared by `diff_drive` and `skid_steer` (everything but the wheel joints)."""
+
     rate: float = Field(50.0, gt=0, description="Control and odometry rate, sim Hz.")
-    left_joint: str = Field("left_wheel_joint", description="Left wheel joint.")
-    right_joint: str = Field("right_wheel_joint", description="Right wheel joint.")
     wheel_separation: PositiveFloat | None = Field(
         None, description="Distance between the wheels, metres (default: measured from the model)."
     )
@@ -64,19 +68,47 @@ class DiffDriveParams(RatedParams):
     )
 
 
-class DiffDrive(Plugin):
-    Params = DiffDriveParams
-    params: DiffDriveParams
+class DiffDriveParams(WheelDriveParams):
+    left_joint: str = Field("left_wheel_joint", description="Left wheel joint.")
+    right_joint: str = Field("right_wheel_joint", description="Right wheel joint.")
+
+
+class WheelDrive(Plugin):
+    """A drive with one or more wheel joints per side, each with its own velocity servo.
+
+    Subclasses say which joints form each side (`sides`). Every wheel of a side gets the same target
+    speed; encoder odometry uses the mean angle of each side's wheels.
+    """
+
+    Params: ClassVar[type[WheelDriveParams]] = WheelDriveParams
+    params: WheelDriveParams
 
     @classmethod
-    def build(cls, params: DiffDriveParams, ctx: BuildContext, name: str) -> list[Topic]:
-        for side, jname in (("left", params.left_joint), ("right", params.right_joint)):
-            joint = ctx.joint(jname, f"{side}_joint")
+    def sides(cls, params: Any) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
+        """(joint name, parameter naming it) of the left and of the right wheels."""
+        raise NotImplementedError
+
+    @classmethod
+    def _actuator_names(cls, params: Any, name: str) -> list[str]:
+        left, right = cls.sides(params)
+        out = []
+        for side, joints in (("left", left), ("right", right)):
+            for jname, _param in joints:
+                out.append(f"{name}/{side}" if len(joints) == 1 else f"{name}/{jname}")
+        return out
+
+    @classmethod
+    def build(cls, params: WheelDriveParams, ctx: BuildContext, name: str) -> list[Topic]:
+        left, right = cls.sides(params)
+        seen: set[str] = set()
+        for (jname, param), act_name in zip(left + right, cls._actuator_names(params, name), strict=True):
+            joint = ctx.joint(jname, param)
             if joint.type != mujoco.mjtJoint.mjJNT_HINGE:
-                raise PluginConfigError(f"wheel joint {jname!r} is not revolute/continuous", f"{side}_joint")
-            act = ctx.spec.add_actuator(
-                name=f"{name}/{side}", target=jname, trntype=mujoco.mjtTrn.mjTRN_JOINT
-            )
+                raise PluginConfigError(f"wheel joint {jname!r} is not revolute/continuous", param)
+            if jname in seen:
+                raise PluginConfigError(f"wheel joint {jname!r} is named twice", param)
+            seen.add(jname)
+            act = ctx.spec.add_actuator(name=act_name, target=jname, trntype=mujoco.mjtTrn.mjTRN_JOINT)
             act.set_to_velocity(kv=params.gain or 1.0)  # the automatic gain is set in setup()
             act.forcelimited = True
             act.forcerange = [-params.max_wheel_torque, params.max_wheel_torque]
@@ -91,42 +123,48 @@ class DiffDrive(Plugin):
         p = self.params
         m, d = self.ctx.model, self.ctx.data
         r = self.ctx.robot
-        self.act = [r.actuator_id(f"{self.name}/left"), r.actuator_id(f"{self.name}/right")]
-        joints = [r.joint_id(p.left_joint), r.joint_id(p.right_joint)]
-        self.qadr = [int(m.jnt_qposadr[j]) for j in joints]
-        self.vadr = [int(m.jnt_dofadr[j]) for j in joints]
+        left, right = self.sides(p)
+        self.nleft = len(left)
+        self.act = np.array([r.actuator_id(a) for a in self._actuator_names(p, self.name)])
+        joints = [r.joint_id(j) for j, _ in left + right]
+        self.qadr = np.array([int(m.jnt_qposadr[j]) for j in joints])
+        self.vadr = np.array([int(m.jnt_dofadr[j]) for j in joints])
         wheel_bodies = [int(m.jnt_bodyid[j]) for j in joints]
-        self.sep = p.wheel_separation or float(
-            np.linalg.norm(d.xpos[wheel_bodies[0]] - d.xpos[wheel_bodies[1]])
-        )
-        self.radius = p.wheel_radius or _wheel_radius(m, wheel_bodies[0])
+        left_centre = np.mean([d.xpos[b] for b in wheel_bodies[: self.nleft]], axis=0)
+        right_centre = np.mean([d.xpos[b] for b in wheel_bodies[self.nleft :]], axis=0)
+        self.sep = p.wheel_separation or float(np.linalg.norm(left_centre - right_centre))
+        self.radius = p.wheel_radius or float(np.mean([_wheel_radius(m, b) for b in wheel_bodies]))
         self.base = r.root_body
         if p.gain is None:
-            kv = _auto_gain(m, r.body_ids, wheel_bodies[0], self.radius)
-            for a in self.act:
+            for a, wheel in zip(self.act, wheel_bodies, strict=True):
+                kv = _auto_gain(m, r.body_ids, wheel, self.radius, len(wheel_bodies))
                 m.actuator_gainprm[a, 0] = kv
                 m.actuator_biasprm[a, 2] = -kv
         self.base_frame = p.base_frame or r.frame(r.root_link)
         self.odom_frame = r.frame(p.odom_frame)
         self.cmd = (0.0, 0.0)
         self.cmd_time = 0
-        self.target = np.zeros(2)
-        self.ctrl = np.zeros(2)
+        # sign of each wheel's share of the turn: -1 for the left side, +1 for the right
+        self.turn_sign = np.where(np.arange(len(joints)) < self.nleft, -1.0, 1.0)
+        self.target = np.zeros(len(joints))
+        self.ctrl = np.zeros(len(joints))
         # Integral of the wheel-speed error: a velocity servo alone lags under load (tyre scrub when
         # turning, slopes); Gazebo's diff drive holds the commanded wheel speed up to the torque limit.
-        self.integral = np.zeros(2)
-        self.integral_max = 0.0
+        self.integral = np.zeros(len(joints))
+        self.integral_max = p.max_wheel_torque / m.actuator_gainprm[self.act, 0]
         self.dt = 1.0 / p.rate
         # encoder odometry state
         self.x = self.y = self.yaw = 0.0
-        self.last_q = np.array([d.qpos[a] for a in self.qadr])
-        self.integral_max = p.max_wheel_torque / float(m.actuator_gainprm[self.act[0], 0])
+        self.last_q = self._side_means(d.qpos[self.qadr])
         self.ctx.subscribe(p.cmd_topic, "geometry_msgs/msg/Twist", self._on_cmd)
         self.odom_pub = self.ctx.publisher(p.odom_topic, "nav_msgs/msg/Odometry") if p.publish_odom else None
         self.tf_pub = self.ctx.publisher(p.tf_topic, "tf2_msgs/msg/TFMessage") if p.publish_tf else None
 
-    def _on_cmd(self, msg: object, stamp_ns: int) -> None:
-        self.cmd = (float(msg.linear.x), float(msg.angular.z))  # type: ignore[attr-defined]
+    def _side_means(self, values: np.ndarray) -> np.ndarray:
+        return np.array([values[: self.nleft].mean(), values[self.nleft :].mean()])
+
+    def _on_cmd(self, msg: Any, stamp_ns: int) -> None:
+        self.cmd = (float(msg.linear.x), float(msg.angular.z))
         self.cmd_time = stamp_ns
 
     def before_step(self, now_ns: int) -> None:
@@ -135,26 +173,25 @@ class DiffDrive(Plugin):
         if p.cmd_timeout and now_ns - self.cmd_time > p.cmd_timeout * 1e9:
             v, w = 0.0, 0.0
         half = w * self.sep / 2.0
-        self.target[:] = ((v - half) / self.radius, (v + half) / self.radius)
+        self.target[:] = (v + self.turn_sign * half) / self.radius
         if p.max_wheel_acceleration > 0:
             step = p.max_wheel_acceleration * self.dt
             self.ctrl += np.clip(self.target - self.ctrl, -step, step)
         else:
             self.ctrl[:] = self.target
         d = self.ctx.data
-        speed = np.array([d.qvel[self.vadr[0]], d.qvel[self.vadr[1]]])
+        speed = d.qvel[self.vadr]
         self.integral += (self.ctrl - speed) * (self.dt / _INTEGRAL_TIME_S)
         np.clip(self.integral, -self.integral_max, self.integral_max, out=self.integral)
-        d.ctrl[self.act[0]] = self.ctrl[0] + self.integral[0]
-        d.ctrl[self.act[1]] = self.ctrl[1] + self.integral[1]
+        d.ctrl[self.act] = self.ctrl + self.integral
 
     def after_step(self, now_ns: int) -> None:
         d = self.ctx.data
-        wl, wr = d.qvel[self.vadr[0]], d.qvel[self.vadr[1]]
+        wl, wr = self._side_means(d.qvel[self.vadr])
         v = self.radius * (wl + wr) / 2.0
         w = self.radius * (wr - wl) / self.sep
         if self.params.odometry_source == "encoders":
-            q = np.array([d.qpos[a] for a in self.qadr])
+            q = self._side_means(d.qpos[self.qadr])
             dl, dr = (q - self.last_q) * self.radius
             self.last_q = q
             ds, dyaw = (dl + dr) / 2.0, (dr - dl) / self.sep
@@ -162,8 +199,8 @@ class DiffDrive(Plugin):
             self.x += ds * math.cos(mid)
             self.y += ds * math.sin(mid)
             self.yaw += dyaw
-            pos = (self.x, self.y, 0.0)
-            quat = yaw_to_quat(self.yaw)
+            pos: Sequence[float] = (self.x, self.y, 0.0)
+            quat: Sequence[float] = yaw_to_quat(self.yaw)
         else:
             pos = d.xpos[self.base]
             quat = d.xquat[self.base]
@@ -174,20 +211,32 @@ class DiffDrive(Plugin):
                 now_ns,
             )
         if self.tf_pub:
-            T = msgs.T
-            tf = T["geometry_msgs/msg/TransformStamped"](
-                header=msgs.header(now_ns, self.odom_frame),
-                child_frame_id=self.base_frame,
-                transform=T["geometry_msgs/msg/Transform"](
-                    translation=T["geometry_msgs/msg/Vector3"](
-                        x=float(pos[0]), y=float(pos[1]), z=float(pos[2])
-                    ),
-                    rotation=T["geometry_msgs/msg/Quaternion"](
-                        x=float(quat[1]), y=float(quat[2]), z=float(quat[3]), w=float(quat[0])
-                    ),
-                ),
-            )
-            self.tf_pub.publish(T["tf2_msgs/msg/TFMessage"](transforms=[tf]), now_ns)
+            self.tf_pub.publish(tf_message(now_ns, self.odom_frame, self.base_frame, pos, quat), now_ns)
+
+
+class DiffDrive(WheelDrive):
+    Params = DiffDriveParams
+    params: DiffDriveParams
+
+    @classmethod
+    def sides(cls, params: DiffDriveParams) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
+        return [(params.left_joint, "left_joint")], [(params.right_joint, "right_joint")]
+
+
+def tf_message(now_ns: int, parent: str, child: str, pos: Sequence[float], quat_wxyz: Sequence[float]) -> Any:
+    """A tf2_msgs/TFMessage holding one transform parent -> child."""
+    T = msgs.T
+    tf = T["geometry_msgs/msg/TransformStamped"](
+        header=msgs.header(now_ns, parent),
+        child_frame_id=child,
+        transform=T["geometry_msgs/msg/Transform"](
+            translation=T["geometry_msgs/msg/Vector3"](x=float(pos[0]), y=float(pos[1]), z=float(pos[2])),
+            rotation=T["geometry_msgs/msg/Quaternion"](
+                x=float(quat_wxyz[1]), y=float(quat_wxyz[2]), z=float(quat_wxyz[3]), w=float(quat_wxyz[0])
+            ),
+        ),
+    )
+    return T["tf2_msgs/msg/TFMessage"](transforms=[tf])
 
 
 def _wheel_radius(m: mujoco.MjModel, body: int) -> float:
@@ -205,10 +254,12 @@ def _wheel_radius(m: mujoco.MjModel, body: int) -> float:
     return best
 
 
-def _auto_gain(m: mujoco.MjModel, robot_bodies: set[int], wheel: int, radius: float) -> float:
+def _auto_gain(
+    m: mujoco.MjModel, robot_bodies: set[int], wheel: int, radius: float, nwheels: int = 2
+) -> float:
     """A servo gain giving a time constant of 5 physics steps (at least 10 ms) for the inertia one wheel
-    sees: its own inertia plus half the robot's mass at the rim."""
+    sees: its own inertia plus its share of the robot's mass at the rim."""
     mass = float(sum(m.body_mass[b] for b in robot_bodies))
-    inertia = float(max(m.body_inertia[wheel])) + mass / 2.0 * radius**2
+    inertia = float(max(m.body_inertia[wheel])) + mass / nwheels * radius**2
     tau = max(5.0 * float(m.opt.timestep), 0.01)
     return inertia / tau

@@ -41,7 +41,9 @@ class GroundTruth(Plugin):
 
     def after_step(self, now_ns: int) -> None:
         m, d = self.ctx.model, self.ctx.data
-        mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, self.body, self.vel, 0)
+        mujoco.mj_objectVelocity(
+            m, d, mujoco.mjtObj.mjOBJ_XBODY, self.body, self.vel, 0
+        )  # at the link origin
         self.pub.publish(
             odometry(
                 now_ns,

@@ -801,7 +801,10 @@ def _planar_move(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[st
     odom = r.bool("publish_odom")
     if odom is not None:
         params["publish_odom"] = odom
-    r.mark("covariance_x", "covariance_y", "covariance_yaw", "cmdTimeout")
+    timeout = r.float("cmdTimeout", "cmd_timeout")
+    if timeout and timeout > 0:
+        params["cmd_timeout"] = timeout
+    r.mark("covariance_x", "covariance_y", "covariance_yaw")
     return "planar_move", params
 
 

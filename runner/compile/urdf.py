@@ -199,6 +199,10 @@ def _apply_link_props(spec: mujoco.MjSpec, gazebo: GazeboInfo, timestep: float) 
                 # geom priority so that its own value is used (a caster's mu1=0 must stay 0).
                 geom.friction = [props.friction, geom.friction[1], geom.friction[2]]
                 geom.priority = 1
+                if props.friction == 0.0:
+                    # Frictionless as MuJoCo means it: a normal-only contact. A zero-friction cone
+                    # (condim 3) lets a loaded caster jitter until the robot is thrown.
+                    geom.condim = 1
             if props.kp:
                 # ODE's kp (N/m) as a MuJoCo contact time constant for the link's own mass, never
                 # below 2 steps (MuJoCo's stability limit). MuJoCo's direct (-stiffness, -damping) form is
