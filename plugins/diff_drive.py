@@ -26,6 +26,7 @@ from runner.geometry import quat_to_yaw, yaw_to_quat
 from runner.plugin import BuildContext, Plugin, PluginConfigError, RatedParams, Topic
 
 _INTEGRAL_TIME_S = 0.2
+_YAW_INTEGRAL_TIME_S = 0.1
 _ROUND = {
     int(mujoco.mjtGeom.mjGEOM_CYLINDER),
     int(mujoco.mjtGeom.mjGEOM_SPHERE),
@@ -65,6 +66,11 @@ class WheelDriveParams(RatedParams):
     )
     cmd_timeout: float = Field(
         0.0, ge=0, description="Stop when no command came for this long, s (0: never)."
+    )
+    yaw_rate_feedback: bool = Field(
+        False,
+        description="Close the loop on the body's yaw rate (as a gyro-stabilised drive does): the wheels "
+        "turn faster until the body turns at the commanded rate.",
     )
 
 
@@ -153,6 +159,8 @@ class WheelDrive(Plugin):
         self.integral = np.zeros(len(joints))
         self.integral_max = p.max_wheel_torque / m.actuator_gainprm[self.act, 0]
         self.dt = 1.0 / p.rate
+        self.yaw_integral = 0.0
+        self._vel = np.zeros(6)
         # encoder odometry state
         self.x = self.y = self.yaw = 0.0
         self.last_q = self._side_means(d.qpos[self.qadr])
@@ -172,6 +180,8 @@ class WheelDrive(Plugin):
         v, w = self.cmd
         if p.cmd_timeout and now_ns - self.cmd_time > p.cmd_timeout * 1e9:
             v, w = 0.0, 0.0
+        if p.yaw_rate_feedback:
+            w = self._yaw_feedback(w)
         half = w * self.sep / 2.0
         self.target[:] = (v + self.turn_sign * half) / self.radius
         if p.max_wheel_acceleration > 0:
@@ -184,6 +194,20 @@ class WheelDrive(Plugin):
         self.integral += (self.ctrl - speed) * (self.dt / _INTEGRAL_TIME_S)
         np.clip(self.integral, -self.integral_max, self.integral_max, out=self.integral)
         d.ctrl[self.act] = self.ctrl + self.integral
+
+    def _yaw_feedback(self, w: float) -> float:
+        """The turn command that makes the body yaw at `w`: an integral on the yaw-rate error, reset when
+        no turn is asked (a skid-steered body scrubs its wheels and turns slower than they say)."""
+        if w == 0.0:
+            self.yaw_integral = 0.0
+            return w
+        mujoco.mj_objectVelocity(
+            self.ctx.model, self.ctx.data, mujoco.mjtObj.mjOBJ_XBODY, self.base, self._vel, 0
+        )
+        self.yaw_integral += (w - float(self._vel[2])) * (self.dt / _YAW_INTEGRAL_TIME_S)
+        limit = 4.0 * abs(w)
+        self.yaw_integral = min(max(self.yaw_integral, -limit), limit)
+        return w + self.yaw_integral
 
     def after_step(self, now_ns: int) -> None:
         d = self.ctx.data

@@ -3,12 +3,16 @@ per side.
 
 The same drive as `diff_drive` (one implementation, plugins/diff_drive.py), with a list of wheel joints per
 side: every wheel of a side gets the same target speed from `cmd_vel` (linear.x, angular.z), each with its
-own torque-limited velocity servo. Skid steering turns by scrubbing the wheels sideways, so the robot
-turns more slowly than the wheel speeds say (as a real one does); encoder odometry then over-reports the
-turn. A larger `wheel_separation` than the geometric one (an "effective track") compensates for both.
+own torque-limited velocity servo. Skid steering turns by scrubbing the wheels sideways, so the body
+turns more slowly than the wheel speeds say (in MuJoCo about 30 % of it on a square wheelbase). By
+default the drive closes the loop on the body's yaw rate (`yaw_rate_feedback`), so `angular.z` is what
+the robot does, and odometry comes from the world (as gazebo_ros_skid_steer_drive's does), since encoder
+odometry over-reports every turn.
 """
 
 from __future__ import annotations
+
+from typing import Literal
 
 from pydantic import Field
 
@@ -16,6 +20,12 @@ from plugins.diff_drive import WheelDrive, WheelDriveParams
 
 
 class SkidSteerParams(WheelDriveParams):
+    yaw_rate_feedback: bool = Field(
+        True, description="Close the loop on the body's yaw rate so the robot turns as commanded."
+    )
+    odometry_source: Literal["encoders", "world"] = Field(
+        "world", description="The true pose (default, like gazebo_ros_skid_steer_drive), or wheel encoders."
+    )
     left_joints: list[str] = Field(
         ["front_left_wheel_joint", "rear_left_wheel_joint"],
         min_length=1,
