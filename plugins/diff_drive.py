@@ -68,9 +68,10 @@ class WheelDriveParams(RatedParams):
         0.0, ge=0, description="Stop when no command came for this long, s (0: never)."
     )
     yaw_rate_feedback: bool = Field(
-        False,
-        description="Close the loop on the body's yaw rate (as a gyro-stabilised drive does): the wheels "
-        "turn faster until the body turns at the commanded rate.",
+        True,
+        description="Close the loop on the body's yaw rate (as a gyro-stabilised drive does): when casters "
+        "drag or wheels scrub, the wheels turn faster until the body turns at the commanded rate. Off: the "
+        "wheel speeds alone follow the command, as in Gazebo's plugins.",
     )
 
 

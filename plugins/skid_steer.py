@@ -20,9 +20,6 @@ from plugins.diff_drive import WheelDrive, WheelDriveParams
 
 
 class SkidSteerParams(WheelDriveParams):
-    yaw_rate_feedback: bool = Field(
-        True, description="Close the loop on the body's yaw rate so the robot turns as commanded."
-    )
     odometry_source: Literal["encoders", "world"] = Field(
         "world", description="The true pose (default, like gazebo_ros_skid_steer_drive), or wheel encoders."
     )

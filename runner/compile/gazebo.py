@@ -47,6 +47,7 @@ _IGNORED_REASONS = {
     "implicitSpringDamper": "MuJoCo integrates joint damping implicitly",
     "disableFixedJointLumping": "fixed joints are never lumped",
     "preserveFixedJoint": "fixed joints are never lumped",
+    "static": "only a whole model can be static, in Gazebo too",
 }
 
 
@@ -633,6 +634,12 @@ class GazeboReader:
         if result is not None:
             type_name, params = result
             self.add(p, type_name, name, params)
+        known = _PLUGIN_PARAMS.get(base)
+        if known is not None:
+            for el in r.leftovers():
+                if el.tag not in known and el.tag not in _IGNORED_REASONS:
+                    r.mark(el.tag)
+                    self.note(el, f"<{el.tag}> is not a parameter of {filename!r}: Gazebo ignores it too")
         self.ignored(r, context)
 
 
@@ -687,7 +694,7 @@ _NOOP_PLUGINS = {
 def _odom_source(text: str | None) -> str | None:
     if text is None:
         return None
-    return "world" if text.strip().lower() in ("1", "world") else "encoders"
+    return "encoders" if text.strip().lower() in ("0", "encoder", "encoders") else "world"
 
 
 def _diff_drive_classic(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str, dict[str, Any]]:
@@ -707,7 +714,8 @@ def _diff_drive_classic(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> t
         "odom_topic": _topic(r.text("odometryTopic")) or remap.get("odom"),
         "odom_frame": r.text("odometryFrame", "odometry_frame"),
         "base_frame": g.frame(r.text("robotBaseFrame", "robot_base_frame")),
-        "odometry_source": _odom_source(r.text("odometrySource", "odometry_source")),
+        # gazebo_ros_diff_drive reports the true pose unless told `encoder` (its default is world)
+        "odometry_source": _odom_source(r.text("odometrySource", "odometry_source")) or "world",
     }
     tf = r.bool("publishTf", "publish_odom_tf", "broadcastTF")
     if tf is not None:
@@ -880,6 +888,105 @@ def _ros_control(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> None:
     r.mark(*[c.tag for c in r.el if isinstance(c.tag, str)])
     return None
 
+
+# The parameters the real Gazebo plugins read (classic ROS 1 and ROS 2 spellings, gz-sim systems): anything
+# else in their block is a typo or a leftover that Gazebo itself ignores, and is reported as such.
+_DIFF_DRIVE_PARAMS = {
+    "alwaysOn",
+    "updateRate",
+    "leftJoint",
+    "rightJoint",
+    "wheelSeparation",
+    "wheelDiameter",
+    "wheelAcceleration",
+    "wheelTorque",
+    "commandTopic",
+    "odometryTopic",
+    "odometryFrame",
+    "robotBaseFrame",
+    "publishWheelTF",
+    "publishOdomTF",
+    "publishWheelJointState",
+    "publishTf",
+    "legacyMode",
+    "rosDebugLevel",
+    "odometrySource",
+    "robotNamespace",
+    "ros",
+    "update_rate",
+    "left_joint",
+    "right_joint",
+    "wheel_separation",
+    "wheel_diameter",
+    "max_wheel_torque",
+    "max_wheel_acceleration",
+    "publish_odom",
+    "publish_odom_tf",
+    "publish_wheel_tf",
+    "odometry_frame",
+    "robot_base_frame",
+    "odometry_source",
+    "covariance_x",
+    "covariance_y",
+    "covariance_yaw",
+    "num_wheel_pairs",
+}
+_GZ_DIFF_DRIVE_PARAMS = {
+    "left_joint",
+    "right_joint",
+    "wheel_separation",
+    "wheel_radius",
+    "odom_publish_frequency",
+    "max_linear_acceleration",
+    "min_linear_acceleration",
+    "max_angular_acceleration",
+    "min_angular_acceleration",
+    "max_linear_velocity",
+    "min_linear_velocity",
+    "max_angular_velocity",
+    "min_angular_velocity",
+    "max_velocity",
+    "max_acceleration",
+    "max_jerk",
+    "min_jerk",
+    "topic",
+    "odom_topic",
+    "tf_topic",
+    "frame_id",
+    "child_frame_id",
+}
+_SKID_STEER_PARAMS = {
+    "alwaysOn",
+    "updateRate",
+    "leftFrontJoint",
+    "rightFrontJoint",
+    "leftRearJoint",
+    "rightRearJoint",
+    "wheelSeparation",
+    "wheelDiameter",
+    "robotBaseFrame",
+    "torque",
+    "commandTopic",
+    "odometryTopic",
+    "odometryFrame",
+    "broadcastTF",
+    "covariance_x",
+    "covariance_y",
+    "covariance_yaw",
+    "robotNamespace",
+    "ros",
+    "update_rate",
+    "left_front_joint",
+    "right_front_joint",
+    "left_rear_joint",
+    "right_rear_joint",
+}
+_PLUGIN_PARAMS = {
+    "gazebo_ros_diff_drive": _DIFF_DRIVE_PARAMS,
+    "gz-sim-diff-drive-system": _GZ_DIFF_DRIVE_PARAMS,
+    "gz-sim-diffdrive-system": _GZ_DIFF_DRIVE_PARAMS,
+    "gazebo_ros_skid_steer_drive": _SKID_STEER_PARAMS,
+}
 
 _MODEL_PLUGINS = {
     "gazebo_ros_diff_drive": _diff_drive_classic,
