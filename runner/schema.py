@@ -65,6 +65,11 @@ class Physics(Strict):
     integrator: Literal["euler", "implicitfast", "implicit", "rk4"] = Field(
         "implicitfast", description="MuJoCo integrator; implicitfast is stable with velocity actuators."
     )
+    friction_cone: Literal["elliptic", "pyramidal"] = Field(
+        "elliptic",
+        description="MuJoCo friction cone. Elliptic is exact; MuJoCo's default pyramidal cone makes high "
+        "friction (Gazebo descriptions use mu up to 100) soften contacts until wheels carry no load.",
+    )
 
 
 class Ground(Strict):

@@ -33,6 +33,7 @@ _GEOM = {
     "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
     "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
 }
+_CONE = {"elliptic": mujoco.mjtCone.mjCONE_ELLIPTIC, "pyramidal": mujoco.mjtCone.mjCONE_PYRAMIDAL}
 _INTEGRATOR = {
     "euler": mujoco.mjtIntegrator.mjINT_EULER,
     "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
@@ -138,6 +139,7 @@ def _world_spec(
     spec.option.timestep = phys.timestep
     spec.option.gravity = list(phys.gravity)
     spec.option.integrator = _INTEGRATOR[phys.integrator]
+    spec.option.cone = _CONE[phys.friction_cone]
     spec.visual.global_.offwidth = 1280
     spec.visual.global_.offheight = 960
     spec.worldbody.add_light(
