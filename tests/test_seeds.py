@@ -178,7 +178,7 @@ def test_warnings_list_only_tags_we_truly_ignore(seed):
 
 @pytest.mark.timeout(240)
 def test_block_robot_commands_reach_only_their_robot_and_both_cameras_see_change():
-    scenario, plan, bus, _ = _run("block_robot")
+    _, plan, bus, _ = _run("block_robot")
     for ns in ("br", "br1"):
         cams = [
             t.key
