@@ -1,0 +1,88 @@
+"""camera: a colour camera -> sensor_msgs/Image + sensor_msgs/CameraInfo, rendered offscreen by MuJoCo.
+
+Like Gazebo's camera sensor with libgazebo_ros_camera: the camera looks along its link's +X axis (+Z up),
+`width` x `height` pixels, horizontal field of view `fov`, clip planes `near`/`far`, gaussian intensity
+noise. CameraInfo is an ideal pinhole: fx = fy = width / (2 tan(fov / 2)), cx = width / 2,
+cy = height / 2, plumb_bob distortion with zeros, R identity, P = [K | 0].
+
+Rendering needs an OpenGL backend: headless, MUJOCO_GL=egl (set by `python -m runner.sim` when unset), or
+MUJOCO_GL=osmesa; see `plugins._render.ensure_gl_backend`. The image shows the world's geoms in MuJoCo's
+visible groups (0-2), the robot's own included, with lights but no shadows or reflections.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import mujoco
+import numpy as np
+
+from plugins._common import pick_link
+from plugins._render import (
+    CAMERA_INFO,
+    IMAGE,
+    CameraParams,
+    CameraRenderer,
+    InfoMaker,
+    Intrinsics,
+    add_camera,
+    add_noise,
+    camera_name,
+    image_msg,
+    to_format,
+)
+from runner.plugin import BuildContext, Plugin, Topic
+
+
+class Camera(Plugin):
+    Params = CameraParams
+    params: CameraParams
+    link_hints: ClassVar[tuple[str, ...]] = ("camera",)
+
+    @classmethod
+    def build(cls, params: CameraParams, ctx: BuildContext, name: str) -> list[Topic]:
+        link = pick_link(ctx, params.link, cls.link_hints)
+        add_camera(ctx, link, name, params)
+        return cls.topics(params)
+
+    @classmethod
+    def topics(cls, p: CameraParams) -> list[Topic]:
+        return [Topic(p.image_topic, IMAGE, "pub", p.rate), Topic(p.info_topic, CAMERA_INFO, "pub", p.rate)]
+
+    def setup(self) -> None:
+        p = self.params
+        ctx = self.ctx
+        r = ctx.robot
+        m = ctx.model
+        cam = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_CAMERA, r.prefix + camera_name(self.name))
+        if cam < 0:
+            raise KeyError(f"camera {r.prefix + camera_name(self.name)!r} not in the model")
+        link = m.body(int(m.cam_bodyid[cam])).name.removeprefix(r.prefix)
+        self.frame_id = p.frame_id or r.frame(link)
+        self.intrinsics = Intrinsics(p.width, p.height, p.fov)
+        self.make_info = InfoMaker(self.intrinsics)
+        self.renderer: CameraRenderer | None = None
+        self.renderer = CameraRenderer(m, cam, p.width, p.height, p.near, p.far)
+        self.color_pubs()
+
+    def color_pubs(self) -> None:
+        p = self.params
+        self.image_pub = self.ctx.publisher(p.image_topic, IMAGE)
+        self.info_pub = self.ctx.publisher(p.info_topic, CAMERA_INFO)
+
+    def publish_color(self, rgb: np.ndarray, now_ns: int) -> None:
+        """Publish the rendered RGB frame in the configured format (with noise) and its CameraInfo."""
+        p = self.params
+        img = add_noise(to_format(rgb, p.format), p.noise_stddev, self.ctx.rng)
+        self.image_pub.publish(image_msg(now_ns, self.frame_id, img, p.format), now_ns)
+        self.info_pub.publish(self.make_info(now_ns, self.frame_id), now_ns)
+
+    def after_step(self, now_ns: int) -> None:
+        assert self.renderer is not None
+        self.renderer.update(self.ctx.data)
+        self.publish_color(self.renderer.rgb(), now_ns)
+
+    def close(self) -> None:
+        if getattr(self, "renderer", None) is not None:
+            self.renderer.close()  # type: ignore[union-attr]
+            self.renderer = None
