@@ -11,7 +11,7 @@ from pydantic import Field
 
 from runner import msgs
 from runner.geometry import rpy_to_quat
-from runner.plugin import BuildContext, PluginConfigError, PluginParams
+from runner.plugin import BuildContext, PluginConfigError, PluginParams, Topic
 
 
 class MountPose(PluginParams):
@@ -76,3 +76,13 @@ def odometry(
         pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=zeros),
         twist=T["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=zeros),
     )
+
+
+def drive_topics(params: Any) -> list[Topic]:
+    """The topics of a base drive: `cmd_vel` in; `odom` and `tf` out when enabled."""
+    topics = [Topic(params.cmd_topic, "geometry_msgs/msg/Twist", "sub")]
+    if params.publish_odom:
+        topics.append(Topic(params.odom_topic, "nav_msgs/msg/Odometry", "pub", params.rate))
+    if params.publish_tf:
+        topics.append(Topic(params.tf_topic, "tf2_msgs/msg/TFMessage", "pub", params.rate))
+    return topics

@@ -20,7 +20,7 @@ import mujoco
 import numpy as np
 from pydantic import Field, PositiveFloat
 
-from plugins._common import odometry
+from plugins._common import drive_topics, odometry
 from runner import msgs
 from runner.geometry import quat_to_yaw, yaw_to_quat
 from runner.plugin import BuildContext, Plugin, PluginConfigError, RatedParams, Topic
@@ -119,12 +119,7 @@ class WheelDrive(Plugin):
             act.set_to_velocity(kv=params.gain or 1.0)  # the automatic gain is set in setup()
             act.forcelimited = True
             act.forcerange = [-params.max_wheel_torque, params.max_wheel_torque]
-        topics = [Topic(params.cmd_topic, "geometry_msgs/msg/Twist", "sub")]
-        if params.publish_odom:
-            topics.append(Topic(params.odom_topic, "nav_msgs/msg/Odometry", "pub", params.rate))
-        if params.publish_tf:
-            topics.append(Topic(params.tf_topic, "tf2_msgs/msg/TFMessage", "pub", params.rate))
-        return topics
+        return drive_topics(params)
 
     def setup(self) -> None:
         p = self.params

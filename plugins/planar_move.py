@@ -22,7 +22,7 @@ import mujoco
 import numpy as np
 from pydantic import Field, PositiveFloat
 
-from plugins._common import odometry
+from plugins._common import drive_topics, odometry
 from plugins.diff_drive import tf_message
 from runner.geometry import quat_to_yaw, yaw_to_quat
 from runner.plugin import BuildContext, Plugin, PluginConfigError, RatedParams, Topic
@@ -79,12 +79,7 @@ class PlanarMove(Plugin):
             act.set_to_velocity(kv=1.0)  # gains and limits are set in setup(), from the compiled model
             act.forcelimited = True
             act.forcerange = [-1.0, 1.0]
-        topics = [Topic(params.cmd_topic, "geometry_msgs/msg/Twist", "sub")]
-        if params.publish_odom:
-            topics.append(Topic(params.odom_topic, "nav_msgs/msg/Odometry", "pub", params.rate))
-        if params.publish_tf:
-            topics.append(Topic(params.tf_topic, "tf2_msgs/msg/TFMessage", "pub", params.rate))
-        return topics
+        return drive_topics(params)
 
     def setup(self) -> None:
         p = self.params

@@ -11,6 +11,8 @@ from typing import Any
 
 import pytest
 
+import runner  # noqa: F401  (headless GL backend chosen before any test module imports mujoco)
+
 REPO = Path(__file__).resolve().parents[1]
 SCENARIOS = REPO / "scenarios"
 DIFFBOT = SCENARIOS / "robots" / "diffbot.urdf.xacro"

@@ -748,19 +748,6 @@ def _diff_drive_gz(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[
         "base_frame": g.frame(r.text("child_frame_id")),
     }
     accel = r.float("max_linear_acceleration")
-    r.mark(
-        "min_linear_acceleration",
-        "max_angular_acceleration",
-        "min_angular_acceleration",
-        "max_linear_velocity",
-        "min_linear_velocity",
-        "max_angular_velocity",
-        "min_angular_velocity",
-        "max_velocity",
-        "max_acceleration",
-        "max_jerk",
-        "min_jerk",
-    )
     radius = params["wheel_radius"]
     if accel and radius:
         params["max_wheel_acceleration"] = accel / radius
