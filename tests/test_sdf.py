@@ -803,3 +803,24 @@ def test_fifty_models_load_quickly(tmp_path: Path) -> None:
     assert len(result.models) == 50
     assert best < 0.1, f"loading 50 models took {best * 1000:.1f} ms"
     _forward(spec)
+
+
+@pytest.mark.timeout(30)
+def test_collada_mesh_is_converted(tmp_path: Path) -> None:
+    import trimesh
+
+    (tmp_path / "box.dae").write_bytes(trimesh.creation.box((1.0, 0.5, 0.25)).export(file_type="dae"))
+    path = _write(
+        tmp_path,
+        "dae_ok.sdf",
+        """
+        <sdf version="1.6"><model name="m"><static>true</static><link name="l">
+          <visual name="v"><geometry><mesh><uri>box.dae</uri><scale>2 2 2</scale></mesh></geometry></visual>
+        </link></model></sdf>
+        """,
+    )
+    spec, _, notices = _load(path)
+    assert not list(notices)
+    model = spec.compile()
+    verts = model.mesh_vert[: model.mesh_vertnum[0]]
+    assert np.allclose(sorted(verts.max(axis=0) - verts.min(axis=0)), [0.5, 1.0, 2.0], atol=1e-3)

@@ -32,6 +32,7 @@ import mujoco
 from lxml import etree
 
 from runner.compile.materials import gazebo_material
+from runner.compile.meshes import MeshError, convert_mesh
 from runner.compile.packages import PackageMap, resolve_uri
 from runner.compile.urdf import COLLISION_GROUP
 from runner.errors import Notices, SourceError
@@ -1067,21 +1068,22 @@ class _Loader:
                 hint="searched: " + ", ".join(self.packages.searched()),
             )
         if path.suffix.lower() not in _MESH_FORMATS:
-            alt = next(
-                (
-                    path.with_suffix(x)
-                    for x in (".stl", ".STL", ".obj", ".OBJ")
-                    if path.with_suffix(x).is_file()
-                ),
-                None,
-            )
-            if alt is None:
-                self.note(
-                    f"mesh {uri!r}: {path.suffix} meshes are not supported (STL, OBJ); left out", src, uri_el
+            try:
+                path = convert_mesh(path)
+            except MeshError as e:
+                alt = next(
+                    (
+                        path.with_suffix(x)
+                        for x in (".stl", ".STL", ".obj", ".OBJ")
+                        if path.with_suffix(x).is_file()
+                    ),
+                    None,
                 )
-                return None
-            self.note(f"mesh {uri!r}: {path.suffix} is not supported; using {alt.name} instead", src, uri_el)
-            path = alt
+                if alt is None:
+                    self.note(f"{e}; left out", src, uri_el)
+                    return None
+                self.note(f"{e}; using {alt.name} instead", src, uri_el)
+                path = alt
         key = (str(path.resolve()), tuple(scale))
         if key in self.meshes:
             return self.meshes[key]

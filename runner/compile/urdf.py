@@ -13,9 +13,7 @@
 
 from __future__ import annotations
 
-import hashlib
 import math
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -25,10 +23,10 @@ from lxml import etree
 
 from runner.compile.gazebo import GazeboInfo, parse, read_gazebo
 from runner.compile.locate import Locator
+from runner.compile.meshes import MUJOCO_MESH_FORMATS, MeshError, convert_mesh
 from runner.compile.packages import PackageMap, resolve_uri
 from runner.errors import Notices, SourceError
 
-MUJOCO_MESH_FORMATS = {".stl", ".obj", ".msh"}
 # URDF visuals are geom group 1 (MuJoCo's import); collisions go to group 3, which cameras do not draw
 # (MuJoCo renders groups 0-2 by default), as in MuJoCo Menagerie models.
 COLLISION_GROUP = 3
@@ -233,35 +231,11 @@ def _rewrite_mesh(mesh: Any, packages: PackageMap, base_dir: Path, where: Any, n
     mesh.set("filename", str(path))
 
 
-def mesh_cache() -> Path:
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "scenario-runner" / "meshes"
-
-
 def _convert_mesh(path: Path, mesh: Any, where: Any) -> Path:
-    """Collada/PLY/... -> binary STL with trimesh, cached by content hash."""
-    data = path.read_bytes()
-    out = mesh_cache() / f"{hashlib.sha256(data).hexdigest()[:20]}.stl"
-    if out.is_file():
-        return out
     try:
-        import trimesh
-
-        loaded = trimesh.load(path, force="mesh")
-        if loaded.is_empty:
-            raise ValueError("no triangles")
-        out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = out.with_suffix(f".{os.getpid()}.tmp")
-        loaded.export(tmp, file_type="stl")
-        tmp.replace(out)
-    except Exception as e:
-        raise DescriptionError(
-            f"mesh {path.name}: cannot convert {path.suffix} to a format MuJoCo reads "
-            f"({type(e).__name__}: {e})",
-            *where(mesh),
-            hint="export it as STL or OBJ",
-        ) from None
-    return out
+        return convert_mesh(path)
+    except MeshError as e:
+        raise DescriptionError(str(e), *where(mesh), hint="export it as STL or OBJ") from None
 
 
 _INTERFACES: dict[str, Literal["position", "velocity", "effort"]] = {
