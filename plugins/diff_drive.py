@@ -187,7 +187,10 @@ class WheelDrive(Plugin):
             self.ctrl[:] = self.target
         d = self.ctx.data
         speed = d.qvel[self.vadr]
-        self.integral += (self.ctrl - speed) * (self.dt / _INTEGRAL_TIME_S)
+        # Integrate only where the target has settled: during an acceleration ramp the servo's lag is
+        # expected, and integrating it would overshoot the limit (conditional integration, anti-windup).
+        settled = self.ctrl == self.target
+        self.integral += np.where(settled, self.ctrl - speed, 0.0) * (self.dt / _INTEGRAL_TIME_S)
         np.clip(self.integral, -self.integral_max, self.integral_max, out=self.integral)
         d.ctrl[self.act] = self.ctrl + self.integral
 
