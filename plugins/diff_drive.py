@@ -203,7 +203,8 @@ class WheelDrive(Plugin):
         mujoco.mj_objectVelocity(
             self.ctx.model, self.ctx.data, mujoco.mjtObj.mjOBJ_XBODY, self.base, self._vel, 0
         )
-        self.yaw_integral += (w - float(self._vel[2])) * (self.dt / _YAW_INTEGRAL_TIME_S)
+        if np.array_equal(self.ctrl, self.target):  # not while the wheels still ramp (anti-windup)
+            self.yaw_integral += (w - float(self._vel[2])) * (self.dt / _YAW_INTEGRAL_TIME_S)
         limit = 4.0 * abs(w)
         self.yaw_integral = min(max(self.yaw_integral, -limit), limit)
         return w + self.yaw_integral
