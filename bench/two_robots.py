@@ -16,18 +16,25 @@ import argparse
 import json
 import os
 import platform
+import sys
 import tempfile
 import time
 from pathlib import Path
 
-import mujoco
+# Run as a script, this folder comes first on sys.path, and bench/plugins.py would shadow the `plugins`
+# package: put the repository first instead.
+REPO = Path(__file__).resolve().parents[1]
+if sys.path and Path(sys.path[0]).resolve() == REPO / "bench":
+    sys.path[0] = str(REPO)
 
-from runner.compile import compile_plan
-from runner.launch import run_plan
-from runner.loader import load_file
-from runner.sim.world import World
-from runner.transport import MemoryBus
-from runner.validate import validate_scenario
+import mujoco  # noqa: E402
+
+from runner.compile import compile_plan  # noqa: E402
+from runner.launch import run_plan  # noqa: E402
+from runner.loader import load_file  # noqa: E402
+from runner.sim.world import World  # noqa: E402
+from runner.transport import MemoryBus  # noqa: E402
+from runner.validate import validate_scenario  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 SCENARIO = HERE.parent / "scenarios" / "two_robots.yaml"

@@ -2,6 +2,10 @@
 
 Uses MuJoCo's own sensors on a site at the IMU link (gyro, accelerometer, framequat). As on a real IMU
 and in Gazebo, linear acceleration includes the reaction to gravity (+9.81 m/s² up at rest).
+
+Errors, per axis in the IMU frame: a constant bias (`*_bias`, plus a random part drawn once at setup from
+`*_bias_stddev` with the plugin's seeded generator, so a run is repeatable) and white Gaussian noise
+(`*_stddev`, drawn at every message). The covariances in the message are those of the white noise.
 """
 
 from __future__ import annotations
@@ -13,6 +17,8 @@ from pydantic import Field
 from plugins._common import MountPose, add_site, pick_link
 from runner import msgs
 from runner.plugin import BuildContext, Plugin, RatedParams, Topic
+
+Vector3 = tuple[float, float, float]
 
 
 class ImuParams(RatedParams):
@@ -26,6 +32,14 @@ class ImuParams(RatedParams):
     angular_velocity_stddev: float = Field(0.0, ge=0, description="Gaussian noise, rad/s.")
     linear_acceleration_stddev: float = Field(0.0, ge=0, description="Gaussian noise, m/s².")
     orientation_stddev: float = Field(0.0, ge=0, description="Gaussian noise on roll/pitch/yaw, rad.")
+    angular_velocity_bias: Vector3 = Field((0.0, 0.0, 0.0), description="Constant bias per axis, rad/s.")
+    linear_acceleration_bias: Vector3 = Field((0.0, 0.0, 0.0), description="Constant bias per axis, m/s².")
+    angular_velocity_bias_stddev: float = Field(
+        0.0, ge=0, description="Random bias per axis, drawn once at start (Gaussian), rad/s."
+    )
+    linear_acceleration_bias_stddev: float = Field(
+        0.0, ge=0, description="Random bias per axis, drawn once at start (Gaussian), m/s²."
+    )
 
 
 class Imu(Plugin):
@@ -64,13 +78,20 @@ class Imu(Plugin):
         self.cov_o = np.eye(3).reshape(-1) * p.orientation_stddev**2
         self.cov_w = np.eye(3).reshape(-1) * p.angular_velocity_stddev**2
         self.cov_a = np.eye(3).reshape(-1) * p.linear_acceleration_stddev**2
+        self.bias_w = np.array(p.angular_velocity_bias, dtype=float)
+        self.bias_a = np.array(p.linear_acceleration_bias, dtype=float)
+        # drawn only when asked for, so that the noise sequence of a scenario without them is unchanged
+        if p.angular_velocity_bias_stddev:
+            self.bias_w += self.ctx.rng.normal(0.0, p.angular_velocity_bias_stddev, 3)
+        if p.linear_acceleration_bias_stddev:
+            self.bias_a += self.ctx.rng.normal(0.0, p.linear_acceleration_bias_stddev, 3)
 
     def after_step(self, now_ns: int) -> None:
         p = self.params
         sd = self.ctx.data.sensordata
         rng = self.ctx.rng
-        w = sd[self.gyro].copy()
-        a = sd[self.accel].copy()
+        w = sd[self.gyro] + self.bias_w
+        a = sd[self.accel] + self.bias_a
         q = sd[self.quat].copy()
         if p.angular_velocity_stddev:
             w += rng.normal(0.0, p.angular_velocity_stddev, 3)

@@ -10,11 +10,41 @@ from functools import cache
 from typing import Any
 
 import numpy as np
-from rosbags.typesys import Stores, get_typestore
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.base import Nodetype
 
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 T = TYPESTORE.types
+
+# Types that ROS 2 Jazzy's store lacks but plugins publish: name -> `.msg` text (as in their ROS packages).
+EXTRA_TYPES = {
+    # gazebo_msgs (gazebo_ros_pkgs, ROS 2): what gazebo_ros_bumper publishes
+    "gazebo_msgs/msg/ContactState": """\
+string info
+string collision1_name
+string collision2_name
+geometry_msgs/Wrench[] wrenches
+geometry_msgs/Wrench total_wrench
+geometry_msgs/Vector3[] contact_positions
+geometry_msgs/Vector3[] contact_normals
+float64[] depths
+""",
+    "gazebo_msgs/msg/ContactsState": """\
+std_msgs/Header header
+gazebo_msgs/ContactState[] states
+""",
+}
+
+
+def _register_extra_types() -> None:
+    """Add `EXTRA_TYPES` to the typestore, so CDR encoding/decoding and `msgdef()` work as for built-ins."""
+    types: dict[str, Any] = {}
+    for name, text in EXTRA_TYPES.items():
+        types.update(get_types_from_msg(text, name))
+    TYPESTORE.register(types)
+
+
+_register_extra_types()
 
 _NUMPY = {
     "bool": np.bool_,

@@ -225,3 +225,33 @@ def test_collada_meshes_are_converted(tmp_path: Path, write_scenario):
     verts = model.mesh_vert[model.mesh_vertadr[0] : model.mesh_vertadr[0] + model.mesh_vertnum[0]]
     extent = verts.max(axis=0) - verts.min(axis=0)
     assert np.allclose(sorted(extent), sorted([0.8, 0.4, 0.2]), atol=1e-3)  # scale 2 applied
+
+
+BUMPER = """<?xml version="1.0"?>
+<robot name="b">
+  <link name="base_link">
+    <collision><geometry><box size="0.3 0.2 0.1"/></geometry></collision>
+    <inertial><mass value="2.0"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+  </link>
+  <gazebo reference="base_link">
+    <sensor name="bumper_sensor" type="contact">
+      <update_rate>15</update_rate>
+      <contact><collision>base_link_collision</collision></contact>
+      <plugin name="bumper" filename="libgazebo_ros_bumper.so">
+        <bumperTopicName>front_bumper</bumperTopicName>
+        <frameName>base_link</frameName>
+      </plugin>
+    </sensor>
+  </gazebo>
+</robot>
+"""
+
+
+def test_classic_bumper_becomes_a_contact_plugin(write_scenario, tmp_path: Path):
+    (tmp_path / "b.urdf").write_text(BUMPER)
+    plan, notices = _compile(write_scenario("name: b\nrobots:\n  - {name: b1, description: b.urdf}\n"))
+    (bumper,) = plan.robots[0].plugins
+    assert bumper.type == "contact" and bumper.rate == 15
+    assert bumper.params["link"] == "base_link" and bumper.params["frame_id"] == "b1/base_link"
+    assert {t.key for t in plan.topics()} >= {"b/b1/front_bumper"}
+    assert not list(notices)

@@ -367,12 +367,21 @@ class GazeboReader:
                 params["angular_velocity_stddev"] = ros["noise"]
                 params["linear_acceleration_stddev"] = ros["noise"]
             self.add(el, "imu", name, params, implicit=not (ros or base_topic))
+        elif kind == "contact":
+            if link is None:
+                self.note(el, f"{context} outside a <gazebo reference=...> block has no link; ignored")
+                return
+            r.child("contact")  # <collision> names: we report every contact of the link
+            ros = self._sensor_plugins(plugins, context, ("bumper_states", "bumper"))
+            params = {**common, "topic": ros.get("topic") or base_topic or "bumper"}
+            params["frame_id"] = ros.get("frame") or frame
+            self.add(el, "contact", name, params)
         else:
             self.note(
                 el,
                 f"sensor type {kind!r} is not supported yet; {context} is ignored",
                 hint="supported: ray, gpu_ray, lidar, gpu_lidar, camera, depth, depth_camera, rgbd_camera, "
-                "imu",
+                "imu, contact",
             )
             return
         self.ignored(r, context)
@@ -516,7 +525,7 @@ class GazeboReader:
             if cam:
                 found["camera"] = cam
             prefix = cam if base in _CAMERA_PLUGINS else None
-            topic = _topic(r.text("topicName", "topic_name"))
+            topic = _topic(r.text("topicName", "topic_name", "bumperTopicName"))
             image = _topic(r.text("imageTopicName", "image_topic_name"))
             info = _topic(r.text("cameraInfoTopicName", "camera_info_topic_name"))
             depth = _topic(r.text("depthImageTopicName", "depth_image_topic_name"))
@@ -678,6 +687,7 @@ _SENSOR_PLUGINS = _CAMERA_PLUGINS | {
     "gazebo_ros_block_laser",
     "gazebo_ros_imu_sensor",
     "gazebo_ros_imu",
+    "gazebo_ros_bumper",
 }
 # gz-sim systems that only switch on what our world always does (physics, sensors, broadcasting).
 _NOOP_PLUGINS = {

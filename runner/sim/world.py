@@ -4,7 +4,8 @@ Time is integer nanoseconds of sim time, counted in whole physics steps (`now = 
 rates and timeline entries land on exact steps and a run is repeatable.
 
 At each boundary time `t` where something is due, in this order:
-  1. `after_step` hooks due at t (sensors read the state at t and publish);
+  1. `after_step` hooks due at t (after `mj_forward`, so sensors read positions, contacts and MuJoCo
+     sensor values of the state at t, not of the step before);
   2. timeline entries with time <= t (published, and delivered to local subscribers at once);
   3. messages from other processes that arrived since the last boundary (delivered in arrival order);
   4. `before_step` hooks due at t (controllers act on the commands);
@@ -202,8 +203,12 @@ class World:
     # ------------------------------------------------------------------------------------------- loop
     def _boundary(self) -> None:
         now = self.now_ns
-        for h in self._after:
-            if now >= h.next_ns:
+        due = [h for h in self._after if now >= h.next_ns]
+        if due:
+            # mj_step leaves positions, contacts and sensor values as they were before its last
+            # integration; bring them to the state at `now` so every sensor reads the same instant.
+            mujoco.mj_forward(self.model, self.data)
+            for h in due:
                 h.fn(now)
                 h.next_ns = _next_due(h, now)
         while self._timeline_i < len(self._timeline) and self._timeline[self._timeline_i][0] <= now:

@@ -1,0 +1,146 @@
+"""tf: the robot's link tree -> tf2_msgs/TFMessage (what robot_state_publisher does for a real robot).
+
+Every link but the root is published relative to its parent link in the URDF tree (in MuJoCo: body parent
+-> child), with namespaced frame ids (`<ns>/<link>`):
+
+- links moved by a joint (revolute, continuous, prismatic, floating...) on `topic` at `rate`, one message
+  per tick holding all of them. Poses are MuJoCo's `xpos`/`xquat`, recomputed (`mj_kinematics`, in a
+  private `MjData`) from the joint positions at the stamp: after `mj_step` the world's own `xpos` is one
+  physics step older than `qpos`, and the transforms must agree with `joint_states` of the same stamp;
+- links on fixed joints once on `static_topic` at the first tick, and again every `static_period`
+  seconds if set (on the first tick at or after each multiple; the transport has no latching, so a late
+  subscriber otherwise misses them).
+
+The root link's own pose (odom -> base) is the drive's job (diff_drive publishes it on `tf` too; both
+plugins may publish on one topic). `include_root: true` adds `world` -> root: on `topic` for a mobile
+robot, on `static_topic` for a welded (`fixed`) one.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import mujoco
+import numpy as np
+from pydantic import Field
+
+from runner import msgs
+from runner.plugin import BuildContext, Plugin, RatedParams, Topic
+
+TF_TYPE = "tf2_msgs/msg/TFMessage"
+WORLD_FRAME = "world"
+
+
+class TfParams(RatedParams):
+    rate: float = Field(50.0, gt=0, description="Publish rate of the moving transforms, sim Hz.")
+    topic: str = Field("tf", description="Topic of the moving transforms.")
+    static_topic: str = Field("tf_static", description="Topic of the fixed transforms.")
+    static_period: float = Field(
+        0.0, ge=0, description="Publish the fixed transforms again this often, sim seconds (0: only once)."
+    )
+    include_root: bool = Field(False, description="Also publish world -> root link.")
+
+
+def _moves(body: Any) -> bool:
+    return len(body.joints) > 0
+
+
+class Tf(Plugin):
+    Params = TfParams
+    params: TfParams
+
+    @classmethod
+    def build(cls, params: TfParams, ctx: BuildContext, name: str) -> list[Topic]:
+        bodies = [b for b in ctx.spec.bodies if b.name and b.name != "world"]
+        root = ctx.body(ctx.root)
+        children = [b for b in bodies if b.name != root.name]
+        moving = any(_moves(b) for b in children) or (params.include_root and _moves(root))
+        fixed = any(not _moves(b) for b in children) or (params.include_root and not _moves(root))
+        topics = []
+        if moving:
+            topics.append(Topic(params.topic, TF_TYPE, "pub", params.rate))
+        if fixed:
+            period = params.static_period
+            topics.append(Topic(params.static_topic, TF_TYPE, "pub", 1.0 / period if period else None))
+        return topics
+
+    def setup(self) -> None:
+        p = self.params
+        r = self.ctx.robot
+        m, d = self.ctx.model, self.ctx.data
+        # (parent body or -1 for the world, child body, parent frame, child frame)
+        self.moving: list[tuple[int, int, str, str]] = []
+        self.fixed: list[tuple[int, int, str, str]] = []
+        for b in sorted(r.body_ids):
+            link = m.body(b).name.removeprefix(r.prefix)
+            moves = int(m.body_jntnum[b]) > 0
+            if b == r.root_body:
+                if not p.include_root:
+                    continue
+                entry = (-1, b, WORLD_FRAME, r.frame(link))
+            else:
+                parent = int(m.body_parentid[b])
+                entry = (parent, b, r.frame(m.body(parent).name.removeprefix(r.prefix)), r.frame(link))
+            (self.moving if moves else self.fixed).append(entry)
+        T = msgs.T
+        self.Msg, self.Stamped, self.Transform = (
+            T[TF_TYPE],
+            T["geometry_msgs/msg/TransformStamped"],
+            T["geometry_msgs/msg/Transform"],
+        )
+        self.Vec, self.Quat = T["geometry_msgs/msg/Vector3"], T["geometry_msgs/msg/Quaternion"]
+        self.pub = self.ctx.publisher(p.topic, TF_TYPE) if self.moving else None
+        self.static_pub = self.ctx.publisher(p.static_topic, TF_TYPE) if self.fixed else None
+        # A fixed link's pose in its parent is a constant of the model; the world -> welded root pose is
+        # read once from the data (the robot's placement).
+        self.static_poses = [
+            (np.array(d.xpos[b]), np.array(d.xquat[b])) if parent < 0 else (m.body_pos[b], m.body_quat[b])
+            for parent, b, _pf, _cf in self.fixed
+        ]
+        self.static_period_ns = round(p.static_period * 1e9)
+        self.next_static_ns: int | None = 0
+        self.kin = mujoco.MjData(m) if self.moving else None  # the world's data stays untouched
+        self._q = np.zeros(4)
+
+    def after_step(self, now_ns: int) -> None:
+        if self.static_pub and self.next_static_ns is not None and now_ns >= self.next_static_ns:
+            tfs = [
+                self._stamped(now_ns, pf, cf, pos, quat)
+                for (_p, _b, pf, cf), (pos, quat) in zip(self.fixed, self.static_poses, strict=True)
+            ]
+            self.static_pub.publish(self.Msg(transforms=tfs), now_ns)
+            period = self.static_period_ns
+            self.next_static_ns = (now_ns // period + 1) * period if period else None
+        if self.pub and self.kin is not None:
+            m, d = self.ctx.model, self.kin
+            d.qpos[:] = self.ctx.data.qpos
+            d.mocap_pos[:] = self.ctx.data.mocap_pos
+            d.mocap_quat[:] = self.ctx.data.mocap_quat
+            mujoco.mj_kinematics(m, d)
+            tfs = []
+            for parent, b, pf, cf in self.moving:
+                if parent < 0:
+                    pos, quat = d.xpos[b], d.xquat[b]
+                else:
+                    pos, quat = self._relative(d, parent, b)
+                tfs.append(self._stamped(now_ns, pf, cf, pos, quat))
+            self.pub.publish(self.Msg(transforms=tfs), now_ns)
+
+    def _relative(self, d: Any, parent: int, child: int) -> tuple[np.ndarray, np.ndarray]:
+        """The child's pose in its parent's frame: p = R_pᵀ (x_c - x_p), q = q_p⁻¹ q_c."""
+        rot = d.xmat[parent].reshape(3, 3)
+        pos = rot.T @ (d.xpos[child] - d.xpos[parent])
+        mujoco.mju_negQuat(self._q, d.xquat[parent])
+        quat = np.zeros(4)
+        mujoco.mju_mulQuat(quat, self._q, d.xquat[child])
+        return pos, quat
+
+    def _stamped(self, now_ns: int, parent: str, child: str, pos: Any, q: Any) -> Any:
+        return self.Stamped(
+            header=msgs.header(now_ns, parent),
+            child_frame_id=child,
+            transform=self.Transform(
+                translation=self.Vec(x=float(pos[0]), y=float(pos[1]), z=float(pos[2])),
+                rotation=self.Quat(x=float(q[1]), y=float(q[2]), z=float(q[3]), w=float(q[0])),
+            ),
+        )
