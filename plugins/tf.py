@@ -4,9 +4,8 @@ Every link but the root is published relative to its parent link in the URDF tre
 -> child), with namespaced frame ids (`<ns>/<link>`):
 
 - links moved by a joint (revolute, continuous, prismatic, floating...) on `topic` at `rate`, one message
-  per tick holding all of them. Poses are MuJoCo's `xpos`/`xquat`, recomputed (`mj_kinematics`, in a
-  private `MjData`) from the joint positions at the stamp: after `mj_step` the world's own `xpos` is one
-  physics step older than `qpos`, and the transforms must agree with `joint_states` of the same stamp;
+  per tick holding all of them. Poses are MuJoCo's `xpos`/`xquat` at the stamp (the world runs
+  `mj_forward` before sensing hooks), so the transforms agree with `joint_states` of the same stamp;
 - links on fixed joints once on `static_topic` at the first tick, and again every `static_period`
   seconds if set (on the first tick at or after each multiple; the transport has no latching, so a late
   subscriber otherwise misses them).
@@ -99,7 +98,6 @@ class Tf(Plugin):
         ]
         self.static_period_ns = round(p.static_period * 1e9)
         self.next_static_ns: int | None = 0
-        self.kin = mujoco.MjData(m) if self.moving else None  # the world's data stays untouched
         self._q = np.zeros(4)
 
     def after_step(self, now_ns: int) -> None:
@@ -111,12 +109,8 @@ class Tf(Plugin):
             self.static_pub.publish(self.Msg(transforms=tfs), now_ns)
             period = self.static_period_ns
             self.next_static_ns = (now_ns // period + 1) * period if period else None
-        if self.pub and self.kin is not None:
-            m, d = self.ctx.model, self.kin
-            d.qpos[:] = self.ctx.data.qpos
-            d.mocap_pos[:] = self.ctx.data.mocap_pos
-            d.mocap_quat[:] = self.ctx.data.mocap_quat
-            mujoco.mj_kinematics(m, d)
+        if self.pub and self.moving:
+            d = self.ctx.data
             tfs = []
             for parent, b, pf, cf in self.moving:
                 if parent < 0:
