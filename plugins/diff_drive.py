@@ -26,7 +26,7 @@ from runner.geometry import quat_to_yaw, yaw_to_quat
 from runner.plugin import BuildContext, Plugin, PluginConfigError, RatedParams, Topic
 
 _INTEGRAL_TIME_S = 0.2
-_YAW_INTEGRAL_TIME_S = 0.1
+_YAW_INTEGRAL_TIME_S = 0.05
 _ROUND = {
     int(mujoco.mjtGeom.mjGEOM_CYLINDER),
     int(mujoco.mjtGeom.mjGEOM_SPHERE),
@@ -203,8 +203,9 @@ class WheelDrive(Plugin):
         mujoco.mj_objectVelocity(
             self.ctx.model, self.ctx.data, mujoco.mjtObj.mjOBJ_XBODY, self.base, self._vel, 0
         )
+        error = w - float(self._vel[2])
         if np.array_equal(self.ctrl, self.target):  # not while the wheels still ramp (anti-windup)
-            self.yaw_integral += (w - float(self._vel[2])) * (self.dt / _YAW_INTEGRAL_TIME_S)
+            self.yaw_integral += error * (self.dt / _YAW_INTEGRAL_TIME_S)
         limit = 4.0 * abs(w)
         self.yaw_integral = min(max(self.yaw_integral, -limit), limit)
         return w + self.yaw_integral

@@ -71,20 +71,27 @@ class RunPlan(BaseModel):
         return f"{self.name}/clock"
 
     def topics(self) -> list[TopicPlan]:
+        """Every topic of the run, once per key and direction; a key several plugins publish on (a
+        robot's `tf`) lists them all and the sum of their rates."""
         out = [
             TopicPlan(key=self.clock_key, type="rosgraph_msgs/msg/Clock", rate=self.clock_rate, owner="world")
         ]
-        seen = {self.clock_key}
+        seen: dict[tuple[str, str], TopicPlan] = {(self.clock_key, "pub"): out[0]}
         for r in self.robots:
             for p in r.plugins:
                 for t in p.topics:
-                    if (t.key, t.direction) not in seen:
-                        out.append(t)
-                        seen.add((t.key, t.direction))
+                    known = seen.get((t.key, t.direction))
+                    if known is None:
+                        seen[(t.key, t.direction)] = t.model_copy()
+                        out.append(seen[(t.key, t.direction)])
+                    else:
+                        known.owner = f"{known.owner}, {t.owner}"
+                        if known.rate is not None and t.rate is not None:
+                            known.rate += t.rate
         for ev in self.timeline:
-            if ev.key not in seen:
-                out.append(TopicPlan(key=ev.key, type=ev.type, direction="pub", owner="timeline"))
-                seen.add(ev.key)
+            if (ev.key, "pub") not in seen:
+                seen[(ev.key, "pub")] = TopicPlan(key=ev.key, type=ev.type, direction="pub", owner="timeline")
+                out.append(seen[(ev.key, "pub")])
         return out
 
 

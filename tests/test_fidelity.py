@@ -203,3 +203,31 @@ def test_imu_at_rest_and_turning(write_scenario):
     assert np.all(np.abs(gyro) < 1e-3)
     turning = [m.angular_velocity.z for t, m in imu if 3.5 <= t / 1e9 <= 5.0]
     assert abs(np.mean(turning) - 0.5) < 0.02 * 0.5
+
+
+SKID = """
+name: s
+duration: {duration}
+rate: max
+robots:
+  - name: r1
+    description: "{skidbot}"
+    pose: {{xyz: [0, 0, 0.065]}}
+    plugins: [{{type: skid_steer}}, {{type: ground_truth}}]
+timeline:
+{timeline}
+"""
+
+
+@pytest.mark.timeout(60)
+def test_skid_steer_straight_and_turning(write_scenario):
+    from tests.test_motion import SKIDBOT
+
+    text = SKID.format(duration=6.0, skidbot=SKIDBOT, timeline=_cmd(0.0, 0.2) + _cmd(5.0))
+    _, bus = simulate(write_scenario(text))
+    p = messages(bus, "r1/ground_truth")[-1][1].pose.pose.position
+    assert abs(math.hypot(p.x, p.y) - 1.0) < 0.05, p
+    text = SKID.format(duration=5.0, skidbot=SKIDBOT, timeline=_cmd(0.0, ang=0.5) + _cmd(4.0))
+    _, bus = simulate(write_scenario(text, "turn.yaml"))
+    yaws = np.unwrap([_yaw(m) for _, m in messages(bus, "r1/ground_truth")])
+    assert abs((yaws[-1] - yaws[0]) - 2.0) < 0.1, yaws[-1]
