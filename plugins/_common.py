@@ -11,7 +11,7 @@ from pydantic import Field
 
 from runner import msgs
 from runner.geometry import rpy_to_quat
-from runner.plugin import BuildContext, PluginConfigError, PluginParams, Topic
+from runner.plugin import BuildContext, PluginConfigError, PluginParams, RatedParams, Topic
 
 
 class MountPose(PluginParams):
@@ -78,7 +78,22 @@ def odometry(
     )
 
 
-def drive_topics(params: Any) -> list[Topic]:
+class BaseDriveParams(RatedParams):
+    """What every base drive (diff_drive, skid_steer, planar_move) has: its topics and frames."""
+
+    cmd_topic: str = Field("cmd_vel", description="Command topic (geometry_msgs/Twist).")
+    odom_topic: str = Field("odom", description="Odometry topic (nav_msgs/Odometry).")
+    tf_topic: str = Field("tf", description="TF topic (tf2_msgs/TFMessage).")
+    publish_odom: bool = Field(True, description="Publish odometry.")
+    publish_tf: bool = Field(True, description="Publish the odom -> base transform.")
+    odom_frame: str = Field("odom", description="Odometry frame (namespaced: <ns>/odom).")
+    base_frame: str | None = Field(None, description="Base frame (default: the root link, namespaced).")
+    cmd_timeout: float = Field(
+        0.0, ge=0, description="Stop when no command came for this long, s (0: never)."
+    )
+
+
+def drive_topics(params: BaseDriveParams) -> list[Topic]:
     """The topics of a base drive: `cmd_vel` in; `odom` and `tf` out when enabled."""
     topics = [Topic(params.cmd_topic, "geometry_msgs/msg/Twist", "sub")]
     if params.publish_odom:

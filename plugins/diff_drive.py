@@ -20,10 +20,10 @@ import mujoco
 import numpy as np
 from pydantic import Field, PositiveFloat
 
-from plugins._common import drive_topics, odometry
+from plugins._common import BaseDriveParams, drive_topics, odometry
 from runner import msgs
 from runner.geometry import quat_to_yaw, yaw_to_quat
-from runner.plugin import BuildContext, Plugin, PluginConfigError, RatedParams, Topic
+from runner.plugin import BuildContext, Plugin, PluginConfigError, Topic
 
 _INTEGRAL_TIME_S = 0.2
 _YAW_INTEGRAL_TIME_S = 0.05
@@ -35,7 +35,7 @@ _ROUND = {
 }
 
 
-class WheelDriveParams(RatedParams):
+class WheelDriveParams(BaseDriveParams):
     """Parameters shared by `diff_drive` and `skid_steer` (everything but the wheel joints)."""
 
     rate: float = Field(50.0, gt=0, description="Control and odometry rate, sim Hz.")
@@ -54,18 +54,8 @@ class WheelDriveParams(RatedParams):
         description="Velocity servo gain of the wheel actuators, N·m per rad/s (default: from the robot's "
         "mass and wheel inertia, for a 5-step time constant; too stiff a servo makes the robot hop).",
     )
-    cmd_topic: str = Field("cmd_vel", description="Command topic (geometry_msgs/Twist).")
-    odom_topic: str = Field("odom", description="Odometry topic (nav_msgs/Odometry).")
-    tf_topic: str = Field("tf", description="TF topic (tf2_msgs/TFMessage).")
-    publish_odom: bool = Field(True, description="Publish odometry.")
-    publish_tf: bool = Field(True, description="Publish the odom -> base transform.")
-    odom_frame: str = Field("odom", description="Odometry frame (namespaced: <ns>/odom).")
-    base_frame: str | None = Field(None, description="Base frame (default: the root link, namespaced).")
     odometry_source: Literal["encoders", "world"] = Field(
         "encoders", description="Integrate wheel encoders, or report the true pose."
-    )
-    cmd_timeout: float = Field(
-        0.0, ge=0, description="Stop when no command came for this long, s (0: never)."
     )
     yaw_rate_feedback: bool = Field(
         True,

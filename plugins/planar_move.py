@@ -22,10 +22,10 @@ import mujoco
 import numpy as np
 from pydantic import Field, PositiveFloat
 
-from plugins._common import drive_topics, odometry
+from plugins._common import BaseDriveParams, drive_topics, odometry
 from plugins.diff_drive import tf_message
 from runner.geometry import quat_to_yaw, yaw_to_quat
-from runner.plugin import BuildContext, Plugin, PluginConfigError, RatedParams, Topic
+from runner.plugin import BuildContext, Plugin, PluginConfigError, Topic
 
 _INTEGRAL_TIME_S = 0.1
 _SERVO_STEPS = 2.0  # time constant of the velocity servos, physics steps
@@ -33,18 +33,8 @@ _FRICTION_MARGIN = 3.0  # default force limit: this many times the robot's weigh
 _AXES = ("x", "y", "yaw")
 
 
-class PlanarMoveParams(RatedParams):
+class PlanarMoveParams(BaseDriveParams):
     rate: float = Field(50.0, gt=0, description="Odometry publish rate (and command update rate), sim Hz.")
-    cmd_topic: str = Field("cmd_vel", description="Command topic (geometry_msgs/Twist).")
-    odom_topic: str = Field("odom", description="Odometry topic (nav_msgs/Odometry).")
-    tf_topic: str = Field("tf", description="TF topic (tf2_msgs/TFMessage).")
-    publish_odom: bool = Field(True, description="Publish odometry.")
-    publish_tf: bool = Field(True, description="Publish the odom -> base transform.")
-    odom_frame: str = Field("odom", description="Odometry frame (namespaced: <ns>/odom).")
-    base_frame: str | None = Field(None, description="Base frame (default: the root link, namespaced).")
-    cmd_timeout: float = Field(
-        0.0, ge=0, description="Stop when no command came for this long, s (0: never)."
-    )
     max_force: PositiveFloat | None = Field(
         None,
         description="Force limit of the planar motion, N (default: three times the robot's weight, enough "

@@ -427,12 +427,9 @@ class GazeboReader:
                 out["vertical_max_angle"] = float(v.findtext("max_angle"))
         rng = ray.find("range")
         if rng is not None:
-            if rng.findtext("min"):
-                out["range_min"] = float(rng.findtext("min"))
-            if rng.findtext("max"):
-                out["range_max"] = float(rng.findtext("max"))
-            if rng.findtext("resolution"):
-                out["resolution"] = float(rng.findtext("resolution"))
+            _put(out, "range_min", rng, "min")
+            _put(out, "range_max", rng, "max")
+            _put(out, "resolution", rng, "resolution")
         noise = self._noise(ray)
         if noise:
             out["noise_stddev"] = noise
@@ -499,10 +496,8 @@ class GazeboReader:
         # classic (SDF 1.4) style: <imu><noise><rate><stddev>, <accel><stddev>
         n = imu.find("noise")
         if n is not None:
-            if n.findtext("rate/stddev"):
-                out["angular_velocity_stddev"] = float(n.findtext("rate/stddev"))
-            if n.findtext("accel/stddev"):
-                out["linear_acceleration_stddev"] = float(n.findtext("accel/stddev"))
+            _put(out, "angular_velocity_stddev", n, "rate/stddev")
+            _put(out, "linear_acceleration_stddev", n, "accel/stddev")
         return out
 
     def _sensor_plugins(self, plugins: list[Any], context: str, out_names: tuple[str, ...]) -> dict[str, Any]:
@@ -650,6 +645,13 @@ class GazeboReader:
                     r.mark(el.tag)
                     self.note(el, f"<{el.tag}> is not a parameter of {filename!r}: Gazebo ignores it too")
         self.ignored(r, context)
+
+
+def _put(out: dict[str, Any], key: str, el: Any, path: str) -> None:
+    """out[key] = the number at `path` under `el`, when there is one."""
+    text = el.findtext(path)
+    if text and text.strip():
+        out[key] = float(text)
 
 
 def _plugin_base(filename: str) -> str:
