@@ -1,20 +1,42 @@
 """Rendering helpers shared by the camera plugins (`camera`, `depth_camera`).
 
-- the headless OpenGL backend (`ensure_gl_backend`);
+- the headless OpenGL backend: `ensure_gl_backend`, `choose_gl_backend`, `probe_gl_backend`,
+  `gl_backend_in_use` (see "Backends" below);
 - the parameters every camera has (`CameraParams`) and mounting a MuJoCo camera with Gazebo's convention
   (`add_camera`);
-- `CameraRenderer`: one offscreen `mujoco.Renderer` per camera, set up for speed (no MSAA, no shadows, no
-  reflections), giving RGB images and metric depth;
+- `CameraRenderer`: one offscreen OpenGL context per camera, set up for speed (no MSAA, no shadows, no
+  reflections), giving RGB images and metric depth, both from one render where that gives the same depth;
 - ROS message builders: `Image`, `CameraInfo`, pixel formats and intensity noise.
 
 Conventions. A Gazebo camera looks along its link's +X axis with +Z up; a MuJoCo camera looks along its
 own -Z with +Y up. Images are in the ROS optical frame (z forward, x right, y down; row 0 is the top).
 Intrinsics: fx = fy = width / (2 tan(fov / 2)), cx = width / 2, cy = height / 2, no distortion.
+
+Backends. MuJoCo picks its OpenGL backend from `MUJOCO_GL` once, when it is imported, and loads that
+backend's libraries into the process (PyOpenGL binds itself to one platform, and MuJoCo's GL loader
+resolves its functions once per process). So the backend cannot change after `import mujoco`: measured, an
+OSMesa context made in a process that loaded EGL fails in MuJoCo's loader (`gladLoadGL error`). The choice
+is therefore made before mujoco is imported, and checked in a subprocess where checking can crash:
+
+- `MUJOCO_GL` set by the user is used as it is (`ensure_gl_backend` only replaces a value with which `import
+  mujoco` itself would fail, by `disable`, keeping it for the error message);
+- unset: EGL (`ensure_gl_backend`; `import runner` and `python -m runner.sim` inline a default before mujoco
+  is imported), headless on a GPU or on the CPU with Mesa's llvmpipe; the default is marked
+  (`SCENARIO_GL_AUTO=1`) so that child processes know it was not the user's choice;
+- a process that starts one that renders (the launcher, before the world process) calls
+  `choose_gl_backend()`: EGL if a probe subprocess renders with it, else OSMesa if its library is there and
+  a probe renders with it, else a `RuntimeError` naming the missing Debian packages; the answer goes in the
+  child's environment;
+- in the rendering process, the first `CameraRenderer` probes the backend mujoco loaded in a subprocess
+  (~0.4 s, once; not when a parent did: `SCENARIO_GL_PROBED`) before making a context itself, so that a
+  backend that cannot render, or a driver that would crash the process, is a `RuntimeError` naming the
+  packages, never a segfault. A process cannot switch to OSMesa itself once mujoco loaded EGL.
 """
 
 from __future__ import annotations
 
 import atexit
+import contextlib
 import math
 import os
 import weakref
@@ -27,6 +49,23 @@ from pydantic import Field, PositiveFloat, PositiveInt, model_validator
 from plugins._common import MountPose
 from runner import msgs
 from runner.geometry import rpy_to_quat
+from runner.gl import (  # noqa: F401  (re-exported for the camera plugins and tests)
+    GL_AUTO_ENV,
+    GL_DISABLED,
+    GL_ENV,
+    GL_KNOWN,
+    GL_LIBRARY,
+    GL_PACKAGES,
+    GL_PROBED_ENV,
+    GL_REQUESTED_ENV,
+    HEADLESS_BACKENDS,
+    choose_gl_backend,
+    ensure_gl_backend,
+    gl_backend_chosen_by_user,
+    gl_library_present,
+    no_backend_message,
+    probe_gl_backend,
+)
 from runner.plugin import BuildContext, PluginConfigError, RatedParams
 
 # The compiler gives every world an offscreen framebuffer of this size (runner/compile/__init__.py):
@@ -42,29 +81,48 @@ POINT_CLOUD = "sensor_msgs/msg/PointCloud2"
 _GAZEBO_FROM_MUJOCO_CAMERA = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
 
-def ensure_gl_backend() -> str:
-    """Choose MuJoCo's OpenGL backend for offscreen rendering, before `mujoco` is imported.
-
-    Sets `MUJOCO_GL=egl` when it is unset: EGL renders headless, on a GPU or on the CPU with Mesa's
-    llvmpipe (Debian: libegl1 libegl-mesa0 libgl1-mesa-dri libgbm1). A user can choose another one by
-    setting the variable first: `MUJOCO_GL=osmesa` is the fallback where EGL does not work (needs
-    libosmesa6, slower), `glfw` needs a display.
-
-    MuJoCo reads the variable once, when it is imported (`import mujoco` loads its GL context class), so
-    this has an effect only before that: importing this module already imports mujoco, so the entry points
-    inline the same line at their very top (`python -m runner.sim`: `os.environ.setdefault("MUJOCO_GL",
-    "egl")`). `CameraRenderer` reports a clear error when mujoco was imported with GLFW and no display.
-    Returns the backend that will be asked for.
-    """
-    return os.environ.setdefault("MUJOCO_GL", "egl")
-
-
 def gl_backend_in_use() -> str:
-    """The backend mujoco loaded at import ('egl', 'osmesa', 'glfw', ...), from its GLContext class."""
+    """The backend mujoco loaded at import ('egl', 'osmesa', 'glfw', ...), from its GLContext class;
+    'none' when it has none (MUJOCO_GL=disable, or the backend's libraries could not be loaded)."""
     ctx_cls = getattr(mujoco, "GLContext", None)
     if ctx_cls is None:
         return "none"
     return ctx_cls.__module__.rsplit(".", 1)[-1]
+
+
+_probed: dict[str, str | None] = {}  # backend -> None (renders) or why not, once per process
+
+
+def _gl_context_class() -> Any:
+    """The OpenGL context class mujoco loaded, checked to work here; else a RuntimeError naming packages."""
+    backend = gl_backend_in_use()
+    requested = os.environ.get(GL_REQUESTED_ENV) or os.environ.get(GL_ENV, "")
+    if backend == "none":
+        name = requested.strip().lower()
+        if name in GL_DISABLED:
+            why = "rendering is disabled"
+        elif name not in GL_KNOWN:
+            why = "not a backend MuJoCo knows (egl, osmesa, glfw)"
+        elif name in HEADLESS_BACKENDS and not gl_library_present(name):
+            why = f"lib{GL_LIBRARY[name]} is not installed"
+        elif name in HEADLESS_BACKENDS:
+            why = f"mujoco could not load the {name} backend's libraries"
+        else:
+            why = "mujoco has no OpenGL context class"
+        raise RuntimeError(no_backend_message({name or "unset": why}, requested))
+    if backend == "glfw" and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        raise RuntimeError(
+            "cannot render camera images: MuJoCo was imported with MUJOCO_GL unset (GLFW), which needs a "
+            "display. Set MUJOCO_GL=egl (Debian packages: " + " ".join(GL_PACKAGES["egl"]) + ") or "
+            "MUJOCO_GL=osmesa (libosmesa6) before mujoco is imported."
+        )
+    if backend in HEADLESS_BACKENDS and os.environ.get(GL_PROBED_ENV) != backend:
+        if backend not in _probed:
+            _probed[backend] = probe_gl_backend(backend)
+        why = _probed[backend]
+        if why is not None:
+            raise RuntimeError(no_backend_message({backend: why}, requested))
+    return mujoco.GLContext
 
 
 # --------------------------------------------------------------------------------------------- params
@@ -154,13 +212,14 @@ def add_camera(ctx: BuildContext, link: str, name: str, p: CameraParams) -> str:
 # ------------------------------------------------------------------------------------------- renderer
 _FAR_MARGIN = 1.001
 _open: weakref.WeakSet[CameraRenderer] = weakref.WeakSet()
+_model_clip: weakref.WeakKeyDictionary[mujoco.MjModel, tuple[float, float]] = weakref.WeakKeyDictionary()
+_atexit_registered = False
 
 
-@atexit.register
 def _close_all() -> None:
-    # A run that fails between setup() and close() would otherwise leave EGL contexts to the garbage
-    # collector at interpreter exit, which prints EGL errors. Registered after mujoco's own atexit handlers,
-    # so it runs before them.
+    # A run that fails between setup() and close() would otherwise leave GL contexts to the garbage collector
+    # at interpreter exit, after mujoco's EGL atexit handler terminated the display (EGL errors printed).
+    # Registered after the first context is made, hence after that handler: atexit runs it first.
     for r in list(_open):
         r.close()
 
@@ -170,20 +229,23 @@ class CameraRenderer:
 
     Renders the model's visible geoms (groups 0-2, as MuJoCo's default), no sites; the camera's own near/far
     clip planes are applied at each frame (MuJoCo has one near/far per model: `vis.map.znear/zfar`, in
-    units of the model's extent, so they are set before each render). Creating one turns off
-    multisampling and the shadow map for all renderers of this model (`vis.quality`): the camera
+    units of the model's extent, so they are set before each scene update, when they differ). Creating one
+    turns off multisampling and the shadow map for all renderers of this model (`vis.quality`): the camera
     plugins do not draw shadows or reflections.
+
+    Each renderer has its own OpenGL context (of the backend mujoco loaded, checked by `_gl_context_class`),
+    MjrContext, scene and reused output buffers. `update()` takes the scene once per frame; then `rgb()`,
+    `depth()` or `rgbd()` (both from one render when that gives the same depth: no skybox and nothing
+    transparent; otherwise depth is rendered apart, in MuJoCo's segmentation mode, as `mujoco.Renderer`
+    does). Depth is converted exactly as `mujoco.Renderer` does it.
     """
 
     def __init__(
         self, model: mujoco.MjModel, camera_id: int, width: int, height: int, near: float, far: float
     ):
-        backend = gl_backend_in_use()
-        if backend == "glfw" and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-            raise RuntimeError(
-                "cannot render camera images: MuJoCo was imported with MUJOCO_GL unset (GLFW), which needs a "
-                "display. Set MUJOCO_GL=egl (or MUJOCO_GL=osmesa) before mujoco is imported."
-            )
+        global _atexit_registered
+        self._gl: Any = None
+        self._con: Any = None
         bw, bh = int(model.vis.global_.offwidth), int(model.vis.global_.offheight)
         if width > bw or height > bh:
             raise RuntimeError(
@@ -191,62 +253,174 @@ class CameraRenderer:
                 f"({bw}x{bh}): make the image smaller or the framebuffer (visual/global offwidth, "
                 "offheight) larger"
             )
+        ctx_cls = _gl_context_class()
         self.model = model
         self.camera_id = camera_id
         self.width, self.height = width, height
         self.near, self.far = float(near), float(far)
         model.vis.quality.offsamples = 0
         model.vis.quality.shadowsize = 0
+        # MuJoCo builds the grid of an infinite ground plane when the context is made, from vis.map.zfar
+        # (its size, and so the size of its cells): make every context from the model's own value, not from
+        # whichever camera's far plane was set last, so that all cameras of a model see the same ground.
+        clip = _model_clip.setdefault(model, (float(model.vis.map.znear), float(model.vis.map.zfar)))
+        now = (float(model.vis.map.znear), float(model.vis.map.zfar))
+        model.vis.map.znear, model.vis.map.zfar = clip
         try:
-            self._r: Any = mujoco.Renderer(model, height, width)
+            self._gl = ctx_cls(width, height)
+            self._gl.make_current()
+            self._con = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_150)
+            mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._con)
+            self._con.readDepthMap = mujoco.mjtDepthMap.mjDEPTH_ZEROFAR
         except Exception as e:
+            self.close()
             raise RuntimeError(
-                f"cannot create an offscreen renderer (MUJOCO_GL={os.environ.get('MUJOCO_GL', '')!r}, "
-                f"backend {backend}): {type(e).__name__}: {e}. Headless rendering needs EGL (Debian: libegl1 "
-                "libegl-mesa0 libgl1-mesa-dri libgbm1) or MUJOCO_GL=osmesa with libosmesa6."
+                no_backend_message(
+                    {gl_backend_in_use(): f"making an offscreen context failed: {type(e).__name__}: {e}"},
+                    os.environ.get(GL_ENV, ""),
+                )
             ) from e
+        finally:
+            model.vis.map.znear, model.vis.map.zfar = now
         _open.add(self)
+        if not _atexit_registered:
+            atexit.register(_close_all)
+            _atexit_registered = True
+        self.scene = mujoco.MjvScene(model, maxgeom=10000)
+        cam = mujoco.MjvCamera()
+        cam.type = mujoco.mjtCamera.mjCAMERA_FIXED
+        cam.fixedcamid = camera_id
+        self._camera = cam
         opt = mujoco.MjvOption()
         opt.sitegroup[:] = 0  # sites are markers, not things a camera sees
         self.option = opt
+        self._rect = mujoco.MjrRect(0, 0, width, height)
+        self._has_skybox = bool(np.any(model.tex_type == mujoco.mjtTexture.mjTEXTURE_SKYBOX))
+        # OpenGL rows run bottom-up: pixels are read into these, then flipped into the outputs.
+        self._raw_rgb = np.empty((height, width, 3), dtype=np.uint8)
+        self._raw_depth = np.empty((height, width), dtype=np.float32)
+        self._depth64 = np.empty((height, width), dtype=np.float64)
         self._rgb = np.empty((height, width, 3), dtype=np.uint8)
         self._depth = np.empty((height, width), dtype=np.float32)
+        self._clip = (np.float32(0.0), np.float32(0.0))
 
+    # ----------------------------------------------------------------------------------------- frames
     def update(self, data: mujoco.MjData) -> None:
-        """Take the scene from `data` (call once per frame, before `rgb()` and `depth()`)."""
+        """Take the scene from `data` (call once per frame, before `rgb()`, `depth()` or `rgbd()`)."""
         m = self.model
+        vmap = m.vis.map
         extent = float(m.stat.extent)
-        m.vis.map.znear = self.near / extent
+        znear = self.near / extent
         # A little beyond `far`: pixels where nothing is drawn read the far plane, which must stay
         # distinguishable from geometry at `far` (float32 round-off in the conversion is ~1e-4 of far).
-        m.vis.map.zfar = self.far * _FAR_MARGIN / extent
-        self._r.update_scene(data, self.camera_id, self.option)
-        flags = self._r.scene.flags
+        zfar = self.far * _FAR_MARGIN / extent
+        if vmap.znear != np.float32(znear):
+            vmap.znear = znear
+        if vmap.zfar != np.float32(zfar):
+            vmap.zfar = zfar
+        # the clip distances this frame's projection uses (as mujoco.Renderer reads them for depth)
+        self._clip = (np.float32(vmap.znear * extent), np.float32(vmap.zfar * extent))
+        mujoco.mjv_updateScene(
+            m, data, self.option, None, self._camera, mujoco.mjtCatBit.mjCAT_ALL, self.scene
+        )
+        flags = self.scene.flags
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
         flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
 
     def rgb(self) -> np.ndarray:
         """The colour image of the last `update`, H x W x 3 uint8, row 0 at the top (a buffer reused)."""
-        self._r.disable_depth_rendering()
-        return self._r.render(out=self._rgb)
+        self._render(depth_too=False)
+        np.copyto(self._rgb, self._raw_rgb[::-1])
+        return self._rgb
 
     def depth(self) -> np.ndarray:
         """Depth along the optical axis (metres, float32, H x W) of the last `update`: +inf where nothing
-        is within `far` (MuJoCo's Renderer turns the depth buffer into metric depth; nothing maps to far)."""
-        self._r.enable_depth_rendering()
+        is within `far` (nothing maps to far). A buffer reused."""
+        self._render_depth()
+        return self._convert_depth()
+
+    def rgbd(self) -> tuple[np.ndarray, np.ndarray]:
+        """`rgb()` and `depth()` of the last `update`, from one render when the depth buffer of the colour
+        render is the depth `depth()` gives (no skybox drawn, nothing transparent); else two renders."""
+        one = self._depth_same_in_color_render()
+        self._render(depth_too=one)
+        np.copyto(self._rgb, self._raw_rgb[::-1])
+        if not one:
+            self._render_depth()
+        return self._rgb, self._convert_depth()
+
+    def _depth_same_in_color_render(self) -> bool:
+        # Checked by rendering both ways: the depth buffers are identical unless a skybox is drawn (it
+        # writes depth) or something is transparent (drawn differently in segmentation mode).
+        m = self.model
+        if self._has_skybox and self.scene.flags[mujoco.mjtRndFlag.mjRND_SKYBOX]:
+            return False
+        for rgba in (m.geom_rgba, m.mat_rgba, m.skin_rgba, m.flex_rgba):
+            if len(rgba) and float(rgba[:, 3].min()) < 1.0:
+                return False
+        return True
+
+    def _render(self, depth_too: bool) -> None:
+        if self._con is None:
+            raise RuntimeError("render cannot be called after close")
+        self._gl.make_current()
+        mujoco.mjr_render(self._rect, self.scene, self._con)
+        mujoco.mjr_readPixels(self._raw_rgb, self._raw_depth if depth_too else None, self._rect, self._con)
+
+    def _render_depth(self) -> None:
+        # Segmentation mode, as mujoco.Renderer renders depth: no lighting or skybox, everything opaque.
+        if self._con is None:
+            raise RuntimeError("render cannot be called after close")
+        flags = self.scene.flags
+        seg, idc = mujoco.mjtRndFlag.mjRND_SEGMENT, mujoco.mjtRndFlag.mjRND_IDCOLOR
+        old = (flags[seg], flags[idc])
+        flags[seg] = flags[idc] = True
         try:
-            depth = self._r.render(out=self._depth)
+            self._gl.make_current()
+            mujoco.mjr_render(self._rect, self.scene, self._con)
+            mujoco.mjr_readPixels(None, self._raw_depth, self._rect, self._con)
         finally:
-            self._r.disable_depth_rendering()
-        depth[depth > np.float32(self.far)] = np.inf
+            flags[seg], flags[idc] = old
+
+    def _convert_depth(self) -> np.ndarray:
+        # mujoco.Renderer's conversion (reversed Z, float32 coefficients, float64 arithmetic, float32
+        # result), on the rows flipped top-down, into reused buffers.
+        znear, zfar = self._clip
+        d64 = self._depth64
+        raw = self._raw_depth[::-1]
+        if self.scene.camera[0].orthographic:
+            np.multiply(raw, zfar - znear, out=d64, dtype=np.float64)
+            np.subtract(np.float64(zfar), d64, out=d64)
+        else:
+            c_coef = -(zfar + znear) / (zfar - znear)
+            d_coef = -(np.float32(2) * zfar * znear) / (zfar - znear)
+            c_coef = np.float32(-0.5) * c_coef - np.float32(0.5)
+            d_coef = np.float32(-0.5) * d_coef
+            np.add(raw, c_coef, out=d64, dtype=np.float64)
+            np.divide(np.float64(d_coef), d64, out=d64)
+        depth = self._depth
+        np.copyto(depth, d64, casting="same_kind")
+        np.copyto(depth, np.float32(np.inf), where=depth > np.float32(self.far))
         return depth
 
+    # ------------------------------------------------------------------------------------------ close
     def close(self) -> None:
-        r = getattr(self, "_r", None)
-        if r is not None:
-            r.close()
-            self._r = None
+        con, gl = self._con, self._gl
+        self._con = self._gl = None
+        # Errors are ignored: closing runs at exit too, when the display may already be gone.
+        if con is not None:
+            with contextlib.suppress(Exception):
+                if gl is not None:
+                    gl.make_current()  # the context's textures and buffers are freed in it
+                con.free()
+        if gl is not None:
+            with contextlib.suppress(Exception):
+                gl.free()
         _open.discard(self)
+
+    def __del__(self) -> None:
+        if getattr(self, "_con", None) is not None or getattr(self, "_gl", None) is not None:
+            self.close()
 
 
 # ------------------------------------------------------------------------------------------- messages

@@ -6,8 +6,9 @@ noise. CameraInfo is an ideal pinhole: fx = fy = width / (2 tan(fov / 2)), cx = 
 cy = height / 2, plumb_bob distortion with zeros, R identity, P = [K | 0].
 
 Rendering needs an OpenGL backend: headless, MUJOCO_GL=egl (set by `python -m runner.sim` when unset), or
-MUJOCO_GL=osmesa; see `plugins._render.ensure_gl_backend`. The image shows the world's geoms in MuJoCo's
-visible groups (0-2), the robot's own included, with lights but no shadows or reflections.
+MUJOCO_GL=osmesa; see "Backends" in `plugins._render`. Where none works, `setup` raises a RuntimeError naming
+the Debian packages to install. The image shows the world's geoms in MuJoCo's visible groups (0-2), the
+robot's own included, with lights but no shadows or reflections. A camera costs nothing between its frames.
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ class Camera(Plugin):
     Params = CameraParams
     params: CameraParams
     link_hints: ClassVar[tuple[str, ...]] = ("camera",)
+    renders: ClassVar[bool] = True
 
     @classmethod
     def build(cls, params: CameraParams, ctx: BuildContext, name: str) -> list[Topic]:

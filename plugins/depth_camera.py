@@ -100,10 +100,13 @@ class DepthCamera(Camera):
         self.renderer.update(self.ctx.data)
         rgb = None
         if p.publish_color:
-            rgb = self.renderer.rgb()
+            # one scene update, and one render for both when that gives the same depth (CameraRenderer.rgbd)
+            rgb, depth = self.renderer.rgbd()
             self.publish_color(rgb, now_ns)
-        depth = self.renderer.depth()
-        self.depth_pub.publish(image_msg(now_ns, self.frame_id, depth, "32FC1"), now_ns)
+        else:
+            depth = self.renderer.depth()
+        # the renderer reuses its buffer: the message gets its own copy
+        self.depth_pub.publish(image_msg(now_ns, self.frame_id, depth.copy(), "32FC1"), now_ns)
         if self.depth_info_pub is not None:
             self.depth_info_pub.publish(self.make_info(now_ns, self.frame_id), now_ns)
         if self.points_pub is not None:
@@ -113,14 +116,16 @@ class DepthCamera(Camera):
         """An organized cloud in the optical frame from a depth image (and colours); NaN where no return."""
         h, w = depth.shape
         buf = np.empty((h, w, self.point_step // 4), dtype=np.float32)
-        invalid = ~np.isfinite(depth)
-        z = np.where(invalid, np.float32(np.nan), depth)
+        z = buf[..., 2]
+        np.copyto(z, depth)
+        np.copyto(z, np.float32(np.nan), where=~np.isfinite(depth))
         np.multiply(self.ray_x, z, out=buf[..., 0])
         np.multiply(self.ray_y, z, out=buf[..., 1])
-        buf[..., 2] = z
         if rgb is not None:
-            c = rgb.astype(np.uint32)
-            buf[..., 3] = ((c[..., 0] << 16) | (c[..., 1] << 8) | c[..., 2]).view(np.float32)
+            # float32 `rgb` holding 0x00RRGGBB, little-endian: bytes B, G, R, 0
+            packed = buf.view(np.uint8).reshape(h, w, self.point_step)[..., 12:16]
+            packed[..., :3] = rgb[..., ::-1]
+            packed[..., 3] = 0
         return self.PointCloud2(
             header=msgs.header(now_ns, self.frame_id),
             height=h,

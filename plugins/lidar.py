@@ -18,6 +18,7 @@ from runner import msgs
 from runner.plugin import BuildContext, Plugin, RatedParams, Topic
 
 _EPS = 1e-4
+_HIDDEN_GROUP = 1  # the geom group rays skip (URDF visuals live there already)
 
 
 class LidarParams(RatedParams):
@@ -103,6 +104,8 @@ class Lidar(Plugin):
         skip[ctx.robot.geom_ids] = True
         skip |= (m.geom_contype == 0) & (m.geom_conaffinity == 0)
         self.skip = skip
+        self.own = np.asarray(ctx.robot.geom_ids, dtype=np.int64)
+        self.own_groups = m.geom_group[self.own].copy()
         self.geomgroup = np.array([1, 0, 1, 1, 1, 1], dtype=np.uint8)
         self.pub = ctx.publisher(p.topic, "sensor_msgs/msg/LaserScan")
         self.LaserScan = msgs.T["sensor_msgs/msg/LaserScan"]
@@ -115,20 +118,26 @@ class Lidar(Plugin):
         origin = d.site_xpos[self.site].copy()
         rot = d.site_xmat[self.site].reshape(3, 3)
         vec = (rot @ self.local).T.copy()  # n x 3
-        mujoco.mj_multiRay(
-            m,
-            d,
-            origin,
-            vec.reshape(-1),
-            self.geomgroup,
-            1,
-            self.body,
-            self.geomid,
-            self.dist,
-            None,
-            len(self.dist),
-            p.range_max,
-        )
+        # The robot's own geoms go to an excluded group for this one call, so rays pass through them in C
+        # instead of being re-cast one by one in Python (a 3D lidar sees its own chassis a lot).
+        m.geom_group[self.own] = _HIDDEN_GROUP
+        try:
+            mujoco.mj_multiRay(
+                m,
+                d,
+                origin,
+                vec.reshape(-1),
+                self.geomgroup,
+                1,
+                self.body,
+                self.geomid,
+                self.dist,
+                None,
+                len(self.dist),
+                p.range_max,
+            )
+        finally:
+            m.geom_group[self.own] = self.own_groups
         dist = self.dist.copy()
         redo = np.nonzero((self.geomid >= 0) & self.skip[np.maximum(self.geomid, 0)])[0]
         if len(redo):

@@ -1,7 +1,7 @@
 """scenario-runner: declarative YAML robot-simulation scenarios (URDF/xacro, MuJoCo, Zenoh, MCAP)."""
 
-import os
+from runner.gl import ensure_gl_backend
 
-# We never open a window: render offscreen through EGL unless the user chose a backend (osmesa, glfw).
-# MuJoCo reads this once, when it is first imported, so it is set before any of our modules import it.
-os.environ.setdefault("MUJOCO_GL", "egl")
+# We never open a window: render offscreen (EGL, else OSMesa) unless the user chose a backend. MuJoCo reads
+# MUJOCO_GL once, when it is first imported, so this runs before any of our modules imports it.
+ensure_gl_backend()

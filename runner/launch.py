@@ -132,7 +132,7 @@ def run_plan(
             plan_file = f.name
         cmd = [sys.executable, "-m", "runner.sim", plan_file, "--connect", _connectable(listen[0])]
         # A session of its own: a terminal's Ctrl-C reaches only us, and we stop the world in order.
-        child = subprocess.Popen(cmd, stderr=subprocess.PIPE, start_new_session=True)
+        child = subprocess.Popen(cmd, stderr=subprocess.PIPE, start_new_session=True, env=_world_env(plan))
         tail = _StderrTail(child.stderr, "[world] ")
         tail.start()
         wall0 = time.perf_counter()
@@ -184,6 +184,27 @@ def run_plan(
         error=error,
         endpoints=listen,
     )
+
+
+def _world_env(plan: RunPlan) -> dict[str, str]:
+    """The world process's environment; with a camera, an OpenGL backend that a test render proved
+    (EGL, else OSMesa), unless the user chose one with MUJOCO_GL."""
+    from runner import gl
+    from runner.registry import load
+
+    env = dict(os.environ)
+    if not any(load(p.type).renders for r in plan.robots for p in r.plugins):
+        return env
+    if gl.gl_backend_chosen_by_user():
+        return env
+    try:
+        backend = gl.choose_gl_backend()
+    except RuntimeError as e:
+        raise RunError(str(e)) from None
+    env.update(
+        {gl.GL_ENV: backend, "PYOPENGL_PLATFORM": backend, gl.GL_AUTO_ENV: "1", gl.GL_PROBED_ENV: backend}
+    )
+    return env
 
 
 def _connectable(endpoint: str) -> str:

@@ -128,6 +128,7 @@ class Plugin:
 
     Params: ClassVar[type[PluginParams]] = PluginParams
     type_name: ClassVar[str] = ""
+    renders: ClassVar[bool] = False  # needs OpenGL: the runner picks a working backend for its process
 
     def __init__(self, params: PluginParams, ctx: RuntimeContext, name: str):
         self.params = params

@@ -15,8 +15,6 @@ import sys
 import time
 from pathlib import Path
 
-os.environ.setdefault("MUJOCO_GL", "egl")  # headless camera rendering; before mujoco is imported
-
 import zenoh
 
 from runner.plan import RunPlan

@@ -1,0 +1,271 @@
+"""camera and depth_camera against real MuJoCo rendering (offscreen, headless EGL), the world stepped in-process."""
+
+from __future__ import annotations
+
+import os
+
+# MuJoCo picks its GL backend when it is first imported: headless EGL unless the user chose one.
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+import math
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from runner.errors import ScenarioError
+from tests.conftest import DIFFBOT
+from tests.helpers import messages, plan_of, simulate
+
+W, H = 160, 120
+FOV = 1.047
+CAM_X, CAM_Z = 0.12, 0.1  # mount on base_link, in front of the chassis; base_link rests 0.05 above ground
+
+CAM = f"pose: {{xyz: [{CAM_X}, 0, {CAM_Z}]}}, width: {W}, height: {H}, fov: {FOV}"
+
+# A red box straight ahead and a green one to the left; a grey wall behind the robot, seen by a depth
+# camera looking backwards (yaw pi) from just behind the chassis: its face is 2.0 - 0.22 = 1.78 m away.
+STATIC = f"""
+name: t
+duration: 0.5
+rate: max
+world:
+  models:
+    - {{name: red, shape: box, size: [0.4, 0.4, 0.4], pose: {{xyz: [1.5, 0, 0.2]}}, rgba: [1, 0, 0, 1]}}
+    - {{name: green, shape: box, size: [0.4, 0.4, 0.4], pose: {{xyz: [1.5, 0.6, 0.2]}}, rgba: [0, 1, 0, 1]}}
+    - {{name: wall, shape: box, size: [0.1, 1.0, 0.6], pose: {{xyz: [-2.05, 0, 0.3]}}}}
+robots:
+  - name: r1
+    description: "{DIFFBOT}"
+    pose: {{xyz: [0, 0, 0.05]}}
+    plugins:
+      - type: camera
+        params: {{{CAM}}}
+      - name: bgr
+        type: camera
+        params: {{{CAM}, format: bgr8, image_topic: bgr/image, info_topic: bgr/info}}
+      - name: mono
+        type: camera
+        params: {{{CAM}, format: mono8, image_topic: mono/image, info_topic: mono/info, rate: 4}}
+      - name: noisy
+        type: camera
+        params: {{{CAM}, noise_stddev: 0.05, image_topic: noisy/image, info_topic: noisy/info}}
+      - type: depth_camera
+        params:
+          pose: {{xyz: [-0.22, 0, {CAM_Z}], rpy: [0, 0, {math.pi}]}}
+          width: {W}
+          height: {H}
+          rate: 5
+          image_topic: rgbd/image
+          info_topic: rgbd/info
+      - name: short
+        type: depth_camera
+        params:
+          pose: {{xyz: [-0.22, 0, {CAM_Z}], rpy: [0, 0, {math.pi}]}}
+          width: 32
+          height: 24
+          far: 1.5
+          publish_color: false
+          points_topic: null
+          depth_topic: short/depth
+          depth_info_topic: null
+"""
+WALL_DIST = 2.0 - 0.22
+
+
+@pytest.fixture(scope="module")
+def static(tmp_path_factory):
+    path = tmp_path_factory.mktemp("cams") / "static.yaml"
+    path.write_text(STATIC)
+    _world, bus = simulate(path)
+    return bus
+
+
+def _image(msg) -> np.ndarray:  # type: ignore[no-untyped-def]
+    data = np.asarray(msg.data, dtype=np.uint8)
+    if msg.encoding == "32FC1":
+        return data.view("<f4").reshape(msg.height, msg.width)
+    channels = msg.step // msg.width
+    return data.reshape(msg.height, msg.width, channels).squeeze()
+
+
+def _last(bus, suffix: str):  # type: ignore[no-untyped-def]
+    return messages(bus, suffix)[-1][1]
+
+
+@pytest.mark.timeout(60)
+def test_camera_sees_a_red_box_ahead_the_ground_below_and_the_sky_above(static):
+    msg = _last(static, "r1/camera/image_raw")
+    assert (msg.width, msg.height, msg.encoding, msg.step, msg.is_bigendian) == (W, H, "rgb8", 3 * W, 0)
+    assert msg.header.frame_id == "r1/base_link"
+    img = _image(msg).astype(int)
+    r, g, b = img[..., 0], img[..., 1], img[..., 2]
+    red = (r > 120) & (g < 90) & (b < 90)
+    centre = red[H // 2 - 10 : H // 2 + 10, W // 2 - 10 : W // 2 + 10]
+    assert centre.mean() > 0.95
+    bottom = img[-10:]  # the ground, grey: channels close together, not dark
+    assert np.all(np.abs(bottom[..., 0] - bottom[..., 2]) < 30) and bottom.mean() > 60
+    assert not red[-10:].any()
+    assert img[:10].max() < 30  # nothing above the horizon: the background
+    # +Y (left of the robot) is on the left of the image
+    green = (g > 120) & (r < 90) & (b < 90)
+    cols = np.nonzero(green.any(axis=0))[0]
+    assert len(cols) and cols.max() < W // 2
+
+
+@pytest.mark.timeout(60)
+def test_bgr8_and_mono8_are_the_same_frame_in_another_format(static):
+    rgb = _image(_last(static, "r1/camera/image_raw"))
+    bgr_msg = _last(static, "r1/bgr/image")
+    assert bgr_msg.encoding == "bgr8"
+    assert np.array_equal(_image(bgr_msg), rgb[..., ::-1])
+    t_mono, mono_msg = messages(static, "r1/mono/image")[-1]
+    assert (mono_msg.encoding, mono_msg.step) == ("mono8", W)
+    rgb_same_time = next(m for t, m in messages(static, "r1/camera/image_raw") if t == t_mono)
+    luma = _image(rgb_same_time).astype(float) @ [0.299, 0.587, 0.114]
+    assert np.abs(_image(mono_msg).astype(float) - luma).max() <= 1.5
+
+
+@pytest.mark.timeout(60)
+def test_intensity_noise_has_the_requested_stddev(static):
+    clean = _image(_last(static, "r1/camera/image_raw")).astype(float)
+    noisy = _image(_last(static, "r1/noisy/image")).astype(float)
+    inside = (clean > 60) & (clean < 195)  # away from clamping at 0 and 255
+    err = (noisy - clean)[inside]
+    assert inside.sum() > 10_000
+    assert abs(err.mean()) < 0.5
+    assert 0.9 * 0.05 * 255 < err.std() < 1.1 * 0.05 * 255
+
+
+@pytest.mark.timeout(60)
+def test_camera_info_is_the_ideal_pinhole_of_the_fov(static):
+    info = _last(static, "r1/camera/camera_info")
+    f = W / (2 * math.tan(FOV / 2))
+    assert (info.width, info.height, info.distortion_model) == (W, H, "plumb_bob")
+    assert np.allclose(info.k, [f, 0, W / 2, 0, f, H / 2, 0, 0, 1])
+    assert np.allclose(info.p, [f, 0, W / 2, 0, 0, f, H / 2, 0, 0, 0, 1, 0])
+    assert np.allclose(info.r, np.eye(3).reshape(-1)) and np.allclose(info.d, 0)
+    assert info.header.frame_id == "r1/base_link"
+    stamps = [t for t, _ in messages(static, "r1/camera/camera_info")]
+    assert stamps == [t for t, _ in messages(static, "r1/camera/image_raw")]
+
+
+@pytest.mark.timeout(60)
+def test_depth_reads_the_wall_distance_along_the_optical_axis_and_inf_where_nothing_is(static):
+    msg = _last(static, "r1/camera/depth/image_raw")
+    assert (msg.encoding, msg.step, msg.width, msg.height) == ("32FC1", 4 * W, W, H)
+    depth = _image(msg)
+    assert abs(depth[H // 2, W // 2] - WALL_DIST) < 0.01
+    # depth along the axis, not along the ray: the same all over the flat wall
+    assert np.allclose(depth[H // 2 - 20 : H // 2 + 5, W // 2 - 30 : W // 2 + 30], WALL_DIST, atol=0.01)
+    assert np.isinf(depth[0, 0]) and np.isinf(depth[0, -1]) and depth[0, 0] > 0  # the sky
+    assert np.all(np.isfinite(depth[-5:]))  # the ground
+    # the same wall beyond `far` (1.5 m) is no return
+    assert np.all(np.isinf(_image(_last(static, "r1/short/depth"))[:12]))
+    assert not messages(static, "short/points") and not messages(static, "short/image_raw")
+
+
+@pytest.mark.timeout(60)
+def test_point_cloud_is_organized_in_the_optical_frame(static):
+    depth = _image(_last(static, "r1/camera/depth/image_raw"))
+    rgb = _image(_last(static, "r1/rgbd/image"))
+    pc = _last(static, "r1/camera/points")
+    assert (pc.height, pc.width, pc.point_step, pc.row_step) == (H, W, 16, 16 * W)
+    assert [(f.name, f.offset, f.datatype, f.count) for f in pc.fields] == [
+        ("x", 0, 7, 1),
+        ("y", 4, 7, 1),
+        ("z", 8, 7, 1),
+        ("rgb", 12, 7, 1),
+    ]
+    assert not pc.is_dense and not pc.is_bigendian
+    pts = np.asarray(pc.data, dtype=np.uint8).view("<f4").reshape(H, W, 4)
+    assert len(pc.data) == W * H * 16
+    c = pts[H // 2, W // 2]
+    assert c[2] == depth[H // 2, W // 2]
+    f = W / (2 * math.tan(FOV / 2))
+    assert abs(c[0] - 0.5 * c[2] / f) < 1e-5 and abs(c[1] - 0.5 * c[2] / f) < 1e-5
+    assert pts[H // 2, 10, 0] < 0 < pts[H // 2, -10, 0]  # x right
+    assert pts[-1, W // 2, 1] > 0 > pts[H // 2 - 20, W // 2, 1]  # y down
+    assert np.all(np.isnan(pts[0, 0, :3]))  # no return: a NaN point
+    packed = pts[H // 2, W // 2, 3:].view("<u4")[0]
+    assert [(packed >> 16) & 255, (packed >> 8) & 255, packed & 255] == list(rgb[H // 2, W // 2])
+
+
+@pytest.mark.timeout(60)
+def test_rates_are_exact_in_sim_time(static):
+    for suffix, rate in (
+        ("r1/camera/image_raw", 10),
+        ("r1/mono/image", 4),
+        ("r1/camera/depth/image_raw", 5),
+        ("r1/camera/points", 5),
+        ("r1/short/depth", 10),
+    ):
+        stamps = [t for t, _ in messages(static, suffix)]
+        assert len(stamps) == int(0.5 * rate) + 1, suffix
+        assert np.all(np.diff(stamps) == round(1e9 / rate)), suffix
+        assert stamps[0] == 0
+
+
+MOVING = f"""
+name: t
+duration: 1.0
+rate: max
+world:
+  models:
+    - {{name: wall, shape: box, size: [0.1, 6, 1], pose: {{xyz: [2.05, 0, 0.5]}}, rgba: [0.2, 0.3, 0.9, 1]}}
+robots:
+  - name: r1
+    description: "{DIFFBOT}"
+    pose: {{xyz: [0, 0, 0.06]}}
+    plugins:
+      - {{type: diff_drive}}
+      - {{type: camera, params: {{rate: 5, width: 64, height: 48, pose: {{xyz: [{CAM_X}, 0, {CAM_Z}]}}}}}}
+      - type: depth_camera
+        params: {{rate: 5, width: 64, height: 48, pose: {{xyz: [{CAM_X}, 0, {CAM_Z}]}}, publish_color: false}}
+timeline:
+  - {{t: 0.0, topic: r1/cmd_vel, type: geometry_msgs/msg/Twist, data: {{linear: {{x: 0.3}}}}}}
+"""
+
+
+@pytest.mark.timeout(60)
+def test_images_follow_the_moving_robot(tmp_path: Path):
+    path = tmp_path / "moving.yaml"
+    path.write_text(MOVING)
+    _, bus = simulate(path)
+    images = [_image(m) for _, m in messages(bus, "r1/camera/image_raw")]
+    assert len(images) == 6
+    assert not np.array_equal(images[0], images[-1])
+    depths = [_image(m)[24, 32] for _, m in messages(bus, "r1/camera/depth/image_raw")]
+    assert abs(depths[0] - (2.0 - CAM_X)) < 0.01
+    assert np.all(np.diff(depths) < 0)  # approaching the wall
+    assert 0.2 < depths[0] - depths[-1] < 0.35  # about 0.3 m/s for 1 s, minus the spin-up
+    _, pc = messages(bus, "r1/camera/points")[-1]
+    assert pc.point_step == 12 and [f.name for f in pc.fields] == ["x", "y", "z"]
+
+
+@pytest.mark.timeout(30)
+@pytest.mark.parametrize(
+    ("params", "where", "text"),
+    [
+        ("{width: 2000}", "width", "offscreen framebuffer"),
+        ("{near: 5, far: 1}", "params", "far"),
+        ("{depth_topic: camera/image_raw}", "params", "same topic"),
+    ],
+)
+def test_bad_camera_params_are_scenario_errors(tmp_path: Path, params: str, where: str, text: str):
+    path = tmp_path / "bad.yaml"
+    path.write_text(
+        textwrap.dedent(f"""\
+        name: t
+        robots:
+          - name: r1
+            description: "{DIFFBOT}"
+            plugins:
+              - {{type: depth_camera, params: {params}}}
+        """)
+    )
+    with pytest.raises(ScenarioError) as e:
+        plan_of(path)
+    msg = str(e.value)
+    assert text in msg and where in msg and ":6" in msg, msg
