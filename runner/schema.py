@@ -203,6 +203,130 @@ class Record(Strict):
     exclude: list[str] = Field(default_factory=list, description="Key expressions of topics not to record.")
 
 
+# ------------------------------------------------------------------------------------------ assertions
+Vec2 = Annotated[tuple[float, float], Field(description="[x, y] in metres, world frame")]
+
+
+class Region(Strict):
+    """A region of the ground plane: a circle (`center` + `radius`) or a box (`min` + `max`)."""
+
+    center: Vec2 | None = Field(None, description="Centre of a circular region.")
+    radius: PositiveFloat | None = Field(None, description="Radius of a circular region, metres.")
+    min: Vec2 | None = Field(None, description="Lower corner [x, y] of a box region.")
+    max: Vec2 | None = Field(None, description="Upper corner [x, y] of a box region.")
+
+    @field_validator("max")
+    @classmethod
+    def _box(cls, v: tuple[float, float] | None, info: Any) -> tuple[float, float] | None:
+        lo = info.data.get("min")
+        if v is not None and lo is not None and (v[0] <= lo[0] or v[1] <= lo[1]):
+            raise ValueError(f"max {list(v)} must exceed min {list(lo)} on both axes")
+        return v
+
+    def contains(self, x: float, y: float) -> bool:
+        if self.center is not None and self.radius is not None:
+            return (x - self.center[0]) ** 2 + (y - self.center[1]) ** 2 <= self.radius**2
+        if self.min is not None and self.max is not None:
+            return self.min[0] <= x <= self.max[0] and self.min[1] <= y <= self.max[1]
+        return False
+
+
+class _AssertionBase(Strict):
+    name: str = Field(description="Name of the check, as reported (JUnit testcase name).")
+
+
+class _Window(Strict):
+    after: NonNegativeFloat = Field(0.0, description="Start of the window, sim seconds.")
+    until: NonNegativeFloat | None = Field(
+        None, description="End of the window, sim seconds (default: the end)."
+    )
+
+
+class Reach(_AssertionBase):
+    """A robot's base comes within `tolerance` of `point` (or inside `region`) by sim time `by`."""
+
+    type: Literal["reach"] = Field(description="Assertion kind.")
+    robot: str = Field(description="Robot name.")
+    point: Vec2 | None = Field(None, description="Goal point [x, y].")
+    tolerance: PositiveFloat = Field(0.25, description="How close to `point` counts, metres.")
+    region: Region | None = Field(None, description="Goal region, instead of a point.")
+    by: PositiveFloat | None = Field(
+        None, description="Deadline in sim seconds (default: the end of the run)."
+    )
+
+
+class StayWithin(_AssertionBase, _Window):
+    """A robot stays inside `region` (or, with `inside: false`, out of it) during the window."""
+
+    type: Literal["stay_within"] = Field(description="Assertion kind.")
+    robot: str = Field(description="Robot name.")
+    region: Region = Field(description="The region.")
+    inside: bool = Field(True, description="Stay inside (true) or keep out (false).")
+
+
+class NoCollision(_AssertionBase, _Window):
+    """No contact between any two of the named robots and world models (from the physics' contacts)."""
+
+    type: Literal["no_collision"] = Field(description="Assertion kind.")
+    between: list[str] = Field(min_length=1, description="Robot and model names; `ground` is the ground.")
+    others: bool = Field(
+        False, description="Also fail on contact between a named body and any unnamed robot or model."
+    )
+
+
+class TopicRate(_AssertionBase):
+    """A topic's rate in sim time stays within bounds after a warm-up."""
+
+    type: Literal["topic_rate"] = Field(description="Assertion kind.")
+    topic: str = Field(description="Topic inside the run, e.g. `r1/scan`.")
+    min: NonNegativeFloat | None = Field(None, description="Lowest acceptable rate, Hz.")
+    max: PositiveFloat | None = Field(None, description="Highest acceptable rate, Hz.")
+    after: NonNegativeFloat = Field(1.0, description="Warm-up in sim seconds before counting.")
+
+
+class MessageCheck(_AssertionBase, _Window):
+    """A predicate on message fields: `always`, `eventually` or `never` true during the window."""
+
+    type: Literal["message"] = Field(description="Assertion kind.")
+    topic: str = Field(description="Topic inside the run, e.g. `r1/scan`.")
+    expr: str = Field(
+        description="Predicate over the message's fields, e.g. `ranges.min() > 0.25`; comparisons, "
+        "and/or/not, arithmetic, abs/len/min/max and .min() .max() .mean() .sum() .std()."
+    )
+    mode: Literal["always", "eventually", "never"] = Field("always", description="When it must hold.")
+
+
+class MaxSpeed(_AssertionBase, _Window):
+    type: Literal["max_speed"] = Field(
+        description="Assertion kind: a robot's planar speed never exceeds `max`."
+    )
+    robot: str = Field(description="Robot name.")
+    max: PositiveFloat = Field(description="Speed bound, m/s.")
+
+
+class MaxTilt(_AssertionBase, _Window):
+    type: Literal["max_tilt"] = Field(
+        description="Assertion kind: a robot's base never tilts more than `max`."
+    )
+    robot: str = Field(description="Robot name.")
+    max: PositiveFloat = Field(description="Tilt bound (angle from upright), radians.")
+
+
+class DistanceTraveled(_AssertionBase):
+    type: Literal["distance_traveled"] = Field(
+        description="Assertion kind: the length of a robot's path over the run is within bounds."
+    )
+    robot: str = Field(description="Robot name.")
+    min: NonNegativeFloat | None = Field(None, description="Shortest acceptable path, metres.")
+    max: PositiveFloat | None = Field(None, description="Longest acceptable path, metres.")
+
+
+Assertion = Annotated[
+    Reach | StayWithin | NoCollision | TopicRate | MessageCheck | MaxSpeed | MaxTilt | DistanceTraveled,
+    Field(discriminator="type"),
+]
+
+
 class Scenario(Strict):
     """A robot-simulation scenario: a world, robots with plugins, a timeline, a recording."""
 
@@ -229,6 +353,12 @@ class Scenario(Strict):
         default_factory=list, description="Messages to publish at sim times."
     )
     record: Record = Field(default_factory=Record, description="What to record, and where.")
+    assertions: list[Assertion] = Field(
+        default_factory=list, description="Checks judged live during the run and from the recording."
+    )
+    stop_on: Literal["never", "first_failure", "all_decided"] = Field(
+        "never", description="End the run early when an assertion fails, or when every one is decided."
+    )
 
     @field_validator("rate", mode="before")
     @classmethod

@@ -39,14 +39,47 @@ def _resolve(data: Any, loc: tuple[Any, ...], about_keys: bool) -> tuple[PathKey
     return tuple(path), cur, missing
 
 
-def _model_at(root: type[BaseModel], path: PathKey) -> type[BaseModel] | None:
-    """The model class that holds the value at `path` (for listing the keys it accepts)."""
+def _model_at(root: type[BaseModel], path: PathKey, data: Any = None) -> type[BaseModel] | None:
+    """The model class that holds the value at `path` (for listing the keys it accepts); in a union
+    tagged by `type`, the member the data names."""
     tp: Any = root
+    cur = data
     for el in path:
+        tp = _pick_member(tp, cur)
         tp = _unwrap_model(tp, el)
+        cur = _step(cur, el)
         if tp is None:
             return None
-    return _unwrap_model(tp, None)
+    return _unwrap_model(_pick_member(tp, cur), None)
+
+
+def _step(cur: Any, el: Any) -> Any:
+    if isinstance(cur, dict):
+        return cur.get(el)
+    if isinstance(cur, list) and isinstance(el, int) and 0 <= el < len(cur):
+        return cur[el]
+    return None
+
+
+def _pick_member(tp: Any, cur: Any) -> Any:
+    """Of a union of models, the one whose `type` literal matches the data's `type`."""
+    if not isinstance(cur, dict) or "type" not in cur:
+        return tp
+    for arg in _flatten(tp):
+        is_model = isinstance(arg, type) and issubclass(arg, BaseModel) and "type" in arg.model_fields
+        if is_model and cur["type"] in get_args(arg.model_fields["type"].annotation):
+            return arg
+    return tp
+
+
+def _flatten(tp: Any) -> list[Any]:
+    args = get_args(tp)
+    if not args:
+        return [tp]
+    out: list[Any] = []
+    for a in args:
+        out += _flatten(a)
+    return out
 
 
 def _unwrap_model(tp: Any, el: Any) -> Any:
@@ -126,7 +159,7 @@ def problems_from_validation(
             )
             continue
         for e, value, missing in errs:
-            problems.append(_problem(e, value, missing, path, doc, model, prefix))
+            problems.append(_problem(e, value, missing, path, doc, model, prefix, data))
     return problems
 
 
@@ -138,13 +171,14 @@ def _problem(
     doc: Document,
     model: type[BaseModel],
     prefix: PathKey,
+    data: Any = None,
 ) -> Problem:
     full = prefix + path
     kind = e["type"]
     msg: str = e["msg"]
     if kind == "extra_forbidden":
         key = path[-1]
-        holder = _model_at(model, path[:-1])
+        holder = _model_at(model, path[:-1], data)
         allowed = sorted(holder.model_fields) if holder else []
         close = difflib.get_close_matches(str(key), allowed, n=1)
         return Problem(
@@ -154,9 +188,22 @@ def _problem(
             expected="one of: " + ", ".join(allowed) if allowed else None,
             hint=f"did you mean {close[0]!r}?" if close else "remove it, or check its indentation",
         )
+    if kind == "union_tag_invalid":
+        ctx = e.get("ctx") or {}
+        tags = [t.strip(" '") for t in str(ctx.get("expected_tags", "")).split(",") if t.strip()]
+        found = str(ctx.get("tag", ""))
+        close = difflib.get_close_matches(found, tags, n=1)
+        where = (*full, str(ctx.get("discriminator", "type")).strip("'"))
+        return Problem(
+            f"unknown {ctx.get('discriminator', 'type')} {found!r}".replace("'type'", "type"),
+            doc.locate(where),
+            where,
+            expected="one of: " + ", ".join(tags),
+            hint=f"did you mean {close[0]!r}?" if close else None,
+        )
     if kind == "missing":
         key = path[-1]
-        holder = _model_at(model, path[:-1])
+        holder = _model_at(model, path[:-1], data)
         desc = holder.model_fields[key].description if holder and key in holder.model_fields else None
         return Problem(
             f"missing required key {key!r}",
