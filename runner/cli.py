@@ -6,6 +6,7 @@ User mistakes (`ScenarioError`, `RunError`) are printed without a traceback and 
 
 from __future__ import annotations
 
+import json
 import math
 import signal
 import sys
@@ -134,8 +135,10 @@ def run(
         list[str] | None, typer.Option(help="Zenoh endpoint of another router to join (repeatable).")
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress line and no table.")] = False,
+    junit: Annotated[Path | None, typer.Option(help="Write the assertions' results as JUnit XML.")] = None,
+    results_json: Annotated[Path | None, typer.Option(help="Write the run's results as JSON.")] = None,
 ) -> None:
-    """Validate, compile and run a scenario; record every message to MCAP.
+    """Validate, compile and run a scenario; record every message to MCAP; judge its assertions.
 
     Examples:
       scenario run scenarios/two_robots.yaml
@@ -188,19 +191,168 @@ def run(
     endpoints = list(listen or []) or [f"tcp/127.0.0.1:{free_port()}"]
     if not quiet:
         err.print(f"running {plan.name} ({total:g} s sim), Zenoh on {', '.join(endpoints)}", markup=False)
+    from runner.checks.report import Suite, judge_for, write_junit
+
+    judge = judge_for(plan)
     try:
-        result = run_plan(plan, listen=endpoints, connect=connect or (), on_progress=on_progress)
+        result = run_plan(plan, listen=endpoints, connect=connect or (), on_progress=on_progress, judge=judge)
     except RunError as e:
         raise _fail(e) from None
     finally:
         if progress is not None:
             progress.stop()
 
+    results = judge.finish(result.sim_ns) if judge is not None else []
     if not quiet:
         _print_summary(result)
+    if results:
+        _print_results(results)
     if result.error:
         err.print("error: " + result.error, markup=False, style="red")
-    raise typer.Exit(result.exit_code)
+    suite = Suite(plan.name, results, result.error, result.wall_s, str(result.mcap) if result.mcap else None)
+    if junit is not None:
+        write_junit(junit, [suite])
+    if results_json is not None:
+        results_json.write_text(json.dumps(suite.to_json(), indent=2))
+    code = result.exit_code
+    if code == 0 and not suite.passed:
+        code = 1
+    raise typer.Exit(code)
+
+
+def _print_results(results: list[Any]) -> None:
+    table = Table(
+        "assertion",
+        "type",
+        "result",
+        "at (sim s)",
+        "value",
+        "bound",
+        title="Assertions",
+        title_justify="left",
+    )
+    for r in results:
+        mark = "[green]pass[/]" if r.passed else "[bold red]FAIL[/]"
+        table.add_row(r.name, r.type, mark, f"{r.t:.3f}" if r.t is not None else "", r.value, r.bound)
+    out.print(table)
+    failed = [r for r in results if not r.passed]
+    summary = f"{len(results) - len(failed)} passed, {len(failed)} failed"
+    out.print(summary, style="red" if failed else "green", markup=False)
+
+
+@app.command()
+def check(
+    mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")],
+    scenario: Annotated[
+        Path, typer.Option("--scenario", "-s", help="The scenario whose assertions to judge.")
+    ],
+    junit: Annotated[Path | None, typer.Option(help="Write the results as JUnit XML.")] = None,
+) -> None:
+    """Judge a recording with a scenario's assertions (the same judge as the live run).
+
+    Example: scenario check runs/two_robots.mcap --scenario scenarios/two_robots.yaml
+    """
+    from runner.checks.report import Suite, judge_recording, write_junit
+
+    try:
+        _scenario, plan = _load(scenario)
+    except ScenarioError as e:
+        raise _fail(e) from None
+    if not plan.assertions:
+        raise _fail(RunError(f"{scenario} has no assertions to judge"))
+    if not mcap.is_file():
+        raise _fail(RunError(f"{mcap}: file not found"))
+    try:
+        results, _end = judge_recording(plan, mcap)
+    except Exception as e:
+        raise _fail(RunError(f"{mcap}: cannot judge it: {type(e).__name__}: {e}")) from None
+    _print_results(results)
+    suite = Suite(plan.name, results, mcap=str(mcap))
+    if junit is not None:
+        write_junit(junit, [suite])
+    raise typer.Exit(0 if suite.passed else 1)
+
+
+@app.command("test")
+def test_cmd(
+    paths: Annotated[list[Path], typer.Argument(help="Scenario files or folders (their *.yaml).")],
+    jobs: Annotated[int, typer.Option("--jobs", "-j", help="Scenarios run at once.", min=1)] = 1,
+    junit: Annotated[Path | None, typer.Option(help="Write every result as JUnit XML.")] = None,
+    out_dir: Annotated[Path, typer.Option("--out", help="Folder for the recordings.")] = Path("runs/test"),
+) -> None:
+    """Run many scenarios (in parallel processes), print a results table, write JUnit XML; exit 0 only if
+    every run completes and every assertion passes.
+
+    Example: scenario test scenarios/ -j 2 --junit report.xml
+    """
+    import concurrent.futures
+    import subprocess
+    import tempfile
+
+    from runner.checks.report import Suite, write_junit
+
+    files: list[Path] = []
+    for p in paths:
+        files += sorted(p.glob("*.yaml")) if p.is_dir() else [p]
+    if not files:
+        raise _fail(RunError("no scenario files found in " + ", ".join(map(str, paths))))
+    out_dir.mkdir(parents=True, exist_ok=True)
+
+    def run_one(f: Path) -> Suite:
+        with tempfile.TemporaryDirectory() as tmp:
+            res = Path(tmp) / "results.json"
+            cmd = [
+                sys.executable,
+                "-m",
+                "runner.cli",
+                "run",
+                str(f),
+                "-q",
+                "--record",
+                str(out_dir / f"{f.stem}.mcap"),
+                "--results-json",
+                str(res),
+            ]
+            proc = subprocess.run(cmd, capture_output=True, text=True)
+            if res.is_file():
+                suite = Suite.from_json(json.loads(res.read_text()))
+                suite.name = f.stem
+                return suite
+            why = (proc.stderr.strip() or proc.stdout.strip() or f"exit {proc.returncode}").splitlines()
+            return Suite(f.stem, error="\n".join(why[-12:]))
+
+    with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+        suites = list(pool.map(run_one, files))
+    table = Table(
+        "scenario",
+        "assertions",
+        "passed",
+        "failed",
+        "result",
+        "time (s)",
+        title="Scenarios",
+        title_justify="left",
+    )
+    for s in suites:
+        failed = sum(1 for r in s.results if not r.passed)
+        verdict = "[green]pass[/]" if s.passed else ("[bold red]ERROR[/]" if s.error else "[bold red]FAIL[/]")
+        table.add_row(
+            s.name, str(len(s.results)), str(len(s.results) - failed), str(failed), verdict, f"{s.time_s:.1f}"
+        )
+    out.print(table)
+    for s in suites:
+        if s.error:
+            err.print(f"{s.name}: {s.error}", markup=False, style="red")
+        for r in s.results:
+            if not r.passed:
+                from runner.checks.report import failure_text
+
+                err.print(f"{s.name}: {failure_text(r)}", markup=False, style="red")
+    if junit is not None:
+        write_junit(junit, suites)
+    ok = sum(1 for s in suites if s.passed)
+    out.print(f"{ok} passed, {len(suites) - ok} failed", markup=False)
+    raise typer.Exit(0 if ok == len(suites) else 1)
 
 
 def _print_summary(result: Any) -> None:

@@ -48,7 +48,7 @@ class RunResult:
 
     @property
     def exit_code(self) -> int:
-        return {"completed": 0, "interrupted": 130}.get(self.reason, 1)
+        return {"completed": 0, "stopped": 0, "interrupted": 130}.get(self.reason, 1)
 
     @property
     def lost(self) -> dict[str, int]:
@@ -79,7 +79,10 @@ def run_plan(
     listen: Sequence[str] = (),
     connect: Sequence[str] = (),
     on_progress: Callable[[int, float], None] | None = None,
+    judge: Any = None,
 ) -> RunResult:
+    """Run a plan; with a `judge` (runner.checks.judge.Judge), feed it every message it asks for, live, and
+    stop the world early when the plan's `stop_on` says so."""
     listen = list(listen) or [f"tcp/127.0.0.1:{free_port()}"]
     conf = make_config("router", listen=listen, connect=connect)
     try:
@@ -126,6 +129,9 @@ def run_plan(
                 ready.set()
 
         subs.append(session.declare_subscriber(meta_key(plan.name, "**"), on_meta))
+        stop_early = threading.Event()
+        if judge is not None:
+            subs += _judge_subscribers(session, plan, judge, stop_early)
 
         with tempfile.NamedTemporaryFile("w", suffix=".plan.json", delete=False) as f:
             f.write(plan.model_dump_json())
@@ -144,6 +150,9 @@ def run_plan(
                     on_progress(sim_ns, time.perf_counter() - started["at"])
                 if not ready.is_set() and time.perf_counter() - wall0 > START_TIMEOUT_S:
                     raise RunError(f"the world process did not start within {START_TIMEOUT_S:.0f} s")
+                if stop_early.is_set():
+                    reason = "stopped"
+                    _stop(child)
         except KeyboardInterrupt:
             reason = "interrupted"
             _stop(child)
@@ -184,6 +193,35 @@ def run_plan(
         error=error,
         endpoints=listen,
     )
+
+
+def _judge_subscribers(session: Any, plan: RunPlan, judge: Any, stop_early: threading.Event) -> list[Any]:
+    """Decode what the judge reads and feed it; with `stop_on`, say when the run can end."""
+    from runner import msgs
+    from runner.checks.judge import contacts_key
+
+    types = {t.key: t.type for t in plan.topics()}
+    types[contacts_key(plan.name)] = "gazebo_msgs/msg/ContactsState"
+    lock = threading.Lock()
+    subs = []
+    for key in sorted(judge.keys):
+        type_name = types[key]
+
+        def on_sample(sample: zenoh.Sample, type_name: str = type_name) -> None:
+            att = sample.attachment
+            parsed = unpack_attachment(att.to_bytes()) if att is not None else None
+            if parsed is None:
+                return
+            msg = msgs.decode(sample.payload.to_bytes(), type_name)
+            with lock:
+                judge.feed(str(sample.key_expr), parsed[1], msg)
+                if (plan.stop_on == "first_failure" and judge.failed()) or (
+                    plan.stop_on == "all_decided" and judge.all_decided()
+                ):
+                    stop_early.set()
+
+        subs.append(session.declare_subscriber(key, on_sample))
+    return subs
 
 
 def _world_env(plan: RunPlan) -> dict[str, str]:

@@ -65,6 +65,10 @@ class RunPlan(BaseModel):
     timeline: list[TimelinePlan]
     record: RecordPlan
     notices: list[str] = []  # warnings from compile: tags read but not acted on
+    assertions: list[dict[str, Any]] = []  # the scenario's assertion models, as plain data
+    assertion_keys: list[str] = []  # the key each assertion reads
+    contact_watch: list[str] = []  # robot/model names whose contacts the world publishes on <run>/_contacts
+    stop_on: Literal["never", "first_failure", "all_decided"] = "never"
 
     @property
     def clock_key(self) -> str:

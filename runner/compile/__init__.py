@@ -14,6 +14,8 @@ import mujoco
 from pydantic import ValidationError
 
 from runner import msgs
+from runner.checks import assertion_keys, check_names, truth_robots
+from runner.checks.judge import TRUTH_RATE, TRUTH_TOPIC
 from runner.compile.gazebo import DescribedPlugin
 from runner.compile.packages import PackageMap
 from runner.compile.sdf import load_sdf_world
@@ -25,7 +27,7 @@ from runner.loader import Document, PathKey
 from runner.plan import PluginPlan, RecordPlan, RobotPlan, RunPlan, TimelinePlan, TopicPlan, topic_key
 from runner.plugin import BuildContext, PluginConfigError
 from runner.registry import PluginLookupError, load
-from runner.schema import Robot, Scenario, WorldModel
+from runner.schema import NoCollision, PluginEntry, Robot, Scenario, WorldModel
 from runner.validate import validate_model
 
 _GEOM = {
@@ -60,8 +62,16 @@ def compile_plan(
             )
 
     world, sdf_rate = _world_spec(sc, doc, packages, notices)
+    check_names(sc, doc, {m.name for m in sc.world.models}, bool(sc.world.sdf))
+    watched = truth_robots(sc)
     robots: list[RobotPlan] = []
     for i, robot in enumerate(sc.robots):
+        if robot.name in watched:
+            # the judge reads the robot's true pose; recorded, so `scenario check` can judge the file
+            extra = PluginEntry(
+                type="ground_truth", name="_truth", params={"topic": TRUTH_TOPIC, "rate": TRUTH_RATE}
+            )
+            robot = robot.model_copy(update={"plugins": [*robot.plugins, extra]})
         model = _robot_model(robot, i, doc, packages, notices, sc.world.physics.timestep)
         plugins = _build_plugins(sc, robot, i, model, doc)
         _add_transmissions(model, notices)
@@ -109,6 +119,10 @@ def compile_plan(
     )
     _check_key_exprs(record, doc)
 
+    published = {t.key: t.type for r in robots for p in r.plugins for t in p.topics if t.direction == "pub"}
+    published.update({f"{sc.name}/{ev.topic.strip('/')}": msgs.normalize_type(ev.type) for ev in sc.timeline})
+    keys = assertion_keys(sc, doc, published)
+    contact_watch = sorted({n for a in sc.assertions if isinstance(a, NoCollision) for n in a.between})
     rate = sc.rate
     if sdf_rate and "rate" not in sc.model_fields_set:
         rate = sdf_rate  # the world file's <real_time_factor>, unless the scenario sets `rate:`
@@ -125,6 +139,10 @@ def compile_plan(
         timeline=timeline,
         record=record,
         notices=[n.render() for n in notices],
+        assertions=[a.model_dump(mode="json") for a in sc.assertions],
+        assertion_keys=keys,
+        contact_watch=contact_watch,
+        stop_on=sc.stop_on,
     )
 
 

@@ -149,6 +149,8 @@ class World:
             (ev.t_ns, ev.key, ev.type, msgs.from_data(ev.type, ev.data)) for ev in plan.timeline
         ]
         self._timeline_i = 0
+        if plan.contact_watch:
+            self._setup_contacts(plan.contact_watch)
         for plugin in self.plugins:
             plugin.setup()
 
@@ -224,6 +226,55 @@ class World:
         if now >= clock.next_ns:
             clock.fn(now)
             clock.next_ns = _next_due(clock, now)
+
+    # ------------------------------------------------------------------------------------ contacts
+    def _setup_contacts(self, watch: list[str]) -> None:
+        """Contacts between named robots and models, for `no_collision` assertions: each geom's owner is
+        its robot's name, its model's name (the first chunk of a world body's name) or `ground`."""
+        from runner.checks.judge import CONTACTS_RATE, contacts_key
+
+        m = self.model
+        owners: list[str] = []
+        for g in range(m.ngeom):
+            body = int(m.geom_bodyid[g])
+            robot = next((r.name for r in self.robots if body in r.body_ids), None)
+            if robot is not None:
+                owners.append(robot)
+            elif body == 0:
+                owners.append((m.geom(g).name or "world").split("/")[0])
+            else:
+                owners.append((m.body(body).name or "world").split("/")[0])
+        self._owners = owners
+        self._watch = set(watch)
+        self._contacts = self._make_publisher(contacts_key(self.plan.name), "gazebo_msgs/msg/ContactsState")
+        self._after.append(_Hook(self._publish_contacts, round(1e9 / CONTACTS_RATE)))
+
+    def _publish_contacts(self, now: int) -> None:
+        d = self.data
+        pairs: set[tuple[str, str]] = set()
+        for i in range(d.ncon):
+            c = d.contact[i]
+            a, b = self._owners[c.geom1], self._owners[c.geom2]
+            if a != b and (a in self._watch or b in self._watch):
+                pairs.add((a, b) if a < b else (b, a))
+        state = msgs.T["gazebo_msgs/msg/ContactState"]
+        zero = msgs.from_data("geometry_msgs/msg/Wrench", {})
+        empty = np.zeros(0)
+        states = [
+            state(
+                info="",
+                collision1_name=a,
+                collision2_name=b,
+                wrenches=[],
+                total_wrench=zero,
+                contact_positions=[],
+                contact_normals=[],
+                depths=empty,
+            )
+            for a, b in sorted(pairs)
+        ]
+        msg = msgs.T["gazebo_msgs/msg/ContactsState"](header=msgs.header(now, "world"), states=states)
+        self.publish(self._contacts, msg, now)
 
     def _publish_clock(self, now: int) -> None:
         self.publish(self._clock, msgs.T["rosgraph_msgs/msg/Clock"](clock=msgs.time_msg(now)), now)

@@ -1,0 +1,114 @@
+"""Assertions: compile-time checks and wiring (here), the judge (`judge.py`), safe expressions (`expr.py`),
+JUnit XML (`junit.py`)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from runner.errors import Location, Problem, ScenarioError
+from runner.loader import Document, PathKey
+from runner.schema import MessageCheck, NoCollision, Scenario, TopicRate
+
+POSE_KINDS = ("reach", "stay_within", "max_speed", "max_tilt", "distance_traveled")
+
+
+def truth_robots(sc: Scenario) -> set[str]:
+    """Robots whose true pose some assertion reads."""
+    return {a.robot for a in sc.assertions if a.type in POSE_KINDS}  # type: ignore[union-attr]
+
+
+def check_names(sc: Scenario, doc: Document, model_names: set[str], has_sdf: bool) -> None:
+    robots = {r.name for r in sc.robots}
+    problems: list[Problem] = []
+    names: set[str] = set()
+    for i, a in enumerate(sc.assertions):
+        if a.name in names:
+            where: PathKey = ("assertions", i, "name")
+            problems.append(Problem(f"two assertions named {a.name!r}", doc.locate(where), where))
+        names.add(a.name)
+        if a.type in POSE_KINDS and a.robot not in robots:  # type: ignore[union-attr]
+            where = ("assertions", i, "robot")
+            problems.append(
+                Problem(
+                    f"no robot named {a.robot!r}",  # type: ignore[union-attr]
+                    doc.locate(where),
+                    where,
+                    expected="one of: " + ", ".join(sorted(robots)) if robots else "a robot of this scenario",
+                )
+            )
+        if isinstance(a, NoCollision) and not has_sdf:
+            known = robots | model_names | {"ground"}
+            for j, n in enumerate(a.between):
+                if n not in known:
+                    where = ("assertions", i, "between", j)
+                    problems.append(
+                        Problem(
+                            f"no robot or model named {n!r}",
+                            doc.locate(where),
+                            where,
+                            expected="one of: " + ", ".join(sorted(known)),
+                        )
+                    )
+    if problems:
+        raise ScenarioError(problems)
+
+
+def assertion_keys(sc: Scenario, doc: Document, topics: dict[str, str]) -> list[str]:
+    """The key each assertion reads; topics and expressions checked against the plan (`topics`: key ->
+    type of every published topic)."""
+    from runner.checks.expr import ExprError, check_fields, compile_expr
+    from runner.checks.judge import contacts_key, truth_key
+
+    ns = {r.name: r.ns for r in sc.robots}
+    keys: list[str] = []
+    problems: list[Problem] = []
+    for i, a in enumerate(sc.assertions):
+        if a.type in POSE_KINDS:
+            keys.append(truth_key(sc.name, ns[a.robot]))  # type: ignore[union-attr]
+            continue
+        if isinstance(a, NoCollision):
+            keys.append(contacts_key(sc.name))
+            continue
+        assert isinstance(a, TopicRate | MessageCheck)
+        key = f"{sc.name}/{a.topic.strip('/')}"
+        keys.append(key)
+        if key not in topics:
+            where: PathKey = ("assertions", i, "topic")
+            problems.append(
+                Problem(
+                    f"no topic {a.topic!r} is published in this scenario",
+                    doc.locate(where),
+                    where,
+                    hint="topics: " + ", ".join(sorted(k.split("/", 1)[1] for k in topics)),
+                )
+            )
+            continue
+        if isinstance(a, MessageCheck):
+            where = ("assertions", i, "expr")
+            try:
+                check_fields(compile_expr(a.expr), topics[key])
+            except ExprError as e:
+                loc = doc.locate(where)
+                problems.append(
+                    Problem(
+                        f"in `{a.expr}`"
+                        + (f" (column {e.column})" if getattr(e, "column", None) else "")
+                        + f": {e.message if hasattr(e, 'message') else e}",
+                        Location(loc.file, loc.line, loc.column),
+                        where,
+                        hint=getattr(e, "hint", None),
+                    )
+                )
+    if problems:
+        raise ScenarioError(problems)
+    return keys
+
+
+def specs_from_plan(raw: list[dict[str, Any]]) -> list[Any]:
+    """The assertion models back from a RunPlan's plain data."""
+    from pydantic import TypeAdapter
+
+    from runner.schema import Assertion
+
+    adapter: TypeAdapter[Any] = TypeAdapter(Assertion)
+    return [adapter.validate_python(a) for a in raw]

@@ -1,0 +1,347 @@
+"""The judge: one piece of code that decides the scenario's assertions from a stream of messages.
+
+It is fed live during `scenario run` (from the run's Zenoh traffic) and offline by `scenario check` (from
+the MCAP file): `feed(key, t_ns, msg)` for every message on a key it asked for, then `finish(end_ns)`.
+Each check reads one key and depends only on that key's messages in order, so both modes decide the same
+way on the same data.
+
+Data it reads: `<run>/<ns>/_truth` (the true pose and velocity of a robot's base, nav_msgs/Odometry, added
+by the compiler for robots that assertions name), `<run>/_contacts` (contacts between named bodies,
+gazebo_msgs/ContactsState, published by the world when a `no_collision` asks), and the topics that
+`topic_rate` and `message` assertions name.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from runner.schema import (
+    DistanceTraveled,
+    MaxSpeed,
+    MaxTilt,
+    MessageCheck,
+    NoCollision,
+    Reach,
+    StayWithin,
+    TopicRate,
+)
+
+TRUTH_TOPIC = "_truth"
+TRUTH_RATE = 50.0
+CONTACTS_TOPIC = "_contacts"
+CONTACTS_RATE = 100.0
+
+
+def truth_key(run: str, namespace: str) -> str:
+    return f"{run}/{namespace}/{TRUTH_TOPIC}"
+
+
+def contacts_key(run: str) -> str:
+    return f"{run}/{CONTACTS_TOPIC}"
+
+
+@dataclass
+class Result:
+    name: str
+    type: str
+    passed: bool
+    t_ns: int | None  # when it was decided (the failure's time), if it was
+    value: str  # what was measured
+    bound: str  # what it was held to
+    message: str
+
+    @property
+    def t(self) -> float | None:
+        return None if self.t_ns is None else self.t_ns / 1e9
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "name": self.name,
+            "type": self.type,
+            "passed": self.passed,
+            "t": self.t,
+            "value": self.value,
+            "bound": self.bound,
+            "message": self.message,
+        }
+
+
+@dataclass
+class _Check:
+    spec: Any
+    key: str
+    result: Result | None = None  # set once decided
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def decided(self) -> bool:
+        return self.result is not None
+
+    def decide(self, passed: bool, t_ns: int | None, value: str, bound: str, message: str) -> None:
+        if self.result is None:
+            self.result = Result(self.spec.name, self.spec.type, passed, t_ns, value, bound, message)
+
+    def in_window(self, t_ns: int) -> bool:
+        after = getattr(self.spec, "after", 0.0) or 0.0
+        until = getattr(self.spec, "until", None)
+        return t_ns >= after * 1e9 and (until is None or t_ns <= until * 1e9)
+
+    def feed(self, t_ns: int, msg: Any) -> None:  # overridden
+        raise NotImplementedError
+
+    def finish(self, end_ns: int) -> None:  # undecided at the end: most checks pass
+        self.decide(True, None, self.extra.get("value", ""), self.extra.get("bound", ""), "held")
+
+
+def _xy(msg: Any) -> tuple[float, float]:
+    p = msg.pose.pose.position
+    return float(p.x), float(p.y)
+
+
+class _Reach(_Check):
+    def feed(self, t_ns: int, msg: Any) -> None:
+        s: Reach = self.spec
+        if self.decided or (s.by is not None and t_ns > s.by * 1e9):
+            return
+        x, y = _xy(msg)
+        if s.region is not None:
+            inside = s.region.contains(x, y)
+            dist = 0.0 if inside else math.nan
+        else:
+            assert s.point is not None
+            dist = math.hypot(x - s.point[0], y - s.point[1])
+            inside = dist <= s.tolerance
+            best = self.extra.get("best")
+            if best is None or dist < best[0]:
+                self.extra["best"] = (dist, x, y, t_ns)
+        if inside:
+            self.decide(True, t_ns, f"({x:.3f}, {y:.3f})", self._bound(), f"reached at t={t_ns / 1e9:.3f} s")
+        self.extra["last"] = (x, y, t_ns)
+
+    def _bound(self) -> str:
+        s: Reach = self.spec
+        by = f" by t={s.by:g} s" if s.by is not None else ""
+        if s.region is not None:
+            return "inside the region" + by
+        return f"within {s.tolerance:g} m of ({s.point[0]:g}, {s.point[1]:g})" + by  # type: ignore[index]
+
+    def finish(self, end_ns: int) -> None:
+        s: Reach = self.spec
+        deadline = round(s.by * 1e9) if s.by is not None else end_ns
+        best = self.extra.get("best")
+        last = self.extra.get("last")
+        if best is not None:
+            value = f"closest {best[0]:.3f} m at t={best[3] / 1e9:.3f} s, at ({best[1]:.3f}, {best[2]:.3f})"
+        elif last is not None:
+            value = f"last at ({last[0]:.3f}, {last[1]:.3f})"
+        else:
+            value = "no pose received"
+        self.decide(False, min(deadline, end_ns), value, self._bound(), "not reached")
+
+
+class _StayWithin(_Check):
+    def feed(self, t_ns: int, msg: Any) -> None:
+        s: StayWithin = self.spec
+        if self.decided or not self.in_window(t_ns):
+            return
+        x, y = _xy(msg)
+        if s.region.contains(x, y) != s.inside:
+            where = "outside" if s.inside else "inside"
+            self.decide(False, t_ns, f"({x:.3f}, {y:.3f})", self._bound(), f"{where} the region")
+
+    def _bound(self) -> str:
+        return "inside the region" if self.spec.inside else "outside the region"
+
+    def finish(self, end_ns: int) -> None:
+        self.decide(True, None, "", self._bound(), "held")
+
+
+class _NoCollision(_Check):
+    def feed(self, t_ns: int, msg: Any) -> None:
+        s: NoCollision = self.spec
+        if self.decided or not self.in_window(t_ns):
+            return
+        named = set(s.between)
+        for st in msg.states:
+            a, b = st.collision1_name, st.collision2_name
+            if a == b:
+                continue
+            hit = (a in named and b in named) or (
+                s.others and (a in named or b in named) and "ground" not in (a, b)
+            )
+            if hit:
+                self.decide(False, t_ns, f"{a} touched {b}", "no contact", f"{a} touched {b}")
+                return
+
+    def finish(self, end_ns: int) -> None:
+        self.decide(True, None, "no contact", "no contact", "held")
+
+
+class _TopicRate(_Check):
+    def feed(self, t_ns: int, msg: Any) -> None:
+        if t_ns < self.spec.after * 1e9:
+            return
+        self.extra["n"] = self.extra.get("n", 0) + 1
+        self.extra.setdefault("first", t_ns)
+        self.extra["last"] = t_ns
+
+    def finish(self, end_ns: int) -> None:
+        s: TopicRate = self.spec
+        n = self.extra.get("n", 0)
+        first, last = self.extra.get("first"), self.extra.get("last")
+        rate = (n - 1) / ((last - first) / 1e9) if n >= 2 and last > first else 0.0
+        lo = s.min if s.min is not None else 0.0
+        hi = s.max if s.max is not None else math.inf
+        bound = f"{lo:g}..{hi:g} Hz" if s.max is not None else f">= {lo:g} Hz"
+        ok = lo <= rate <= hi
+        self.decide(
+            ok,
+            None if ok else end_ns,
+            f"{rate:.2f} Hz ({n} messages)",
+            bound,
+            "held" if ok else "rate out of bounds",
+        )
+
+
+class _Message(_Check):
+    def feed(self, t_ns: int, msg: Any) -> None:
+        s: MessageCheck = self.spec
+        if self.decided or not self.in_window(t_ns):
+            return
+        expr = self.extra["expr"]
+        try:
+            value = expr.test(msg)
+        except Exception as e:  # a reducer on an empty sequence, a missing field: it fails, with why
+            self.decide(False, t_ns, f"error: {e}", s.expr, f"could not evaluate `{s.expr}`")
+            return
+        self.extra["seen"] = True
+        if s.mode == "always" and not value:
+            self.decide(
+                False, t_ns, "false", f"always {s.expr}", f"`{s.expr}` was false at t={t_ns / 1e9:.3f} s"
+            )
+        elif s.mode == "never" and value:
+            self.decide(
+                False, t_ns, "true", f"never {s.expr}", f"`{s.expr}` was true at t={t_ns / 1e9:.3f} s"
+            )
+        elif s.mode == "eventually" and value:
+            self.decide(True, t_ns, "true", f"eventually {s.expr}", f"true at t={t_ns / 1e9:.3f} s")
+
+    def finish(self, end_ns: int) -> None:
+        s: MessageCheck = self.spec
+        if s.mode == "eventually":
+            self.decide(False, end_ns, "never true", f"eventually {s.expr}", f"`{s.expr}` never held")
+        elif not self.extra.get("seen"):
+            self.decide(
+                False, end_ns, "no message", f"{s.mode} {s.expr}", f"no message on {s.topic} in the window"
+            )
+        else:
+            self.decide(True, None, "held", f"{s.mode} {s.expr}", "held")
+
+
+class _MaxSpeed(_Check):
+    def feed(self, t_ns: int, msg: Any) -> None:
+        s: MaxSpeed = self.spec
+        if self.decided or not self.in_window(t_ns):
+            return
+        v = msg.twist.twist.linear
+        speed = math.hypot(float(v.x), float(v.y))
+        self.extra["peak"] = max(self.extra.get("peak", 0.0), speed)
+        if speed > s.max:
+            self.decide(False, t_ns, f"{speed:.3f} m/s", f"<= {s.max:g} m/s", "too fast")
+
+    def finish(self, end_ns: int) -> None:
+        self.decide(
+            True, None, f"peak {self.extra.get('peak', 0.0):.3f} m/s", f"<= {self.spec.max:g} m/s", "held"
+        )
+
+
+class _MaxTilt(_Check):
+    def feed(self, t_ns: int, msg: Any) -> None:
+        s: MaxTilt = self.spec
+        if self.decided or not self.in_window(t_ns):
+            return
+        q = msg.pose.pose.orientation
+        # angle between the body's z axis and the world's: cos = 1 - 2 (x² + y²)
+        c = max(-1.0, min(1.0, 1.0 - 2.0 * (float(q.x) ** 2 + float(q.y) ** 2)))
+        tilt = math.acos(c)
+        self.extra["peak"] = max(self.extra.get("peak", 0.0), tilt)
+        if tilt > s.max:
+            self.decide(False, t_ns, f"{tilt:.3f} rad", f"<= {s.max:g} rad", "tilted too far")
+
+    def finish(self, end_ns: int) -> None:
+        self.decide(
+            True, None, f"peak {self.extra.get('peak', 0.0):.3f} rad", f"<= {self.spec.max:g} rad", "held"
+        )
+
+
+class _Distance(_Check):
+    def feed(self, t_ns: int, msg: Any) -> None:
+        x, y = _xy(msg)
+        last = self.extra.get("last")
+        if last is not None:
+            self.extra["d"] = self.extra.get("d", 0.0) + math.hypot(x - last[0], y - last[1])
+        self.extra["last"] = (x, y)
+
+    def finish(self, end_ns: int) -> None:
+        s: DistanceTraveled = self.spec
+        d = self.extra.get("d", 0.0)
+        lo = s.min if s.min is not None else 0.0
+        hi = s.max if s.max is not None else math.inf
+        ok = lo <= d <= hi
+        bound = f"{lo:g}..{hi:g} m" if s.max is not None else f">= {lo:g} m"
+        self.decide(
+            ok, None if ok else end_ns, f"{d:.3f} m", bound, "held" if ok else "path length out of bounds"
+        )
+
+
+_CHECKS: dict[type, type[_Check]] = {
+    Reach: _Reach,
+    StayWithin: _StayWithin,
+    NoCollision: _NoCollision,
+    TopicRate: _TopicRate,
+    MessageCheck: _Message,
+    MaxSpeed: _MaxSpeed,
+    MaxTilt: _MaxTilt,
+    DistanceTraveled: _Distance,
+}
+
+
+class Judge:
+    """Decides assertions from messages. `specs` are the scenario's assertion models; `keys[i]` is the
+    Zenoh key the i-th one reads (from `assertion_keys`)."""
+
+    def __init__(self, specs: list[Any], keys: list[str]):
+        from runner.checks.expr import compile_expr
+
+        self.checks: list[_Check] = []
+        for spec, key in zip(specs, keys, strict=True):
+            check = _CHECKS[type(spec)](spec, key)
+            if isinstance(spec, MessageCheck):
+                check.extra["expr"] = compile_expr(spec.expr)
+            self.checks.append(check)
+        self._by_key: dict[str, list[_Check]] = {}
+        for c in self.checks:
+            self._by_key.setdefault(c.key, []).append(c)
+
+    @property
+    def keys(self) -> set[str]:
+        return set(self._by_key)
+
+    def feed(self, key: str, t_ns: int, msg: Any) -> None:
+        for c in self._by_key.get(key, ()):
+            if not c.decided or isinstance(c, _TopicRate | _Distance):
+                c.feed(t_ns, msg)
+
+    def failed(self) -> bool:
+        return any(c.result is not None and not c.result.passed for c in self.checks)
+
+    def all_decided(self) -> bool:
+        return all(c.decided for c in self.checks)
+
+    def finish(self, end_ns: int) -> list[Result]:
+        for c in self.checks:
+            if not c.decided:
+                c.finish(end_ns)
+        return [c.result for c in self.checks if c.result is not None]
