@@ -136,6 +136,10 @@ def run(
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress line and no table.")] = False,
     junit: Annotated[Path | None, typer.Option(help="Write the assertions' results as JUnit XML.")] = None,
+    no_judge: Annotated[
+        bool,
+        typer.Option("--no-judge", help="Do not judge the assertions (e.g. with a shortened --duration)."),
+    ] = False,
     results_json: Annotated[Path | None, typer.Option(help="Write the run's results as JSON.")] = None,
 ) -> None:
     """Validate, compile and run a scenario; record every message to MCAP; judge its assertions.
@@ -193,7 +197,7 @@ def run(
         err.print(f"running {plan.name} ({total:g} s sim), Zenoh on {', '.join(endpoints)}", markup=False)
     from runner.checks.report import Suite, judge_for, write_junit
 
-    judge = judge_for(plan)
+    judge = None if no_judge else judge_for(plan)
     try:
         result = run_plan(plan, listen=endpoints, connect=connect or (), on_progress=on_progress, judge=judge)
     except RunError as e:
@@ -279,6 +283,9 @@ def test_cmd(
     jobs: Annotated[int, typer.Option("--jobs", "-j", help="Scenarios run at once.", min=1)] = 1,
     junit: Annotated[Path | None, typer.Option(help="Write every result as JUnit XML.")] = None,
     out_dir: Annotated[Path, typer.Option("--out", help="Folder for the recordings.")] = Path("runs/test"),
+    no_record: Annotated[
+        bool, typer.Option("--no-record", help="Judge live only; write no recordings.")
+    ] = False,
 ) -> None:
     """Run many scenarios (in parallel processes), print a results table, write JUnit XML; exit 0 only if
     every run completes and every assertion passes.
@@ -296,23 +303,14 @@ def test_cmd(
         files += sorted(p.glob("*.yaml")) if p.is_dir() else [p]
     if not files:
         raise _fail(RunError("no scenario files found in " + ", ".join(map(str, paths))))
-    out_dir.mkdir(parents=True, exist_ok=True)
+    if not no_record:
+        out_dir.mkdir(parents=True, exist_ok=True)
 
     def run_one(f: Path) -> Suite:
         with tempfile.TemporaryDirectory() as tmp:
             res = Path(tmp) / "results.json"
-            cmd = [
-                sys.executable,
-                "-m",
-                "runner.cli",
-                "run",
-                str(f),
-                "-q",
-                "--record",
-                str(out_dir / f"{f.stem}.mcap"),
-                "--results-json",
-                str(res),
-            ]
+            cmd = [sys.executable, "-m", "runner.cli", "run", str(f), "-q", "--results-json", str(res)]
+            cmd += ["--no-record"] if no_record else ["--record", str(out_dir / f"{f.stem}.mcap")]
             proc = subprocess.run(cmd, capture_output=True, text=True)
             if res.is_file():
                 suite = Suite.from_json(json.loads(res.read_text()))

@@ -27,7 +27,14 @@ def test_two_runs_with_one_seed_give_identical_bytes(tmp_path: Path):
     for i in range(2):
         mcap = tmp_path / f"run{i}.mcap"
         proc = run_cli(
-            "run", str(SCENARIOS / "two_robots.yaml"), "--duration", "6", "--record", str(mcap), "-q"
+            "run",
+            str(SCENARIOS / "two_robots.yaml"),
+            "--duration",
+            "6",
+            "--record",
+            str(mcap),
+            "-q",
+            "--no-judge",
         )
         assert proc.returncode == 0, proc.stderr
         runs.append(_payloads(mcap))
@@ -45,8 +52,12 @@ def test_another_seed_gives_other_noise(write_scenario, tmp_path: Path):
         text.replace("robots/diffbot.urdf.xacro", str(other.parent / "robots" / "diffbot.urdf.xacro"))
     )
     m1, m2 = tmp_path / "a.mcap", tmp_path / "b.mcap"
-    assert run_cli("run", str(other), "--duration", "1", "--record", str(m1), "-q").returncode == 0
-    assert run_cli("run", str(path), "--duration", "1", "--record", str(m2), "-q").returncode == 0
+    assert (
+        run_cli("run", str(other), "--duration", "1", "--record", str(m1), "-q", "--no-judge").returncode == 0
+    )
+    assert (
+        run_cli("run", str(path), "--duration", "1", "--record", str(m2), "-q", "--no-judge").returncode == 0
+    )
     a, b = _payloads(m1), _payloads(m2)
     assert a["two_robots/r1/scan"] != b["two_robots/r1/scan"]
     assert a["two_robots/r1/odom"] == b["two_robots/r1/odom"]  # physics itself has no noise

@@ -1,0 +1,56 @@
+"""`scenario test` over every example, JUnit XML in the common shape; the pytest plugin."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import REPO, SCENARIOS, run_cli
+
+
+@pytest.mark.timeout(400)
+def test_all_examples_pass_their_assertions_with_junit(tmp_path: Path):
+    junit = tmp_path / "out.xml"
+    proc = run_cli("test", str(SCENARIOS), "-j", "2", "--no-record", "--junit", str(junit), timeout=380)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    root = ET.parse(junit).getroot()
+    assert root.tag == "testsuites"
+    suites = root.findall("testsuite")
+    assert {s.get("name") for s in suites} == {p.stem for p in SCENARIOS.glob("*.yaml")}
+    for s in suites:
+        cases = s.findall("testcase")
+        assert cases and int(s.get("tests", "0")) == len(cases)  # every example carries assertions
+        assert all(c.get("classname") == s.get("name") and c.get("name") for c in cases)
+        assert s.find("testcase/failure") is None and s.get("failures") == "0"
+
+
+@pytest.mark.timeout(120)
+def test_a_tightened_bound_fails_the_run_and_names_it(tmp_path: Path):
+    text = (SCENARIOS / "two_robots.yaml").read_text().replace("min: 2.7, max: 3.3", "min: 2.7, max: 2.9")
+    text = text.replace("robots/diffbot.urdf.xacro", str(SCENARIOS / "robots" / "diffbot.urdf.xacro"))
+    path = tmp_path / "tightened.yaml"
+    path.write_text(text)
+    junit = tmp_path / "j.xml"
+    proc = run_cli("test", str(path), "--no-record", "--junit", str(junit))
+    assert proc.returncode == 1
+    failure = ET.parse(junit).getroot().find(".//testcase[@name='r1_drives_about_3_m']/failure")
+    assert failure is not None
+    message = failure.get("message", "")
+    assert "r1_drives_about_3_m" in message and "t=20.000 s" in message and "2.999 m" in message
+
+
+@pytest.mark.timeout(120)
+def test_pytest_collects_scenarios_with_assertions():
+    proc = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(SCENARIOS / "two_robots.yaml")],
+        capture_output=True,
+        text=True,
+        timeout=110,
+        cwd=REPO,
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "9 passed" in proc.stdout
