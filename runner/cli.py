@@ -214,6 +214,8 @@ def run(
     if result.error:
         err.print("error: " + result.error, markup=False, style="red")
     suite = Suite(plan.name, results, result.error, result.wall_s, str(result.mcap) if result.mcap else None)
+    if results and not suite.passed and result.mcap is not None:
+        _plot(plan, result.mcap, results)
     if junit is not None:
         write_junit(junit, [suite])
     if results_json is not None:
@@ -222,6 +224,19 @@ def run(
     if code == 0 and not suite.passed:
         code = 1
     raise typer.Exit(code)
+
+
+def _plot(plan: Any, mcap: Path, results: list[Any]) -> None:
+    """A failed assertion: the robots' paths, regions and the failure point, as a PNG beside the MCAP."""
+    from runner.checks.plot import trajectory_plot
+
+    try:
+        png = trajectory_plot(plan, mcap, results, mcap.with_suffix(".trajectory.png"))
+    except Exception as e:  # a picture must never hide the verdict
+        err.print(f"warning: no trajectory plot ({type(e).__name__}: {e})", markup=False)
+        return
+    if png is not None:
+        out.print(f"trajectory plot: {png}", markup=False)
 
 
 def _print_results(results: list[Any]) -> None:
@@ -272,6 +287,8 @@ def check(
         raise _fail(RunError(f"{mcap}: cannot judge it: {type(e).__name__}: {e}")) from None
     _print_results(results)
     suite = Suite(plan.name, results, mcap=str(mcap))
+    if not suite.passed:
+        _plot(plan, mcap, results)
     if junit is not None:
         write_junit(junit, [suite])
     raise typer.Exit(0 if suite.passed else 1)

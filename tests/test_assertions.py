@@ -6,6 +6,7 @@ import json
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from runner import msgs
@@ -180,3 +181,38 @@ def test_live_and_offline_judgements_agree_and_junit_names_the_failure(write_sce
         assert r["passed"] == name.startswith("ok_"), (name, r)
     reach = verdicts(on)["reach"]
     assert reach is not None and "reach" in reach and "t=" in reach and "closest" in reach
+    # a failed run leaves a trajectory plot beside its recording
+    png = mcap.with_suffix(".trajectory.png")
+    assert png.is_file() and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    import zlib
+
+    data = png.read_bytes()
+    idat = data.index(b"IDAT")
+    size = int.from_bytes(data[idat - 4 : idat], "big")
+    raw = np.frombuffer(zlib.decompress(data[idat + 4 : idat + 4 + size]), dtype=np.uint8).reshape(
+        640, 1 + 640 * 3
+    )
+    rgb = raw[:, 1:].reshape(640, 640, 3).astype(int)
+    red = (rgb[..., 0] > 200) & (rgb[..., 1] < 60) & (rgb[..., 2] < 60)
+    blue = (rgb[..., 2] > 150) & (rgb[..., 0] < 60)
+    assert red.sum() > 20 and blue.sum() > 50  # the failure marks and r1's path are drawn
+
+
+@pytest.mark.timeout(120)
+def test_stop_on_first_failure_ends_the_run_early(write_scenario, tmp_path: Path):
+    text = (
+        BASE.format(
+            assertions="  - {name: slow, type: max_speed, robot: r1, max: 0.3}\n"
+            "  - {name: stays, type: stay_within, robot: r2, region: {center: [0, 2], radius: 0.1}}"
+        ).replace("duration: 6.0", "duration: 60.0")
+        + "stop_on: first_failure\n"
+    )
+    path = write_scenario(text)
+    res = tmp_path / "r.json"
+    proc = run_cli("run", str(path), "--no-record", "--results-json", str(res))
+    assert proc.returncode == 1, proc.stderr
+    assert "stopped:" in proc.stdout  # ended by the judge, not by the duration
+    sim = float(proc.stdout.split("stopped: ")[1].split(" s sim")[0])
+    assert sim < 10.0  # r1 exceeds 0.3 m/s within a second; the run ends soon after, not at 60 s
+    results = {r["name"]: r for r in json.loads(res.read_text())["results"]}
+    assert not results["slow"]["passed"] and results["slow"]["t"] < 2.0
