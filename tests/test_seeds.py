@@ -50,6 +50,21 @@ IGNORABLE = (
 )
 
 
+def _shrunk_plan(name: str) -> Any:
+    """The example's plan with its cameras at 48x36 (their rates unchanged)."""
+    doc = load_file(SCENARIOS / f"{name}.yaml")
+    scenario = validate_scenario(doc)
+    plan = compile_plan(scenario, doc)
+    for robot_plan, robot in zip(plan.robots, scenario.robots, strict=True):
+        extra = [
+            PluginEntry(type=p.type, name=p.name, params={"width": 48, "height": 36})
+            for p in robot_plan.plugins
+            if p.type in CAMERAS
+        ]
+        robot.plugins = [*robot.plugins, *extra]
+    return compile_plan(scenario, doc)
+
+
 def _run(name: str) -> tuple[Scenario, Any, MemoryBus, Notices]:
     doc = load_file(SCENARIOS / f"{name}.yaml")
     scenario = validate_scenario(doc)
