@@ -71,9 +71,12 @@ def validate(
     Example: scenario validate scenarios/two_robots.yaml
     """
     try:
-        _scenario, plan = _load(file)
+        plans = _load_variants(file, None, None)
     except ScenarioError as e:
         raise _fail(e) from None
+    plan = plans[0][1]
+    if len(plans) > 1:
+        out.print(f"{len(plans)} variants: " + "; ".join(label for label, _ in plans), markup=False)
     if as_json:
         out.print_json(plan.model_dump_json(exclude={"mjcf"}))
         return
@@ -141,29 +144,78 @@ def run(
         typer.Option("--no-judge", help="Do not judge the assertions (e.g. with a shortened --duration)."),
     ] = False,
     results_json: Annotated[Path | None, typer.Option(help="Write the run's results as JSON.")] = None,
+    variant: Annotated[
+        int | None, typer.Option(help="Run only this variant of the scenario's matrix (0-based).", min=0)
+    ] = None,
 ) -> None:
-    """Validate, compile and run a scenario; record every message to MCAP; judge its assertions.
+    """Validate, compile and run a scenario; record every message to MCAP; judge its assertions. With a
+    `matrix:`, every variant runs and is judged on its own.
 
     Examples:
       scenario run scenarios/two_robots.yaml
       scenario run scenarios/two_robots.yaml --rate realtime --listen tcp/127.0.0.1:7447
     """
-    from runner.launch import run_plan
-
     parsed_rate = _parse_rate(rate)
     try:
-        _scenario, plan = _load(file, record)
+        plans = _load_variants(file, record, variant)
     except ScenarioError as e:
         raise _fail(e) from None
-    if duration is not None:
-        plan.duration_ns = round(duration * 1e9)
-    if parsed_rate is not None:
-        plan.rate = parsed_rate
-    if no_record:
-        plan.record.enabled = False
-
     # SIGTERM ends the run like Ctrl-C: in order, with the recording finished.
     signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(KeyboardInterrupt()))
+    suites = []
+    code = 0
+    for i, (label, plan) in enumerate(plans):
+        if duration is not None:
+            plan.duration_ns = round(duration * 1e9)
+        if parsed_rate is not None:
+            plan.rate = parsed_rate
+        if no_record:
+            plan.record.enabled = False
+        elif len(plans) > 1:
+            path = Path(plan.record.path)
+            plan.record.path = str(path.with_name(f"{path.stem}-{i}{path.suffix}"))
+        if label and not quiet:
+            err.print(f"variant {i}: {label}", markup=False)
+        suite, rc = _run_one(plan, label, quiet, listen, connect, no_judge)
+        suites.append(suite)
+        code = max(code, rc)
+        if rc == 130:
+            break
+    if junit is not None:
+        from runner.checks.report import write_junit
+
+        write_junit(junit, suites)
+    if results_json is not None:
+        data = suites[0].to_json() if len(suites) == 1 else {"variants": [s.to_json() for s in suites]}
+        results_json.write_text(json.dumps(data, indent=2))
+    raise typer.Exit(code)
+
+
+def _load_variants(file: Path, record: str | None, variant: int | None) -> list[tuple[str, Any]]:
+    """[(label, plan)] of the scenario's matrix variants (one, unlabelled, without a matrix)."""
+    from runner.compile import compile_plan
+    from runner.loader import load_file
+    from runner.matrix import variants
+    from runner.validate import validate_scenario
+
+    found = variants(load_file(file))
+    if variant is not None:
+        if not 0 <= variant < len(found):
+            raise typer.BadParameter(f"the scenario has {len(found)} variant(s): 0..{len(found) - 1}")
+        found = [found[variant]]
+    out = []
+    for label, doc in found:
+        sc = validate_scenario(doc)
+        out.append((label, compile_plan(sc, doc, record_path=record)))
+    return out
+
+
+def _run_one(
+    plan: Any, label: str, quiet: bool, listen: list[str] | None, connect: list[str] | None, no_judge: bool
+) -> tuple[Any, int]:
+    from runner.checks.report import Suite, judge_for
+    from runner.launch import run_plan
+    from runner.transport import free_port
 
     total = plan.duration_ns / 1e9
     progress = None
@@ -187,16 +239,11 @@ def run(
             sim = sim_ns / 1e9
             progress.update(task, completed=sim, sim=sim, rtf=sim / wall_s if wall_s > 0 else 0.0)
 
-    from runner.transport import free_port
-
     if not quiet:
         _print_notices(plan.notices, verbose=False)
-
     endpoints = list(listen or []) or [f"tcp/127.0.0.1:{free_port()}"]
     if not quiet:
         err.print(f"running {plan.name} ({total:g} s sim), Zenoh on {', '.join(endpoints)}", markup=False)
-    from runner.checks.report import Suite, judge_for, write_junit
-
     judge = None if no_judge else judge_for(plan)
     try:
         result = run_plan(plan, listen=endpoints, connect=connect or (), on_progress=on_progress, judge=judge)
@@ -213,17 +260,14 @@ def run(
         _print_results(results)
     if result.error:
         err.print("error: " + result.error, markup=False, style="red")
-    suite = Suite(plan.name, results, result.error, result.wall_s, str(result.mcap) if result.mcap else None)
+    name = f"{plan.name}[{label}]" if label else plan.name
+    suite = Suite(name, results, result.error, result.wall_s, str(result.mcap) if result.mcap else None)
     if results and not suite.passed and result.mcap is not None:
         _plot(plan, result.mcap, results)
-    if junit is not None:
-        write_junit(junit, [suite])
-    if results_json is not None:
-        results_json.write_text(json.dumps(suite.to_json(), indent=2))
     code = result.exit_code
     if code == 0 and not suite.passed:
         code = 1
-    raise typer.Exit(code)
+    return suite, code
 
 
 def _plot(plan: Any, mcap: Path, results: list[Any]) -> None:
@@ -323,21 +367,37 @@ def test_cmd(
     if not no_record:
         out_dir.mkdir(parents=True, exist_ok=True)
 
-    def run_one(f: Path) -> Suite:
+    from runner.loader import load_file
+    from runner.matrix import variants
+
+    tasks: list[tuple[Path, int | None, str]] = []
+    for f in files:
+        try:
+            labels = [label for label, _ in variants(load_file(f))]
+        except ScenarioError:
+            labels = [""]  # the run itself reports the error
+        tasks += [(f, i if len(labels) > 1 else None, label) for i, label in enumerate(labels)]
+
+    def run_one(task: tuple[Path, int | None, str]) -> Suite:
+        f, index, label = task
+        name = f"{f.stem}[{label}]" if label else f.stem
         with tempfile.TemporaryDirectory() as tmp:
             res = Path(tmp) / "results.json"
             cmd = [sys.executable, "-m", "runner.cli", "run", str(f), "-q", "--results-json", str(res)]
-            cmd += ["--no-record"] if no_record else ["--record", str(out_dir / f"{f.stem}.mcap")]
+            stem = f.stem if index is None else f"{f.stem}-{index}"
+            cmd += ["--no-record"] if no_record else ["--record", str(out_dir / f"{stem}.mcap")]
+            if index is not None:
+                cmd += ["--variant", str(index)]
             proc = subprocess.run(cmd, capture_output=True, text=True)
             if res.is_file():
                 suite = Suite.from_json(json.loads(res.read_text()))
-                suite.name = f.stem
+                suite.name = name
                 return suite
             why = (proc.stderr.strip() or proc.stdout.strip() or f"exit {proc.returncode}").splitlines()
-            return Suite(f.stem, error="\n".join(why[-12:]))
+            return Suite(name, error="\n".join(why[-12:]))
 
     with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
-        suites = list(pool.map(run_one, files))
+        suites = list(pool.map(run_one, tasks))
     table = Table(
         "scenario",
         "assertions",

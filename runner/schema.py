@@ -356,6 +356,11 @@ class Scenario(Strict):
     assertions: list[Assertion] = Field(
         default_factory=list, description="Checks judged live during the run and from the recording."
     )
+    matrix: dict[str, list[Any]] = Field(
+        default_factory=dict,
+        description="Parameter variants: paths into this scenario (`seed`, `robots[0].pose.xyz`, "
+        "`timeline[0].data.linear.x`) mapped to lists of values; each combination is run and judged apart.",
+    )
     stop_on: Literal["never", "first_failure", "all_decided"] = Field(
         "never", description="End the run early when an assertion fails, or when every one is decided."
     )

@@ -245,3 +245,38 @@ def test_live_and_recorded_judgements_agree_on_every_example(example: str, tmp_p
     off, _ = judge_recording(plan, tmp_path / "x.mcap")
     assert [r.to_json() for r in on] == [r.to_json() for r in off]
     assert all(r.passed for r in on), [r for r in on if not r.passed]
+
+
+MATRIX = (
+    BASE.format(assertions="  - {name: not_too_fast, type: max_speed, robot: r1, max: 0.45}").replace(
+        "duration: 6.0", "duration: 2.0"
+    )
+    + """matrix:
+  seed: [1, 2]
+  timeline[0].data.linear.x: [0.3, 0.6]
+"""
+)
+
+
+@pytest.mark.timeout(200)
+def test_matrix_variants_are_run_and_reported_apart(write_scenario, tmp_path: Path):
+    path = write_scenario(MATRIX)
+    proc = run_cli("validate", str(path))
+    assert proc.returncode == 0 and "4 variants" in proc.stdout, proc.stdout + proc.stderr
+    junit = tmp_path / "m.xml"
+    proc = run_cli("test", str(path), "-j", "2", "--no-record", "--junit", str(junit), timeout=180)
+    assert proc.returncode == 1  # the fast variants break the speed bound
+    suites = {s.get("name"): s for s in ET.parse(junit).getroot().findall("testsuite")}
+    assert set(suites) == {
+        f"scenario[seed={seed},timeline[0].data.linear.x={v}]" for seed in (1, 2) for v in (0.3, 0.6)
+    }
+    for name, s in suites.items():
+        failed = s.find("testcase/failure") is not None
+        assert failed == name.endswith("=0.6]"), name
+
+
+def test_a_bad_matrix_path_is_a_clear_error(write_scenario):
+    path = write_scenario(MATRIX.replace("timeline[0].data.linear.x", "timeline[5].data.linear.x"))
+    proc = run_cli("validate", str(path))
+    assert proc.returncode == 1 and "Traceback" not in proc.stderr
+    assert "matrix.timeline[5].data.linear.x" in proc.stderr and "does not lead to a value" in proc.stderr

@@ -1,0 +1,120 @@
+"""`matrix:` parameter variants: one scenario file, several runs.
+
+```yaml
+matrix:
+  seed: [1, 2]
+  robots[0].pose.xyz: [[0, 0, 0.06], [1, 0, 0.06]]
+  timeline[0].data.linear.x: [0.2, 0.4]
+```
+expands into the cartesian product (here 8 variants); each key is a path into the scenario, each value
+replaces what is there (missing mappings on the way are created). Every variant is validated, run and judged
+on its own, and reported as `<name>[seed=1,robots[0].pose.xyz=[0, 0, 0.06],...]`.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import re
+from typing import Any
+
+from runner.errors import Problem, ScenarioError
+from runner.loader import Document
+
+_PART = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(-?\d+)\]")
+
+
+def parse_path(text: str) -> tuple[str | int, ...] | None:
+    """`robots[0].pose.xyz` -> ("robots", 0, "pose", "xyz"); None if it is not such a path."""
+    out: list[str | int] = []
+    for chunk in text.split("."):
+        parts = list(_PART.finditer(chunk))
+        if not chunk or "".join(m.group(0) for m in parts) != chunk or parts[0].group(1) is None:
+            return None
+        out += [m.group(1) if m.group(1) is not None else int(m.group(2)) for m in parts]
+    return tuple(out) if out else None
+
+
+def _set(data: Any, path: tuple[str | int, ...], value: Any) -> bool:
+    cur = data
+    for i, el in enumerate(path):
+        last = i == len(path) - 1
+        if isinstance(el, int):
+            if not isinstance(cur, list) or not -len(cur) <= el < len(cur):
+                return False
+            if last:
+                cur[el] = value
+                return True
+            cur = cur[el]
+        else:
+            if not isinstance(cur, dict):
+                return False
+            if last:
+                cur[el] = value
+                return True
+            if el not in cur or cur[el] is None:
+                cur[el] = {}
+            cur = cur[el]
+    return False
+
+
+def _label(value: Any) -> str:
+    text = str(value).replace("'", "")
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def variants(doc: Document) -> list[tuple[str, Document]]:
+    """[(label, document)] for every combination; [("", doc)] without a matrix."""
+    data = doc.data
+    if not isinstance(data, dict) or not data.get("matrix"):
+        return [("", doc)]
+    matrix = data["matrix"]
+    problems: list[Problem] = []
+    if not isinstance(matrix, dict):
+        raise ScenarioError(
+            Problem(
+                "`matrix` must map paths to lists of values",
+                doc.locate(("matrix",)),
+                ("matrix",),
+                hint="e.g. `matrix: {seed: [1, 2]}`",
+            )
+        )
+    paths: list[tuple[str, tuple[str | int, ...]]] = []
+    for key, values in matrix.items():
+        where = ("matrix", key)
+        path = parse_path(str(key))
+        if path is None or path[0] in ("matrix", "name"):
+            problems.append(
+                Problem(
+                    f"{key!r} is not a path into the scenario",
+                    doc.locate(where),
+                    where,
+                    hint="paths look like `seed`, `robots[0].pose.xyz`, `timeline[1].data.linear.x`",
+                )
+            )
+        elif not isinstance(values, list) or not values:
+            problems.append(
+                Problem("expected a non-empty list of values", doc.locate(where), where, found=repr(values))
+            )
+        else:
+            paths.append((str(key), path))
+    if problems:
+        raise ScenarioError(problems)
+    out: list[tuple[str, Document]] = []
+    for combo in itertools.product(*[matrix[k] for k, _ in paths]):
+        variant = copy.deepcopy(data)
+        del variant["matrix"]
+        for (key, path), value in zip(paths, combo, strict=True):
+            if not _set(variant, path, copy.deepcopy(value)):
+                where = ("matrix", key)
+                raise ScenarioError(
+                    Problem(
+                        f"{key!r} does not lead to a value in this scenario",
+                        doc.locate(where),
+                        where,
+                        hint="list indices must exist (robots[0] needs a first robot)",
+                    )
+                )
+        label = ",".join(f"{key}={_label(v)}" for (key, _), v in zip(paths, combo, strict=True))
+        out.append((label, Document(variant, doc.file, doc.positions)))
+    return out
