@@ -51,16 +51,6 @@ def _parse_rate(value: str | None) -> str | float | None:
     return f
 
 
-def _load(file: Path, record: str | None = None) -> Any:
-    from runner.compile import compile_plan
-    from runner.loader import load_file
-    from runner.validate import validate_scenario
-
-    doc = load_file(file)
-    scenario = validate_scenario(doc)
-    return scenario, compile_plan(scenario, doc, record_path=record)
-
-
 @app.command()
 def validate(
     file: Annotated[Path, typer.Argument(help="Scenario YAML file.")],
@@ -310,6 +300,9 @@ def check(
         Path, typer.Option("--scenario", "-s", help="The scenario whose assertions to judge.")
     ],
     junit: Annotated[Path | None, typer.Option(help="Write the results as JUnit XML.")] = None,
+    variant: Annotated[
+        int | None, typer.Option(help="The matrix variant the recording is of (0-based).", min=0)
+    ] = None,
 ) -> None:
     """Judge a recording with a scenario's assertions (the same judge as the live run).
 
@@ -318,9 +311,12 @@ def check(
     from runner.checks.report import Suite, judge_recording, write_junit
 
     try:
-        _scenario, plan = _load(scenario)
+        plans = _load_variants(scenario, None, variant)
     except ScenarioError as e:
         raise _fail(e) from None
+    if len(plans) > 1:
+        raise _fail(RunError(f"{scenario} has {len(plans)} variants: say which one with --variant"))
+    plan = plans[0][1]
     if not plan.assertions:
         raise _fail(RunError(f"{scenario} has no assertions to judge"))
     if not mcap.is_file():

@@ -198,10 +198,9 @@ def run_plan(
 def _judge_subscribers(session: Any, plan: RunPlan, judge: Any, stop_early: threading.Event) -> list[Any]:
     """Decode what the judge reads and feed it; with `stop_on`, say when the run can end."""
     from runner import msgs
-    from runner.checks.judge import contacts_key
+    from runner.checks.judge import judged_types
 
-    types = {t.key: t.type for t in plan.topics()}
-    types[contacts_key(plan.name)] = "gazebo_msgs/msg/ContactsState"
+    types = judged_types(plan)
     lock = threading.Lock()
     subs = []
     for key in sorted(judge.keys):

@@ -280,3 +280,16 @@ def test_a_bad_matrix_path_is_a_clear_error(write_scenario):
     proc = run_cli("validate", str(path))
     assert proc.returncode == 1 and "Traceback" not in proc.stderr
     assert "matrix.timeline[5].data.linear.x" in proc.stderr and "does not lead to a value" in proc.stderr
+
+
+@pytest.mark.timeout(120)
+def test_check_judges_one_variant_of_a_matrix(write_scenario, tmp_path: Path):
+    path = write_scenario(MATRIX)
+    mcap = tmp_path / "v.mcap"
+    proc = run_cli("run", str(path), "--variant", "3", "--record", str(mcap), "-q")
+    assert proc.returncode == 1  # variant 3 drives at 0.6 m/s
+    unnamed = run_cli("check", str(mcap), "--scenario", str(path))
+    assert unnamed.returncode == 1
+    assert "4 variants" in unnamed.stderr and "--variant" in unnamed.stderr
+    proc = run_cli("check", str(mcap), "--scenario", str(path), "--variant", "3")
+    assert proc.returncode == 1 and "not_too_fast" in proc.stdout and "FAIL" in proc.stdout

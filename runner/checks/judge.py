@@ -42,6 +42,13 @@ def contacts_key(run: str) -> str:
     return f"{run}/{CONTACTS_TOPIC}"
 
 
+def judged_types(plan: Any) -> dict[str, str]:
+    """The ROS type of every key a judge of `plan` may read (the plan's topics and the world's contacts)."""
+    types = {t.key: t.type for t in plan.topics()}
+    types[contacts_key(plan.name)] = "gazebo_msgs/msg/ContactsState"
+    return types
+
+
 @dataclass
 class Result:
     name: str
@@ -331,7 +338,7 @@ class Judge:
 
     def feed(self, key: str, t_ns: int, msg: Any) -> None:
         for c in self._by_key.get(key, ()):
-            if not c.decided or isinstance(c, _TopicRate | _Distance):
+            if not c.decided:  # topic_rate and distance_traveled are decided only by finish()
                 c.feed(t_ns, msg)
 
     def failed(self) -> bool:

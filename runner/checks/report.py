@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from runner.checks.judge import Judge, Result, contacts_key
+from runner.checks.judge import Judge, Result, judged_types
 
 
 def judge_for(plan: Any) -> Judge | None:
@@ -28,8 +28,7 @@ def judge_recording(plan: Any, mcap: Path) -> tuple[list[Result], int]:
     judge = judge_for(plan)
     if judge is None:
         return [], 0
-    types = {t.key: t.type for t in plan.topics()}
-    types[contacts_key(plan.name)] = "gazebo_msgs/msg/ContactsState"
+    types = judged_types(plan)
     end_ns = 0
     with open(mcap, "rb") as f:
         reader = make_reader(f)

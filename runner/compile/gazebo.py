@@ -454,14 +454,7 @@ class GazeboReader:
             out["height"] = int(float(h))
         fmt = (cam.findtext("image/format") or "").strip()
         if fmt:
-            mapped = {
-                "R8G8B8": "rgb8",
-                "RGB_INT8": "rgb8",
-                "B8G8R8": "bgr8",
-                "BGR_INT8": "bgr8",
-                "L8": "mono8",
-                "L_INT8": "mono8",
-            }.get(fmt.upper())
+            mapped = _FORMATS.get(fmt.upper())
             if mapped:
                 out["format"] = mapped
             else:

@@ -246,6 +246,12 @@ class World:
                 owners.append((m.body(body).name or "world").split("/")[0])
         self._owners = owners
         self._watch = set(watch)
+        # built once: every contact state shares them
+        self._contact_parts = (
+            msgs.T["gazebo_msgs/msg/ContactState"],
+            msgs.from_data("geometry_msgs/msg/Wrench", {}),
+            np.zeros(0),
+        )
         self._contacts = self._make_publisher(contacts_key(self.plan.name), "gazebo_msgs/msg/ContactsState")
         self._after.append(_Hook(self._publish_contacts, round(1e9 / CONTACTS_RATE)))
 
@@ -257,9 +263,7 @@ class World:
             a, b = self._owners[c.geom1], self._owners[c.geom2]
             if a != b and (a in self._watch or b in self._watch):
                 pairs.add((a, b) if a < b else (b, a))
-        state = msgs.T["gazebo_msgs/msg/ContactState"]
-        zero = msgs.from_data("geometry_msgs/msg/Wrench", {})
-        empty = np.zeros(0)
+        state, zero, empty = self._contact_parts
         states = [
             state(
                 info="",
