@@ -11,7 +11,7 @@ from pydantic import Field
 
 from runner import msgs
 from runner.geometry import rpy_to_quat
-from runner.plugin import BuildContext, PluginConfigError, PluginParams, RatedParams, Topic
+from runner.plugin import BuildContext, PluginConfigError, PluginParams, Publisher, RatedParams, Topic
 
 
 class MountPose(PluginParams):
@@ -101,3 +101,68 @@ def drive_topics(params: BaseDriveParams) -> list[Topic]:
     if params.publish_tf:
         topics.append(Topic(params.tf_topic, "tf2_msgs/msg/TFMessage", "pub", params.rate))
     return topics
+
+
+class OdometryWriter:
+    """Publishes nav_msgs/Odometry with fixed frames (and zero covariances), written in place into a
+    fixed layout: a few microseconds a message instead of building message objects."""
+
+    def __init__(self, pub: Publisher, frame_id: str, child: str):
+        self.pub = pub
+        zero = (0.0, 0.0, 0.0)
+        self.layout = pub.layout(
+            odometry(0, frame_id, child, zero, (1.0, 0.0, 0.0, 0.0), zero, zero), ["header.stamp"]
+        )
+        self.pose = self.layout.view("pose.pose")  # position xyz, orientation xyzw
+        self.twist = self.layout.view("twist.twist")  # linear xyz, angular xyz
+
+    def publish(
+        self,
+        now_ns: int,
+        pos: Sequence[float],
+        quat_wxyz: Sequence[float],
+        lin: Sequence[float],
+        ang: Sequence[float],
+    ) -> None:
+        pose, twist = self.pose, self.twist
+        pose[0:3] = pos
+        pose[3:6] = quat_wxyz[1:4]
+        pose[6] = quat_wxyz[0]
+        twist[0:3] = lin
+        twist[3:6] = ang
+        self.pub.publish_cdr(self.layout.encode(now_ns), now_ns)
+
+
+def tf_message(now_ns: int, parent: str, child: str, pos: Sequence[float], quat_wxyz: Sequence[float]) -> Any:
+    """A tf2_msgs/TFMessage holding one transform parent -> child."""
+    T = msgs.T
+    tf = T["geometry_msgs/msg/TransformStamped"](
+        header=msgs.header(now_ns, parent),
+        child_frame_id=child,
+        transform=T["geometry_msgs/msg/Transform"](
+            translation=T["geometry_msgs/msg/Vector3"](x=float(pos[0]), y=float(pos[1]), z=float(pos[2])),
+            rotation=T["geometry_msgs/msg/Quaternion"](
+                x=float(quat_wxyz[1]), y=float(quat_wxyz[2]), z=float(quat_wxyz[3]), w=float(quat_wxyz[0])
+            ),
+        ),
+    )
+    return T["tf2_msgs/msg/TFMessage"](transforms=[tf])
+
+
+class TransformWriter:
+    """Publishes a tf2_msgs/TFMessage of one transform parent -> child, written in place."""
+
+    def __init__(self, pub: Publisher, parent: str, child: str):
+        self.pub = pub
+        self.layout = pub.layout(
+            tf_message(0, parent, child, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)),
+            ["transforms[0].header.stamp"],
+        )
+        self.transform = self.layout.view("transforms[0].transform")  # translation xyz, rotation xyzw
+
+    def publish(self, now_ns: int, pos: Sequence[float], quat_wxyz: Sequence[float]) -> None:
+        tf = self.transform
+        tf[0:3] = pos
+        tf[3:6] = quat_wxyz[1:4]
+        tf[6] = quat_wxyz[0]
+        self.pub.publish_cdr(self.layout.encode(now_ns), now_ns)

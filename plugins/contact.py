@@ -47,6 +47,7 @@ def _collides(m: Any, g: int) -> bool:
 
 
 class Contact(Plugin):
+    needs_forward = True  # contact forces come from the constraint solver
     Params = ContactParams
     params: ContactParams
 

@@ -20,8 +20,7 @@ import mujoco
 import numpy as np
 from pydantic import Field, PositiveFloat
 
-from plugins._common import BaseDriveParams, drive_topics, odometry
-from runner import msgs
+from plugins._common import BaseDriveParams, OdometryWriter, TransformWriter, drive_topics
 from runner.geometry import quat_to_yaw, yaw_to_quat
 from runner.plugin import BuildContext, Plugin, PluginConfigError, Topic
 
@@ -149,40 +148,56 @@ class WheelDrive(Plugin):
         self._vel = np.zeros(6)
         # encoder odometry state
         self.x = self.y = self.yaw = 0.0
+        n = len(joints)
+        self._means = np.zeros((2, n))  # row 0 averages the left wheels, row 1 the right
+        self._means[0, : self.nleft] = 1.0 / self.nleft
+        self._means[1, self.nleft :] = 1.0 / (n - self.nleft)
         self.last_q = self._side_means(d.qpos[self.qadr])
+        self.settled = True
+        self.qpos, self.qvel, self.actuator_ctrl = d.qpos, d.qvel, d.ctrl  # views, looked up once
         self.ctx.subscribe(p.cmd_topic, "geometry_msgs/msg/Twist", self._on_cmd)
-        self.odom_pub = self.ctx.publisher(p.odom_topic, "nav_msgs/msg/Odometry") if p.publish_odom else None
-        self.tf_pub = self.ctx.publisher(p.tf_topic, "tf2_msgs/msg/TFMessage") if p.publish_tf else None
+        odom_pub = self.ctx.publisher(p.odom_topic, "nav_msgs/msg/Odometry") if p.publish_odom else None
+        tf_pub = self.ctx.publisher(p.tf_topic, "tf2_msgs/msg/TFMessage") if p.publish_tf else None
+        self.odom_out = OdometryWriter(odom_pub, self.odom_frame, self.base_frame) if odom_pub else None
+        self.tf_out = TransformWriter(tf_pub, self.odom_frame, self.base_frame) if tf_pub else None
 
     def _side_means(self, values: np.ndarray) -> np.ndarray:
-        return np.array([values[: self.nleft].mean(), values[self.nleft :].mean()])
+        return self._means @ values
 
     def _on_cmd(self, msg: Any, stamp_ns: int) -> None:
         self.cmd = (float(msg.linear.x), float(msg.angular.z))
         self.cmd_time = stamp_ns
 
     def before_step(self, now_ns: int) -> None:
+        # small arrays (one entry per wheel): in-place ufuncs only, no temporaries beyond one
         p = self.params
         v, w = self.cmd
         if p.cmd_timeout and now_ns - self.cmd_time > p.cmd_timeout * 1e9:
             v, w = 0.0, 0.0
         if p.yaw_rate_feedback:
             w = self._yaw_feedback(w)
-        half = w * self.sep / 2.0
-        self.target[:] = (v + self.turn_sign * half) / self.radius
+        target, ctrl, integral = self.target, self.ctrl, self.integral
+        np.multiply(self.turn_sign, w * self.sep / 2.0 / self.radius, out=target)
+        target += v / self.radius
         if p.max_wheel_acceleration > 0:
             step = p.max_wheel_acceleration * self.dt
-            self.ctrl += np.clip(self.target - self.ctrl, -step, step)
+            delta = target - ctrl
+            np.minimum(delta, step, out=delta)
+            np.maximum(delta, -step, out=delta)
+            ctrl += delta
         else:
-            self.ctrl[:] = self.target
-        d = self.ctx.data
-        speed = d.qvel[self.vadr]
+            ctrl[:] = target
         # Integrate only where the target has settled: during an acceleration ramp the servo's lag is
         # expected, and integrating it would overshoot the limit (conditional integration, anti-windup).
-        settled = self.ctrl == self.target
-        self.integral += np.where(settled, self.ctrl - speed, 0.0) * (self.dt / _INTEGRAL_TIME_S)
-        np.clip(self.integral, -self.integral_max, self.integral_max, out=self.integral)
-        d.ctrl[self.act] = self.ctrl + self.integral
+        settled = ctrl == target
+        self.settled = bool(settled.all())
+        error = ctrl - self.qvel[self.vadr]
+        error *= settled
+        error *= self.dt / _INTEGRAL_TIME_S
+        integral += error
+        np.minimum(integral, self.integral_max, out=integral)
+        np.maximum(integral, -self.integral_max, out=integral)
+        self.actuator_ctrl[self.act] = ctrl + integral
 
     def _yaw_feedback(self, w: float) -> float:
         """The turn command that makes the body yaw at `w`: an integral on the yaw-rate error, reset when
@@ -194,7 +209,7 @@ class WheelDrive(Plugin):
             self.ctx.model, self.ctx.data, mujoco.mjtObj.mjOBJ_XBODY, self.base, self._vel, 0
         )
         error = w - float(self._vel[2])
-        if np.array_equal(self.ctrl, self.target):  # not while the wheels still ramp (anti-windup)
+        if self.settled:  # not while the wheels still ramp (anti-windup)
             self.yaw_integral += error * (self.dt / _YAW_INTEGRAL_TIME_S)
         limit = 4.0 * abs(w)
         self.yaw_integral = min(max(self.yaw_integral, -limit), limit)
@@ -202,12 +217,12 @@ class WheelDrive(Plugin):
 
     def after_step(self, now_ns: int) -> None:
         d = self.ctx.data
-        wl, wr = self._side_means(d.qvel[self.vadr])
+        wl, wr = self._side_means(self.qvel[self.vadr]).tolist()
         v = self.radius * (wl + wr) / 2.0
         w = self.radius * (wr - wl) / self.sep
         if self.params.odometry_source == "encoders":
-            q = self._side_means(d.qpos[self.qadr])
-            dl, dr = (q - self.last_q) * self.radius
+            q = self._side_means(self.qpos[self.qadr])
+            dl, dr = ((q - self.last_q) * self.radius).tolist()
             self.last_q = q
             ds, dyaw = (dl + dr) / 2.0, (dr - dl) / self.sep
             mid = self.yaw + dyaw / 2.0
@@ -220,13 +235,10 @@ class WheelDrive(Plugin):
             pos = d.xpos[self.base]
             quat = d.xquat[self.base]
             self.yaw = quat_to_yaw(quat)
-        if self.odom_pub:
-            self.odom_pub.publish(
-                odometry(now_ns, self.odom_frame, self.base_frame, pos, quat, (v, 0.0, 0.0), (0.0, 0.0, w)),
-                now_ns,
-            )
-        if self.tf_pub:
-            self.tf_pub.publish(tf_message(now_ns, self.odom_frame, self.base_frame, pos, quat), now_ns)
+        if self.odom_out:
+            self.odom_out.publish(now_ns, pos, quat, (v, 0.0, 0.0), (0.0, 0.0, w))
+        if self.tf_out:
+            self.tf_out.publish(now_ns, pos, quat)
 
 
 class DiffDrive(WheelDrive):
@@ -236,22 +248,6 @@ class DiffDrive(WheelDrive):
     @classmethod
     def sides(cls, params: DiffDriveParams) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
         return [(params.left_joint, "left_joint")], [(params.right_joint, "right_joint")]
-
-
-def tf_message(now_ns: int, parent: str, child: str, pos: Sequence[float], quat_wxyz: Sequence[float]) -> Any:
-    """A tf2_msgs/TFMessage holding one transform parent -> child."""
-    T = msgs.T
-    tf = T["geometry_msgs/msg/TransformStamped"](
-        header=msgs.header(now_ns, parent),
-        child_frame_id=child,
-        transform=T["geometry_msgs/msg/Transform"](
-            translation=T["geometry_msgs/msg/Vector3"](x=float(pos[0]), y=float(pos[1]), z=float(pos[2])),
-            rotation=T["geometry_msgs/msg/Quaternion"](
-                x=float(quat_wxyz[1]), y=float(quat_wxyz[2]), z=float(quat_wxyz[3]), w=float(quat_wxyz[0])
-            ),
-        ),
-    )
-    return T["tf2_msgs/msg/TFMessage"](transforms=[tf])
 
 
 def _wheel_radius(m: mujoco.MjModel, body: int) -> float:

@@ -10,7 +10,7 @@ import mujoco
 import numpy as np
 from pydantic import Field
 
-from plugins._common import odometry
+from plugins._common import OdometryWriter
 from runner.plugin import BuildContext, Plugin, RatedParams, Topic
 
 
@@ -36,7 +36,9 @@ class GroundTruth(Plugin):
         link = self.params.link or r.root_link
         self.body = r.body_id(link)
         self.child = r.frame(link)
-        self.pub = self.ctx.publisher(self.params.topic, "nav_msgs/msg/Odometry")
+        self.out = OdometryWriter(
+            self.ctx.publisher(self.params.topic, "nav_msgs/msg/Odometry"), self.params.frame_id, self.child
+        )
         self.vel = np.zeros(6)
 
     def after_step(self, now_ns: int) -> None:
@@ -44,15 +46,4 @@ class GroundTruth(Plugin):
         mujoco.mj_objectVelocity(
             m, d, mujoco.mjtObj.mjOBJ_XBODY, self.body, self.vel, 0
         )  # at the link origin
-        self.pub.publish(
-            odometry(
-                now_ns,
-                self.params.frame_id,
-                self.child,
-                d.xpos[self.body],
-                d.xquat[self.body],
-                self.vel[3:],
-                self.vel[:3],
-            ),
-            now_ns,
-        )
+        self.out.publish(now_ns, d.xpos[self.body], d.xquat[self.body], self.vel[3:], self.vel[:3])

@@ -50,15 +50,19 @@ class JointStates(Plugin):
         self.qadr = np.array([m.jnt_qposadr[j] for j in ids], dtype=np.int64)
         self.vadr = np.array([m.jnt_dofadr[j] for j in ids], dtype=np.int64)
         self.pub = self.ctx.publisher(self.params.topic, "sensor_msgs/msg/JointState")
-        self.JointState = msgs.T["sensor_msgs/msg/JointState"]
+        n = len(ids)
+        template = msgs.T["sensor_msgs/msg/JointState"](
+            header=msgs.header(0, ""),
+            name=self.names,
+            position=np.zeros(n),
+            velocity=np.zeros(n),
+            effort=np.zeros(n),
+        )
+        self.layout = self.pub.layout(template, ["header.stamp", "position", "velocity", "effort"])
 
     def after_step(self, now_ns: int) -> None:
         d = self.ctx.data
-        msg = self.JointState(
-            header=msgs.header(now_ns, ""),
-            name=self.names,
-            position=d.qpos[self.qadr].astype(np.float64),
-            velocity=d.qvel[self.vadr].astype(np.float64),
-            effort=d.qfrc_actuator[self.vadr].astype(np.float64),
+        self.pub.publish_cdr(
+            self.layout.encode(now_ns, d.qpos[self.qadr], d.qvel[self.vadr], d.qfrc_actuator[self.vadr]),
+            now_ns,
         )
-        self.pub.publish(msg, now_ns)

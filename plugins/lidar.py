@@ -108,8 +108,20 @@ class Lidar(Plugin):
         self.own_groups = m.geom_group[self.own].copy()
         self.geomgroup = np.array([1, 0, 1, 1, 1, 1], dtype=np.uint8)
         self.pub = ctx.publisher(p.topic, "sensor_msgs/msg/LaserScan")
-        self.LaserScan = msgs.T["sensor_msgs/msg/LaserScan"]
-        self.empty = np.zeros(0, dtype=np.float32)
+        template = msgs.T["sensor_msgs/msg/LaserScan"](
+            header=msgs.header(0, self.frame_id),
+            angle_min=p.min_angle,
+            angle_max=p.max_angle,
+            angle_increment=self.increment,
+            time_increment=0.0,
+            scan_time=1.0 / p.rate,
+            range_min=p.range_min,
+            range_max=p.range_max,
+            ranges=np.zeros(p.samples, dtype=np.float32),
+            intensities=np.zeros(0, dtype=np.float32),
+        )
+        self.layout = self.pub.layout(template, ["header.stamp"])
+        self.out_ranges = self.layout.view("ranges")
 
     def scan(self) -> np.ndarray:
         """Distances along each beam (inf where nothing is hit within range_max)."""
@@ -159,32 +171,23 @@ class Lidar(Plugin):
 
     def after_step(self, now_ns: int) -> None:
         p = self.params
-        every = self.scan()
-        finite = np.isfinite(every)
+        every = self.scan()  # inf where nothing is hit: noise and rounding leave those inf
         if p.noise_stddev > 0:
-            every[finite] += self.ctx.rng.normal(0.0, p.noise_stddev, int(finite.sum()))
+            noise = self.ctx.rng.standard_normal(len(every))
+            noise *= p.noise_stddev
+            every += noise
         if p.resolution > 0:
-            every[finite] = np.round(every[finite] / p.resolution) * p.resolution
+            every /= p.resolution
+            np.round(every, out=every)
+            every *= p.resolution
         n = p.samples
         if p.vertical_samples > 1:
             self._publish_points(every, now_ns)
-        ranges = every[self.scan_row * n : (self.scan_row + 1) * n].copy()
-        finite = np.isfinite(ranges)
-        ranges[finite & (ranges > p.range_max)] = np.inf
-        ranges[finite & (ranges < p.range_min)] = -np.inf
-        msg = self.LaserScan(
-            header=msgs.header(now_ns, self.frame_id),
-            angle_min=p.min_angle,
-            angle_max=p.max_angle,
-            angle_increment=self.increment,
-            time_increment=0.0,
-            scan_time=1.0 / p.rate,
-            range_min=p.range_min,
-            range_max=p.range_max,
-            ranges=ranges.astype(np.float32),
-            intensities=self.empty,
-        )
-        self.pub.publish(msg, now_ns)
+        out = self.out_ranges  # float32 view into the message bytes
+        out[:] = every[self.scan_row * n : (self.scan_row + 1) * n]
+        out[out > p.range_max] = np.inf  # REP 117: beyond range +inf, too close -inf
+        out[out < p.range_min] = -np.inf
+        self.pub.publish_cdr(self.layout.encode(now_ns), now_ns)
 
     def _publish_points(self, ranges: np.ndarray, now_ns: int) -> None:
         """A PointCloud2 (x, y, z float32, sensor frame, one row per elevation); NaN where no return."""

@@ -22,8 +22,7 @@ import mujoco
 import numpy as np
 from pydantic import Field, PositiveFloat
 
-from plugins._common import BaseDriveParams, drive_topics, odometry
-from plugins.diff_drive import tf_message
+from plugins._common import BaseDriveParams, OdometryWriter, TransformWriter, drive_topics
 from runner.geometry import quat_to_yaw, yaw_to_quat
 from runner.plugin import BuildContext, Plugin, PluginConfigError, Topic
 
@@ -105,8 +104,10 @@ class PlanarMove(Plugin):
         self.base_frame = p.base_frame or r.frame(r.root_link)
         self.odom_frame = r.frame(p.odom_frame)
         self.ctx.subscribe(p.cmd_topic, "geometry_msgs/msg/Twist", self._on_cmd)
-        self.odom_pub = self.ctx.publisher(p.odom_topic, "nav_msgs/msg/Odometry") if p.publish_odom else None
-        self.tf_pub = self.ctx.publisher(p.tf_topic, "tf2_msgs/msg/TFMessage") if p.publish_tf else None
+        odom_pub = self.ctx.publisher(p.odom_topic, "nav_msgs/msg/Odometry") if p.publish_odom else None
+        tf_pub = self.ctx.publisher(p.tf_topic, "tf2_msgs/msg/TFMessage") if p.publish_tf else None
+        self.odom_out = OdometryWriter(odom_pub, self.odom_frame, self.base_frame) if odom_pub else None
+        self.tf_out = TransformWriter(tf_pub, self.odom_frame, self.base_frame) if tf_pub else None
 
     def _on_cmd(self, msg: Any, stamp_ns: int) -> None:
         self.cmd[:] = (float(msg.linear.x), float(msg.linear.y), float(msg.angular.z))
@@ -130,13 +131,10 @@ class PlanarMove(Plugin):
         mujoco.mju_mulQuat(quat, self.q0_inv, d.xquat[self.base])
         # XBODY: the link's own frame at its origin (BODY would be its inertial frame, at its centre of mass)
         mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_XBODY, self.base, self.vel, 1)
-        if self.odom_pub:
-            self.odom_pub.publish(
-                odometry(now_ns, self.odom_frame, self.base_frame, pos, quat, self.vel[3:], self.vel[:3]),
-                now_ns,
-            )
-        if self.tf_pub:
-            self.tf_pub.publish(tf_message(now_ns, self.odom_frame, self.base_frame, pos, quat), now_ns)
+        if self.odom_out:
+            self.odom_out.publish(now_ns, pos, quat, self.vel[3:], self.vel[:3])
+        if self.tf_out:
+            self.tf_out.publish(now_ns, pos, quat)
 
 
 def _servo_inertia(m: mujoco.MjModel, d: mujoco.MjData, site: int) -> np.ndarray:

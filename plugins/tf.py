@@ -99,6 +99,17 @@ class Tf(Plugin):
         self.static_period_ns = round(p.static_period * 1e9)
         self.next_static_ns: int | None = 0
         self._q = np.zeros(4)
+        self._quat = np.zeros(4)
+        if self.pub:
+            # moving links: one message of fixed shape, written in place (stamps and transforms)
+            zero = (np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
+            template = self.Msg(
+                transforms=[self._stamped(0, pf, cf, *zero) for _p, _b, pf, cf in self.moving]
+            )
+            self.layout = self.pub.layout(
+                template, [f"transforms[{i}].header.stamp" for i in range(len(self.moving))]
+            )
+            self.out = [self.layout.view(f"transforms[{i}].transform") for i in range(len(self.moving))]
 
     def after_step(self, now_ns: int) -> None:
         if self.static_pub and self.next_static_ns is not None and now_ns >= self.next_static_ns:
@@ -109,25 +120,25 @@ class Tf(Plugin):
             self.static_pub.publish(self.Msg(transforms=tfs), now_ns)
             period = self.static_period_ns
             self.next_static_ns = (now_ns // period + 1) * period if period else None
-        if self.pub and self.moving:
+        if self.pub:
             d = self.ctx.data
-            tfs = []
-            for parent, b, pf, cf in self.moving:
+            for (parent, b, _pf, _cf), out in zip(self.moving, self.out, strict=True):
                 if parent < 0:
                     pos, quat = d.xpos[b], d.xquat[b]
                 else:
                     pos, quat = self._relative(d, parent, b)
-                tfs.append(self._stamped(now_ns, pf, cf, pos, quat))
-            self.pub.publish(self.Msg(transforms=tfs), now_ns)
+                out[0:3] = pos  # translation xyz, rotation xyzw
+                out[3:6] = quat[1:]
+                out[6] = quat[0]
+            self.pub.publish_cdr(self.layout.encode(*[now_ns] * len(self.out)), now_ns)
 
     def _relative(self, d: Any, parent: int, child: int) -> tuple[np.ndarray, np.ndarray]:
         """The child's pose in its parent's frame: p = R_pᵀ (x_c - x_p), q = q_p⁻¹ q_c."""
         rot = d.xmat[parent].reshape(3, 3)
         pos = rot.T @ (d.xpos[child] - d.xpos[parent])
         mujoco.mju_negQuat(self._q, d.xquat[parent])
-        quat = np.zeros(4)
-        mujoco.mju_mulQuat(quat, self._q, d.xquat[child])
-        return pos, quat
+        mujoco.mju_mulQuat(self._quat, self._q, d.xquat[child])
+        return pos, self._quat
 
     def _stamped(self, now_ns: int, parent: str, child: str, pos: Any, q: Any) -> Any:
         return self.Stamped(

@@ -14,7 +14,7 @@ Built-ins are registered in the `scenario.plugins` entry-point group, as a third
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
@@ -23,6 +23,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat
 
 if TYPE_CHECKING:
+    from runner.cdr import Layout
     from runner.sim.world import RobotHandle
 
 
@@ -92,15 +93,42 @@ class BuildContext:
 
 
 class Publisher:
-    """Publishes one topic. Made by `RuntimeContext.publisher`; messages are rosbags message objects."""
+    """Publishes one topic. Made by `RuntimeContext.publisher`.
 
-    def __init__(self, key: str, type_name: str, send: Callable[[Any, int], None]):
+    `publish(msg, stamp)` takes a rosbags message object and encodes it. On hot paths, encode once into a
+    fixed layout and send bytes: `layout = pub.layout(template, fields)`, then
+    `pub.publish_cdr(layout.encode(stamp, ...), stamp)` (see `runner.cdr`): a few microseconds a message.
+    """
+
+    def __init__(
+        self,
+        key: str,
+        type_name: str,
+        send: Callable[[Any, int], None],
+        send_cdr: Callable[[bytes, int], None] | None = None,
+    ):
         self.key = key
         self.type = type_name
-        self._send = send
+        # the sender's own functions, bound as attributes: no extra call per message
+        self.publish: Callable[[Any, int], None] = send
+        if send_cdr is not None:
+            self.publish_cdr: Callable[[bytes, int], None] = send_cdr
 
-    def publish(self, msg: Any, stamp_ns: int) -> None:
-        self._send(msg, stamp_ns)
+    def publish(self, msg: Any, stamp_ns: int) -> None:  # type: ignore[no-redef]  # replaced in __init__
+        """Publish a rosbags message object of this topic's type."""
+        raise NotImplementedError
+
+    def publish_cdr(self, payload: bytes, stamp_ns: int) -> None:  # type: ignore[no-redef]
+        """Publish bytes that are already the CDR encoding of a message of this topic's type."""
+        from runner import msgs
+
+        self.publish(msgs.decode(payload, self.type), stamp_ns)
+
+    def layout(self, template: Any, fields: Sequence[str] = ()) -> Layout:
+        """A fixed-layout encoder for this topic's type (see `runner.cdr.Layout`)."""
+        from runner.cdr import Layout
+
+        return Layout(self.type, template, fields)
 
 
 @dataclass
@@ -129,6 +157,11 @@ class Plugin:
     Params: ClassVar[type[PluginParams]] = PluginParams
     type_name: ClassVar[str] = ""
     renders: ClassVar[bool] = False  # needs OpenGL: the runner picks a working backend for its process
+    # `after_step` reads values of MuJoCo's acceleration stage (contact and constraint forces, force/torque/
+    # touch sensors): the world then runs `mj_forward` before it. Otherwise the hook sees positions,
+    # velocities, contacts and position/velocity sensors of the current instant, and acceleration-stage
+    # sensor values (accelerometer) of the step that led to it, at no extra cost.
+    needs_forward: ClassVar[bool] = False
 
     def __init__(self, params: PluginParams, ctx: RuntimeContext, name: str):
         self.params = params

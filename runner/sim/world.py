@@ -4,13 +4,17 @@ Time is integer nanoseconds of sim time, counted in whole physics steps (`now = 
 rates and timeline entries land on exact steps and a run is repeatable.
 
 At each boundary time `t` where something is due, in this order:
-  1. `after_step` hooks due at t (after `mj_forward`, so sensors read positions, contacts and MuJoCo
-     sensor values of the state at t, not of the step before);
+  1. `after_step` hooks due at t. The step into t is split (`mj_step1` at t, `mj_step2` after the
+     hooks), so sensors read positions, velocities, contacts and position/velocity sensor values of the
+     state at t, at no extra cost; acceleration-stage values (accelerometers) are those of the step that
+     led to t. A plugin that reads constraint forces sets `needs_forward` and gets an `mj_forward` first.
+     (With the RK4 integrator, which cannot be split, every boundary with sensors due runs `mj_forward`.)
   2. timeline entries with time <= t (published, and delivered to local subscribers at once);
   3. messages from other processes that arrived since the last boundary (delivered in arrival order);
   4. `before_step` hooks due at t (controllers act on the commands);
   5. the clock, if due;
-then MuJoCo steps (`mj_step(..., nstep=n)`) straight to the next boundary.
+then MuJoCo finishes the step (`mj_step2`) and steps (`mj_step(..., nstep=n - 1)`, `mj_step1`) straight to
+the next boundary: the loop costs nothing between boundaries, and nothing but the hooks at them.
 """
 
 from __future__ import annotations
@@ -26,10 +30,12 @@ import mujoco
 import numpy as np
 
 from runner import msgs
+from runner.cdr import Layout
 from runner.plan import RobotPlan, RunPlan, topic_key
 from runner.plugin import Plugin, Publisher, RuntimeContext, overrides
 from runner.registry import load
-from runner.transport import Bus, pack_attachment
+from runner.transport import ATTACHMENT as _ATT
+from runner.transport import Bus
 
 # Without anything due, the loop still stops this often (sim time) to take input and check for a stop.
 MAX_BATCH_NS = 10_000_000
@@ -87,14 +93,35 @@ class _Hook:
     fn: Callable[[int], None]
     period_ns: int  # 0: every step
     next_ns: int = 0
+    forward: bool = False  # needs mj_forward first (acceleration-stage values)
 
 
-@dataclass
 class _Outgoing:
-    key: str
-    type: str
-    send: Callable[[bytes, bytes], None]
-    seq: int = 0
+    """One published key: sends CDR bytes with the (sequence, stamp) attachment and hands the message to
+    subscribers inside this process (decoded only when there is one)."""
+
+    __slots__ = ("key", "local", "send", "seq", "type")
+
+    def __init__(self, key: str, type_name: str, send: Callable[[bytes, bytes], None]):
+        self.key = key
+        self.type = type_name
+        self.send = send
+        self.seq = 0
+        self.local: list[tuple[str, Callable[[Any, int], None]]] = []
+
+    def publish(self, msg: Any, stamp_ns: int) -> None:
+        self.send(msgs.encode(msg, self.type), _ATT.pack(self.seq, stamp_ns))
+        self.seq += 1
+        for _type, cb in self.local:
+            cb(msg, stamp_ns)
+
+    def publish_cdr(self, payload: bytes, stamp_ns: int) -> None:
+        self.send(payload, _ATT.pack(self.seq, stamp_ns))
+        self.seq += 1
+        if self.local:
+            msg = msgs.decode(payload, self.type)
+            for _type, cb in self.local:
+                cb(msg, stamp_ns)
 
 
 @dataclass
@@ -112,6 +139,8 @@ class World:
         self.model = mujoco.MjModel.from_xml_string(plan.mjcf)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
+        # mj_step1/mj_step2 split the step around the hooks; RK4 cannot be split
+        self._split = int(self.model.opt.integrator) != int(mujoco.mjtIntegrator.mjINT_RK4)
         self.step_ns = plan.step_ns
         self.now_ns = 0
         self.rng = np.random.default_rng(plan.seed)
@@ -142,8 +171,11 @@ class World:
                 if overrides(plugin, "before_step"):
                     self._before.append(_Hook(plugin.before_step, period))
                 if overrides(plugin, "after_step"):
-                    self._after.append(_Hook(plugin.after_step, period))
+                    self._after.append(_Hook(plugin.after_step, period, forward=plugin.needs_forward))
         self._clock = self._make_publisher(plan.clock_key, "rosgraph_msgs/msg/Clock")
+        self._clock_layout = Layout(
+            self._clock.type, msgs.T[self._clock.type](clock=msgs.time_msg(0)), ["clock"]
+        )
         self._clock_hook = _Hook(self._publish_clock, round(1e9 / plan.clock_rate))
         self._timeline = [
             (ev.t_ns, ev.key, ev.type, msgs.from_data(ev.type, ev.data)) for ev in plan.timeline
@@ -159,29 +191,30 @@ class World:
         out = self._out.get(key)
         if out is None:
             out = _Outgoing(key, type_name, self.bus.publisher(key, type_name))
+            out.local = self._local.setdefault(key, [])
             self._out[key] = out
         elif out.type != type_name:
             raise ValueError(f"{key} is published as {out.type} and as {type_name}")
         return out
 
     def publish(self, out: _Outgoing, msg: Any, stamp_ns: int) -> None:
-        payload = msgs.encode(msg, out.type)
-        out.send(payload, pack_attachment(out.seq, stamp_ns))
-        out.seq += 1
-        for _type, cb in self._local.get(out.key, ()):
-            cb(msg, stamp_ns)
+        out.publish(msg, stamp_ns)
+
+    def publish_cdr(self, out: _Outgoing, payload: bytes, stamp_ns: int) -> None:
+        out.publish_cdr(payload, stamp_ns)
 
     def _publisher_factory(self, namespace: str) -> Callable[[str, str], Publisher]:
         def make(topic: str, type_name: str) -> Publisher:
             type_name = msgs.normalize_type(type_name)
             out = self._make_publisher(topic_key(self.plan.name, namespace, topic), type_name)
-            return Publisher(out.key, type_name, lambda msg, stamp: self.publish(out, msg, stamp))
+            return Publisher(out.key, type_name, out.publish, out.publish_cdr)
 
         return make
 
     def _subscriber_factory(self, namespace: str) -> Callable[[str, str, Callable[[Any, int], None]], None]:
         def subscribe(topic: str, type_name: str, callback: Callable[[Any, int], None]) -> None:
             key = topic_key(self.plan.name, namespace, topic)
+            # the same list as the publisher's `local`, if this process also publishes the key
             self._local.setdefault(key, []).append((msgs.normalize_type(type_name), callback))
             if key not in self._remote_subscribed:
                 self._remote_subscribed.add(key)
@@ -207,9 +240,8 @@ class World:
         now = self.now_ns
         due = [h for h in self._after if now >= h.next_ns]
         if due:
-            # mj_step leaves positions, contacts and sensor values as they were before its last
-            # integration; bring them to the state at `now` so every sensor reads the same instant.
-            mujoco.mj_forward(self.model, self.data)
+            if self._split is False or any(h.forward for h in due):
+                mujoco.mj_forward(self.model, self.data)
             for h in due:
                 h.fn(now)
                 h.next_ns = _next_due(h, now)
@@ -244,44 +276,54 @@ class World:
                 owners.append((m.geom(g).name or "world").split("/")[0])
             else:
                 owners.append((m.body(body).name or "world").split("/")[0])
-        self._owners = owners
-        self._watch = set(watch)
-        # built once: every contact state shares them
-        self._contact_parts = (
-            msgs.T["gazebo_msgs/msg/ContactState"],
-            msgs.from_data("geometry_msgs/msg/Wrench", {}),
-            np.zeros(0),
-        )
+        names = sorted(set(owners))  # ids in name order: pairs (lo, hi) by id are sorted by name
+        self._owner_names = names
+        self._owner_ids = np.array([names.index(o) for o in owners], dtype=np.int64)
+        self._watched = np.array([n in watch for n in names])
+        self._contact_layouts: dict[tuple[int, ...], Layout] = {}
         self._contacts = self._make_publisher(contacts_key(self.plan.name), "gazebo_msgs/msg/ContactsState")
         self._after.append(_Hook(self._publish_contacts, round(1e9 / CONTACTS_RATE)))
 
     def _publish_contacts(self, now: int) -> None:
+        """The pairs of owners in contact (one state each, sorted by name): the set changes rarely, so each
+        distinct set is encoded once into a fixed layout and then only re-stamped."""
         d = self.data
-        pairs: set[tuple[str, str]] = set()
-        for i in range(d.ncon):
-            c = d.contact[i]
-            a, b = self._owners[c.geom1], self._owners[c.geom2]
-            if a != b and (a in self._watch or b in self._watch):
-                pairs.add((a, b) if a < b else (b, a))
-        state, zero, empty = self._contact_parts
+        pairs: tuple[int, ...] = ()
+        if d.ncon:
+            ids = self._owner_ids
+            o1, o2 = ids[d.contact.geom1], ids[d.contact.geom2]
+            keep = (o1 != o2) & (self._watched[o1] | self._watched[o2])
+            if keep.any():
+                o1, o2 = o1[keep], o2[keep]
+                k = len(self._owner_names)
+                pairs = tuple(sorted(set((np.minimum(o1, o2) * k + np.maximum(o1, o2)).tolist())))
+        layout = self._contact_layouts.get(pairs)
+        if layout is None:
+            layout = self._contact_layouts[pairs] = self._contacts_layout(pairs)
+        self.publish_cdr(self._contacts, layout.encode(now), now)
+
+    def _contacts_layout(self, pairs: tuple[int, ...]) -> Layout:
+        names, k = self._owner_names, len(self._owner_names)
+        zero = msgs.from_data("geometry_msgs/msg/Wrench", {})
+        state = msgs.T["gazebo_msgs/msg/ContactState"]
         states = [
             state(
                 info="",
-                collision1_name=a,
-                collision2_name=b,
+                collision1_name=names[code // k],
+                collision2_name=names[code % k],
                 wrenches=[],
                 total_wrench=zero,
                 contact_positions=[],
                 contact_normals=[],
-                depths=empty,
+                depths=np.zeros(0),
             )
-            for a, b in sorted(pairs)
+            for code in pairs
         ]
-        msg = msgs.T["gazebo_msgs/msg/ContactsState"](header=msgs.header(now, "world"), states=states)
-        self.publish(self._contacts, msg, now)
+        msg = msgs.T["gazebo_msgs/msg/ContactsState"](header=msgs.header(0, "world"), states=states)
+        return Layout(self._contacts.type, msg, ["header.stamp"])
 
     def _publish_clock(self, now: int) -> None:
-        self.publish(self._clock, msgs.T["rosgraph_msgs/msg/Clock"](clock=msgs.time_msg(now)), now)
+        self.publish_cdr(self._clock, self._clock_layout.encode(now), now)
 
     def _next_boundary(self, end_ns: int) -> int:
         nxt = min(end_ns, self.now_ns + MAX_BATCH_NS, self._clock_hook.next_ns)
@@ -299,6 +341,7 @@ class World:
         on_progress: Callable[[int], None] | None = None,
     ) -> WorldStats:
         plan = self.plan
+        m, d = self.model, self.data
         end_ns = plan.duration_ns
         factor = {"realtime": 1.0, "max": None}.get(plan.rate, plan.rate)  # type: ignore[arg-type]
         wall0 = time.perf_counter()
@@ -310,7 +353,13 @@ class World:
                 break
             target = self._next_boundary(end_ns)
             n = max(1, math.ceil((target - self.now_ns) / self.step_ns))
-            mujoco.mj_step(self.model, self.data, nstep=n)
+            if self._split:
+                mujoco.mj_step2(m, d)  # finish the step begun at the boundary, with the new controls
+                if n > 1:
+                    mujoco.mj_step(m, d, nstep=n - 1)
+                mujoco.mj_step1(m, d)  # positions, velocities, contacts at the next boundary
+            else:
+                mujoco.mj_step(m, d, nstep=n)
             steps += n
             self.now_ns += n * self.step_ns
             wall = time.perf_counter()
