@@ -250,13 +250,13 @@ def best_rate(fn: Callable[[], Any], min_s: float, repeat: int, warmup: int = 3)
     return best
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict[str, Any]:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seconds", type=float, default=2.0, help="sim seconds of the per-call run")
     ap.add_argument("--repeat", type=int, default=3, help="best of N for each figure")
     ap.add_argument("--min-time", type=float, default=1.0, help="wall seconds per rate measurement")
     ap.add_argument("--out", type=Path, default=HERE / "results" / "plugins.json", help="JSON results file")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
 
     with tempfile.TemporaryDirectory() as tmp_dir:
         tmp = Path(tmp_dir)
@@ -436,6 +436,7 @@ def main() -> None:
     except ValueError:
         shown = args.out
     print(f"wrote {shown}")
+    return result_doc
 
 
 def _raw_multiray(lidar: Any) -> Callable[[], None] | None:

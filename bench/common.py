@@ -1,0 +1,146 @@
+"""What the benchmark sections share: machine info, scenarios built from text, worlds on a real Zenoh
+session, the raw MuJoCo step rate, tables."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import platform
+import sys
+import tempfile
+import time
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+RESULTS = HERE / "results"
+DIFFBOT = REPO / "scenarios" / "robots" / "diffbot.urdf.xacro"
+TWO_ROBOTS = REPO / "scenarios" / "two_robots.yaml"
+
+import mujoco  # noqa: E402
+import zenoh  # noqa: E402
+
+from runner.compile import compile_plan  # noqa: E402
+from runner.loader import load_file, load_text  # noqa: E402
+from runner.plan import RunPlan  # noqa: E402
+from runner.sim.world import World, WorldStats  # noqa: E402
+from runner.transport import ZenohBus, free_port, make_config  # noqa: E402
+from runner.validate import validate_scenario  # noqa: E402
+
+
+def machine() -> dict[str, Any]:
+    cpu = platform.processor() or platform.machine()
+    with contextlib.suppress(OSError):
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    return {
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+        "cpu": cpu,
+        "cpus": os.cpu_count(),
+        "mujoco": mujoco.__version__,
+        "zenoh": getattr(zenoh, "__version__", "?"),
+        "date": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+    }
+
+
+def plan_from_file(path: Path, *, seconds: float | None = None, judge: bool = False) -> RunPlan:
+    doc = load_file(path)
+    scenario = validate_scenario(doc)
+    if not judge:
+        scenario = scenario.model_copy(update={"assertions": []})
+    plan = compile_plan(scenario, doc)
+    return _adjust(plan, seconds)
+
+
+def plan_from_text(text: str, *, seconds: float | None = None) -> RunPlan:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "bench.yaml"
+        path.write_text(text)
+        doc = load_text(text, path)
+        plan = compile_plan(validate_scenario(doc), doc)
+    return _adjust(plan, seconds)
+
+
+def _adjust(plan: RunPlan, seconds: float | None) -> RunPlan:
+    plan.rate = "max"
+    if seconds is not None:
+        plan.duration_ns = round(seconds * 1e9)
+    return plan
+
+
+def raw_rate(plan: RunPlan, steps: int, *, batched: bool = True) -> float:
+    """Physics steps per second of the compiled model, no plugins (their actuators and sensors are in
+    the model), robots at rest: the limit."""
+    model = mujoco.MjModel.from_xml_string(plan.mjcf)
+    data = mujoco.MjData(model)
+    mujoco.mj_step(model, data, nstep=50)  # settle contacts
+    t0 = time.perf_counter()
+    if batched:
+        mujoco.mj_step(model, data, nstep=steps)
+    else:
+        for _ in range(steps):
+            mujoco.mj_step(model, data)
+    return steps / (time.perf_counter() - t0)
+
+
+@contextlib.contextmanager
+def zenoh_session(mode: str = "peer") -> Iterator[Any]:
+    """A real Zenoh session on loopback with nothing else on it."""
+    with zenoh.open(make_config(mode, listen=[f"tcp/127.0.0.1:{free_port()}"])) as session:
+        yield session
+
+
+def world_on_zenoh(plan: RunPlan) -> WorldStats:
+    """The world with every plugin publishing on a real Zenoh session, nothing subscribed."""
+    with zenoh_session() as session:
+        bus = ZenohBus(session)
+        try:
+            return World(plan, bus).run()
+        finally:
+            bus.undeclare_all()
+
+
+def best(values: Sequence[float]) -> float:
+    return max(values)
+
+
+def table(title: str, header: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:
+    """A plain text table (also valid Markdown) — printed, and pasted into the README."""
+    cells = [[str(h) for h in header]] + [[_fmt(c) for c in row] for row in rows]
+    widths = [max(len(r[i]) for r in cells) for i in range(len(header))]
+    lines = [f"### {title}", ""]
+    for n, row in enumerate(cells):
+        lines.append(
+            "| "
+            + " | ".join(
+                c.ljust(w) if i == 0 else c.rjust(w) for i, (c, w) in enumerate(zip(row, widths, strict=True))
+            )
+            + " |"
+        )
+        if n == 0:
+            lines.append("|" + "|".join("-" * (w + 2) for w in widths) + "|")
+    return "\n".join(lines)
+
+
+def _fmt(v: Any) -> str:
+    if isinstance(v, float):
+        if v == 0:
+            return "0"
+        if abs(v) >= 1000:
+            return f"{v:,.0f}"
+        if abs(v) >= 100:
+            return f"{v:.0f}"
+        if abs(v) >= 10:
+            return f"{v:.1f}"
+        return f"{v:.2f}"
+    return str(v)
+
+
+def say(text: str) -> None:
+    print(text, flush=True)
+    sys.stdout.flush()
