@@ -491,7 +491,7 @@ def recorder(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
 def plugins(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     from bench import plugins as pl
 
-    argv = ["--out", str(RESULTS / "plugins.json")]
+    argv = ["--out", str(args.results / "plugins.json")]
     if args.quick:
         argv += ["--repeat", "1", "--min-time", "0.3"]
     doc = pl.main(argv)
@@ -519,7 +519,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", default="", help=f"comma-separated sections of: {', '.join(SECTIONS)}")
     ap.add_argument("--repeat", type=int, default=3, help="best of N for each figure")
     ap.add_argument("--readme", action="store_true", help="write the tables into README.md")
+    ap.add_argument("--results", type=Path, default=RESULTS, help="folder for the JSON results")
     args = ap.parse_args(argv)
+    results = args.results
     if args.quick:
         args.repeat = min(args.repeat, 1)
     chosen = [s.strip() for s in args.only.split(",") if s.strip()] or list(SECTIONS)
@@ -528,7 +530,7 @@ def main(argv: list[str] | None = None) -> int:
         ap.error(f"unknown section(s) {', '.join(unknown)}; sections: {', '.join(SECTIONS)}")
     info = machine()
     say(f"machine: {info['cpu']}, {info['cpus']} cpus, Python {info['python']}, MuJoCo {info['mujoco']}")
-    RESULTS.mkdir(parents=True, exist_ok=True)
+    results.mkdir(parents=True, exist_ok=True)
     texts: dict[str, str] = {}
     with tempfile.TemporaryDirectory() as tmp_dir:
         for name in chosen:
@@ -540,7 +542,7 @@ def main(argv: list[str] | None = None) -> int:
                 texts[name] = text
             if name != "plugins":  # bench/plugins.py writes its own file
                 doc = {"benchmark": name, "machine": info, "quick": args.quick, **doc}
-                (RESULTS / f"{name}.json").write_text(json.dumps(doc, indent=2) + "\n")
+                (results / f"{name}.json").write_text(json.dumps(doc, indent=2) + "\n")
             for target, met in (doc.get("targets") or {}).items():
                 if isinstance(met, bool):
                     say(f"  target {'met    ' if met else 'NOT met'}: {target}")

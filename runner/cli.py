@@ -490,6 +490,21 @@ def schema(
     out.print(f"wrote {output}", markup=False)
 
 
+@app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
+def bench(ctx: typer.Context) -> None:
+    """Run the benchmark suite (a checkout's bench/ folder): `scenario bench --quick`, `--only two_robots`,
+    `--readme`. Same as `python -m bench`."""
+    repo = Path(__file__).resolve().parents[1]
+    if not (repo / "bench" / "__main__.py").is_file():
+        err.print("[red]error:[/red] the benchmark suite lives in a checkout's bench/ folder; none here")
+        raise typer.Exit(2)
+    if str(repo) not in sys.path:
+        sys.path.insert(0, str(repo))
+    from bench.__main__ import main as bench_main
+
+    raise typer.Exit(bench_main(list(ctx.args)))
+
+
 def main() -> None:
     try:
         app()

@@ -6,23 +6,63 @@
 - Sequence numbers are checked per topic, so a lost message is counted, not guessed.
 - The file is written in chunks and finished on every exit path (`close()` in a `finally`), so it is
   readable after a normal end, an error or Ctrl-C.
+
+Speed: the per-message path is a few dict/attribute lookups and two `bytearray` appends. Messages are
+packed straight into the chunk being built (`_McapFile`: the `mcap` package's `Writer` spends ~3 µs in
+Python per message); only the records written once per chunk or per file (chunk, indexes, summary) go
+through the `mcap` package's record classes. `bench/recorder.py` measures it.
 """
 
 from __future__ import annotations
 
+import contextlib
+import struct
+import sys
 import threading
+import zlib
+from array import array
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
 
 import zenoh
-from mcap.writer import CompressionType, Writer
+import zstandard
+from mcap.data_stream import RecordBuilder
+from mcap.opcode import Opcode
+from mcap.records import (
+    Channel,
+    ChunkIndex,
+    DataEnd,
+    Header,
+    McapRecord,
+    Schema,
+    Statistics,
+    SummaryOffset,
+)
 
 from runner import msgs
-from runner.transport import type_from_encoding, unpack_attachment
+from runner.transport import ATTACHMENT, type_from_encoding, unpack_attachment
+
+CHUNK_SIZE = 256 * 1024  # uncompressed bytes per chunk
+ZSTD_LEVEL = 1  # level 1 compresses ~40% faster than the default 3, for a few % more bytes
+DRAIN_BATCH = 256  # samples the drain thread records per lock acquisition, at most
+
+_MAGIC = b"\x89MCAP0\r\n"
+# Message record: opcode, record length, channel id, sequence, log time, publish time (then the data).
+_MESSAGE_HEAD = struct.Struct("<BQHIQQ")
+_MESSAGE_FIXED = _MESSAGE_HEAD.size - 9  # the record's length minus the data's
+_MESSAGE_INDEX_HEAD = struct.Struct("<BQHI")
+# Chunk record up to its data: opcode, record length, start, end, uncompressed size and crc, compression
+# (a 4-byte string: "zstd"), compressed size.
+_CHUNK_HEAD = struct.Struct("<BQQQQII4sQ")
+_ZSTD = b"zstd"
+_OP_MESSAGE = int(Opcode.MESSAGE)
+_PUT = zenoh.SampleKind.PUT
+_unpack_att = ATTACHMENT.unpack
+_ATT_SIZE = ATTACHMENT.size
 
 
-@dataclass
+@dataclass(slots=True)
 class TopicStats:
     key: str
     type: str
@@ -39,24 +79,206 @@ class TopicStats:
         return (self.count - 1) / ((self.last_ns - self.first_ns) / 1e9)
 
 
-@dataclass
 class _Channel:
-    id: int
-    stats: TopicStats
+    __slots__ = ("id", "index", "stats")
+
+    def __init__(self, channel_id: int, stats: TopicStats):
+        self.id = channel_id
+        self.stats = stats
+        # (log time, offset in the chunk) of each of its messages in the chunk being built, flat
+        self.index = array("Q")
+
+
+def _record_bytes(record: McapRecord) -> bytes:
+    builder = RecordBuilder()
+    record.write(builder)
+    return bytes(builder.end())
+
+
+class _McapFile:
+    """A chunked, indexed MCAP writer (the layout of `mcap.writer.Writer` with its defaults: zstd chunks,
+    message indexes, chunk indexes, statistics, repeated schemas and channels, summary offsets, summary
+    CRC), whose per-message work is two appends to the chunk and two to the channel's index.
+
+    Not thread-safe: the `Recorder` calls it under its lock.
+    """
+
+    def __init__(self, stream: IO[bytes], *, profile: str, library: str, chunk_size: int = CHUNK_SIZE):
+        self._stream = stream
+        self.chunk_size = chunk_size
+        self.chunk = bytearray()  # the uncompressed records of the chunk being built
+        self._zstd = zstandard.ZstdCompressor(level=ZSTD_LEVEL)
+        self._schemas: list[Schema] = []
+        self._channels: list[Channel] = []
+        self._by_id: dict[int, _Channel] = {}
+        self._chunk_indexes: list[ChunkIndex] = []
+        self._start_ns: int | None = None
+        self._end_ns = 0
+        self._pos = 0
+        self._write(_MAGIC + _record_bytes(Header(profile=profile, library=library)))
+
+    def _write(self, data: bytes | bytearray) -> None:
+        self._stream.write(data)
+        self._pos += len(data)
+
+    def register_schema(self, name: str, encoding: str, data: bytes) -> int:
+        schema = Schema(id=len(self._schemas) + 1, data=data, encoding=encoding, name=name)
+        self._schemas.append(schema)
+        self.chunk += _record_bytes(schema)
+        return schema.id
+
+    def register_channel(
+        self, topic: str, message_encoding: str, schema_id: int, stats: TopicStats
+    ) -> _Channel:
+        channel = Channel(
+            id=len(self._channels) + 1,
+            topic=topic,
+            message_encoding=message_encoding,
+            schema_id=schema_id,
+            metadata={},
+        )
+        self._channels.append(channel)
+        self.chunk += _record_bytes(channel)
+        ch = self._by_id[channel.id] = _Channel(channel.id, stats)
+        return ch
+
+    def add_message(self, ch: _Channel, sequence: int, stamp: int, data: bytes) -> None:
+        chunk = self.chunk
+        offset = len(chunk)
+        # packed first: a stamp that does not fit (negative) raises before anything changed
+        chunk += _MESSAGE_HEAD.pack(_OP_MESSAGE, _MESSAGE_FIXED + len(data), ch.id, sequence, stamp, stamp)
+        chunk += data
+        ch.index.append(stamp)
+        ch.index.append(offset)
+        if len(chunk) >= self.chunk_size:
+            self.flush_chunk()
+
+    def flush_chunk(self) -> None:
+        """Compress the chunk being built and write it, with its message indexes."""
+        chunk = self.chunk
+        indexed = [ch for ch in self._by_id.values() if ch.index]
+        if not indexed:
+            # Schemas and channels but no message yet: they stay for the next chunk (as `mcap.Writer` does,
+            # a chunk without messages is never written; the summary repeats them anyway).
+            return
+        start = min(min(ch.index[0::2]) for ch in indexed)
+        end = max(max(ch.index[0::2]) for ch in indexed)
+        compressed = self._zstd.compress(chunk)
+        chunk_start = self._pos
+        self._write(
+            _CHUNK_HEAD.pack(
+                int(Opcode.CHUNK),
+                _CHUNK_HEAD.size - 9 + len(compressed),
+                start,
+                end,
+                len(chunk),
+                zlib.crc32(chunk),
+                len(_ZSTD),
+                _ZSTD,
+                len(compressed),
+            )
+        )
+        self._write(compressed)
+        chunk_length = self._pos - chunk_start
+        offsets: dict[int, int] = {}
+        index_start = self._pos
+        for ch in indexed:
+            entries = ch.index
+            if sys.byteorder != "little":
+                entries = array("Q", entries)
+                entries.byteswap()
+            data = entries.tobytes()
+            offsets[ch.id] = self._pos
+            self._write(_MESSAGE_INDEX_HEAD.pack(int(Opcode.MESSAGE_INDEX), 6 + len(data), ch.id, len(data)))
+            self._write(data)
+            del ch.index[:]
+        self._chunk_indexes.append(
+            ChunkIndex(
+                message_start_time=start,
+                message_end_time=end,
+                chunk_start_offset=chunk_start,
+                chunk_length=chunk_length,
+                message_index_offsets=offsets,
+                message_index_length=self._pos - index_start,
+                compression=_ZSTD.decode(),
+                compressed_size=len(compressed),
+                uncompressed_size=len(chunk),
+            )
+        )
+        self._start_ns = start if self._start_ns is None else min(self._start_ns, start)
+        self._end_ns = max(self._end_ns, end)
+        chunk.clear()
+
+    def finish(self) -> None:
+        """Write the last chunk, the summary and the footer. Does not close the stream."""
+        self.flush_chunk()
+        self._write(_record_bytes(DataEnd(data_section_crc=0)))
+        summary_start = self._pos
+        summary = RecordBuilder()
+        offsets: list[SummaryOffset] = []
+
+        def group(opcode: Opcode, records: list[Any]) -> None:
+            if not records:
+                return
+            begin = summary.count
+            for r in records:
+                r.write(summary)
+            offsets.append(SummaryOffset(int(opcode), summary_start + begin, summary.count - begin))
+
+        counts = {ch.id: ch.stats.count for ch in self._by_id.values()}
+        stats = Statistics(
+            attachment_count=0,
+            channel_count=len(self._channels),
+            channel_message_counts=counts,
+            chunk_count=len(self._chunk_indexes),
+            message_count=sum(counts.values()),
+            message_end_time=self._end_ns,
+            message_start_time=self._start_ns or 0,
+            metadata_count=0,
+            schema_count=len(self._schemas),
+        )
+        group(Opcode.SCHEMA, self._schemas)
+        group(Opcode.CHANNEL, self._channels)
+        group(Opcode.STATISTICS, [stats])
+        group(Opcode.CHUNK_INDEX, self._chunk_indexes)
+        summary_offset_start = summary_start + summary.count
+        for o in offsets:
+            o.write(summary)
+        data = summary.end()
+        footer_head = struct.pack("<BQQQ", int(Opcode.FOOTER), 8 + 8 + 4, summary_start, summary_offset_start)
+        crc = zlib.crc32(footer_head, zlib.crc32(data))
+        self._write(data)
+        self._write(footer_head + struct.pack("<I", crc) + _MAGIC)
+        self._stream.flush()
 
 
 @dataclass
 class Recorder:
+    """Records the samples of a run into an MCAP file.
+
+    Two ways to feed it, both thread-safe, both safe against a concurrent `close()`:
+
+    - `on_sample`, a Zenoh callback: `session.declare_subscriber(f"{run}/**", recorder.on_sample)`.
+      Zenoh's receive thread runs the recording code (a few µs per sample, Python included).
+    - `subscribe(session, f"{run}/**")`, faster: the recorder declares the subscriber itself, with a
+      bounded FIFO channel, and a thread of its own drains it in batches (one lock acquisition per
+      batch). Zenoh's thread only queues; a full queue back-pressures the publishers (with BLOCK
+      congestion control nothing is dropped). `close()` undeclares that subscriber, records what is
+      still queued, and only then finishes the file: no need to undeclare it separately.
+
+    `write()` records one message given as plain values (tests, replay).
+    """
+
     path: Path
     include: list[str]
     exclude: list[str] = field(default_factory=list)
     library: str = "scenario-runner"
+    chunk_size: int = CHUNK_SIZE
 
     def __post_init__(self) -> None:
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._file: IO[bytes] = open(self.path, "wb")  # noqa: SIM115 - closed in close()
-        self._writer = Writer(self._file, chunk_size=256 * 1024, compression=CompressionType.ZSTD)
-        self._writer.start(profile="ros2", library=self.library)
+        self._mcap = _McapFile(self._file, profile="ros2", library=self.library, chunk_size=self.chunk_size)
         self._lock = threading.Lock()
         self._schemas: dict[str, int] = {}
         self._channels: dict[str, _Channel] = {}
@@ -66,6 +288,9 @@ class Recorder:
         self.latest_ns = 0
         self.unknown: dict[str, int] = {}  # keys whose samples had no ROS type in their encoding
         self.closed = False
+        self.error: BaseException | None = None  # what stopped the drain thread's recording, if anything
+        self._subscriber: Any = None
+        self._drainer: threading.Thread | None = None
 
     # ------------------------------------------------------------------------------------------- input
     def wanted(self, key: str) -> bool:
@@ -77,60 +302,115 @@ class Recorder:
         return not skip
 
     def on_sample(self, sample: zenoh.Sample) -> None:
-        if sample.kind != zenoh.SampleKind.PUT:
+        """Record one Zenoh sample (a PUT); usable as a subscriber callback."""
+        with self._lock:
+            if not self.closed:
+                self._take(sample)
+
+    def subscribe(self, session: zenoh.Session, key_expr: str, capacity: int = 1 << 16) -> None:
+        """Declare a subscriber on `key_expr` whose samples a thread of this recorder drains (see the class
+        docstring). Undeclared by `close()`."""
+        if self._subscriber is not None:
+            raise RuntimeError("the recorder already has its subscriber")
+        self._subscriber = session.declare_subscriber(key_expr, zenoh.handlers.FifoChannel(capacity))
+        self._drainer = threading.Thread(
+            target=self._drain, args=(self._subscriber.handler,), name="recorder-drain", daemon=True
+        )
+        self._drainer.start()
+
+    def _drain(self, handler: Any) -> None:
+        recv, try_recv, take, lock = handler.recv, handler.try_recv, self._take, self._lock
+        while True:
+            try:
+                sample = recv()  # blocks without the GIL
+            except zenoh.ZError:  # undeclared, and nothing left
+                return
+            if self.closed or self.error is not None:
+                continue  # keep consuming, so that a publisher is never blocked by a full queue
+            try:
+                with lock:
+                    if self.closed:
+                        continue
+                    take(sample)
+                    for _ in range(DRAIN_BATCH):
+                        sample = try_recv()
+                        if sample is None:
+                            break
+                        take(sample)
+            except zenoh.ZError:
+                return
+            except Exception as e:  # e.g. the disk is full: say it once, keep the queue moving
+                self.error = e
+                print(f"recorder: recording stopped: {e!r}", file=sys.stderr, flush=True)
+
+    def _take(self, sample: zenoh.Sample) -> None:
+        """Record a sample; the lock is held and the recorder open."""
+        if sample.kind != _PUT:
             return
         key = str(sample.key_expr)
         att = sample.attachment
-        self.write(
-            key,
-            type_from_encoding(sample.encoding),
-            sample.payload.to_bytes(),
-            unpack_attachment(att.to_bytes()) if att is not None else None,
-        )
+        ch = self._channels.get(key)
+        if ch is not None and att is not None:
+            raw = att.to_bytes()
+            if len(raw) == _ATT_SIZE:
+                seq, stamp = _unpack_att(raw)
+                if stamp > self.latest_ns:
+                    self.latest_ns = stamp
+                self._add(ch, seq, stamp, sample.payload.to_bytes())
+                return
+        # first sample of a key, a key not recorded, or no attachment
+        parsed = unpack_attachment(att.to_bytes()) if att is not None else None
+        if ch is None and not self.wanted(key):
+            if parsed is not None:
+                self.latest_ns = max(self.latest_ns, parsed[1])
+            return
+        self._write(key, type_from_encoding(sample.encoding), sample.payload.to_bytes(), parsed)
 
     def write(self, key: str, type_name: str | None, payload: bytes, att: tuple[int, int] | None) -> None:
+        """Record one message: `att` is (sequence number, sim time ns) or None (no attachment)."""
         with self._lock:
-            if self.closed:
-                return
-            if att is not None:
-                seq, stamp = att
-                self.latest_ns = max(self.latest_ns, stamp)
-            else:
-                seq, stamp = None, self.latest_ns
+            if not self.closed:
+                self._write(key, type_name, payload, att)
+
+    def _write(self, key: str, type_name: str | None, payload: bytes, att: tuple[int, int] | None) -> None:
+        if att is not None:
+            seq, stamp = att
+            self.latest_ns = max(self.latest_ns, stamp)
+        else:
+            seq, stamp = None, self.latest_ns
+        ch = self._channels.get(key)
+        if ch is None:
             if not self.wanted(key):
                 return
-            ch = self._channels.get(key)
-            if ch is None:
-                if type_name is None or not msgs.is_known(type_name):
-                    self.unknown[key] = self.unknown.get(key, 0) + 1
-                    return
-                ch = self._register(key, msgs.normalize_type(type_name))
-            st = ch.stats
-            if seq is not None:
-                if st.next_seq is not None and seq > st.next_seq:
-                    st.lost += seq - st.next_seq
-                st.next_seq = seq + 1
-            st.count += 1
-            if st.first_ns is None:
-                st.first_ns = stamp
-            st.last_ns = stamp
-            self._writer.add_message(
-                channel_id=ch.id,
-                log_time=stamp,
-                publish_time=stamp,
-                data=payload,
-                sequence=(seq if seq is not None else st.count - 1) & 0xFFFFFFFF,
-            )
+            if type_name is None or not msgs.is_known(type_name):
+                self.unknown[key] = self.unknown.get(key, 0) + 1
+                return
+            ch = self._register(key, msgs.normalize_type(type_name))
+        self._add(ch, seq, stamp, payload)
+
+    def _add(self, ch: _Channel, seq: int | None, stamp: int, payload: bytes) -> None:
+        st = ch.stats
+        self._mcap.add_message(ch, (seq if seq is not None else st.count) & 0xFFFFFFFF, stamp, payload)
+        if seq is not None:
+            expected = st.next_seq
+            if expected is not None and seq > expected:
+                st.lost += seq - expected
+            st.next_seq = seq + 1
+        st.count += 1
+        if st.first_ns is None:
+            st.first_ns = stamp
+        st.last_ns = stamp
 
     def _register(self, key: str, type_name: str) -> _Channel:
         schema_id = self._schemas.get(type_name)
         if schema_id is None:
-            schema_id = self._writer.register_schema(
+            schema_id = self._mcap.register_schema(
                 name=type_name, encoding="ros2msg", data=msgs.msgdef(type_name).encode()
             )
             self._schemas[type_name] = schema_id
-        channel_id = self._writer.register_channel(topic=key, message_encoding="cdr", schema_id=schema_id)
-        ch = _Channel(channel_id, TopicStats(key, type_name))
+        ch = self._mcap.register_channel(
+            topic=key, message_encoding="cdr", schema_id=schema_id, stats=TopicStats(key, type_name)
+        )
         self._channels[key] = ch
         return ch
 
@@ -144,12 +424,19 @@ class Recorder:
             return {k: c.stats.count for k, c in self._channels.items()}
 
     def close(self) -> None:
+        """Stop recording (what `subscribe` queued first) and finish the file. Idempotent."""
+        sub, self._subscriber = self._subscriber, None
+        if sub is not None:
+            with contextlib.suppress(Exception):
+                sub.undeclare()
+            if self._drainer is not None and self._drainer is not threading.current_thread():
+                self._drainer.join(timeout=10.0)
         with self._lock:
             if self.closed:
                 return
             self.closed = True
             try:
-                self._writer.finish()
+                self._mcap.finish()
             finally:
                 self._file.close()
 

@@ -1,0 +1,60 @@
+"""The benchmark suite runs (its cheapest sections), so it does not rot between releases. Figures are not
+judged here: timings belong to `python -m bench`, not to tests on a shared CI machine."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.timeout(120)
+def test_bench_suite_runs_and_writes_results(tmp_path: Path) -> None:
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "bench",
+            "--quick",
+            "--only",
+            "messages,two_robots",
+            "--results",
+            str(tmp_path),
+        ],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=110,
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert "raw MuJoCo, batched mj_step (the limit)" in proc.stdout
+    doc = json.loads((tmp_path / "two_robots.json").read_text())
+    assert doc["machine"]["cpus"] >= 1
+    rates = doc["steps_per_s"]
+    # the limit is the limit: nothing with plugins is faster than raw physics of the same model
+    assert rates["raw_batched"] > rates["world_zenoh"] > 0
+    assert rates["recorded"] > 0
+    assert doc["lost"] == [0]
+    messages = json.loads((tmp_path / "messages.json").read_text())
+    types = {row["type"] for row in messages["rows"]}
+    assert {"sensor_msgs/msg/Imu", "sensor_msgs/msg/LaserScan", "nav_msgs/msg/Odometry"} <= types
+    # a fixed layout is cheaper than building the bytes with rosbags
+    assert all(row["fixed_layout_us"] < row["rosbags_encode_us"] for row in messages["rows"])
+
+
+@pytest.mark.timeout(60)
+def test_unknown_section_is_a_clear_error() -> None:
+    proc = subprocess.run(
+        [sys.executable, "-m", "bench", "--only", "nope"],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert proc.returncode == 2
+    assert "unknown section(s) nope" in proc.stderr
