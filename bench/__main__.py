@@ -336,17 +336,26 @@ def cameras(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     cams = plan_from_text(_robots_scene(2, seconds, extra=_CAMERA.format()), seconds=seconds)
     dt = base.step_ns / 1e9
     without = max(_full_run(base, tmp, f"nocam{i}")[0] for i in range(args.repeat))
-    with_cams = max(_full_run(cams, tmp, f"cam{i}")[0] for i in range(args.repeat))
+    cams.renderers = "world"
+    inline = max(_full_run(cams, tmp, f"cam{i}")[0] for i in range(args.repeat))
+    cams.renderers = "process"
+    apart = max(_full_run(cams, tmp, f"camp{i}")[0] for i in range(args.repeat))
     rows = [
-        ("2 robots, no cameras, recorded", without * dt),
-        ("+ 2 × 320x240 RGB at 10 Hz, rendered in the sim process, recorded", with_cams * dt),
-        ("+ 2 × 320x240 RGB at 10 Hz, in renderer processes", "not built yet (issue 7)"),
+        ("2 robots, no cameras", without * dt),
+        ("+ 2 × 320x240 RGB at 10 Hz, rendered in the sim process", inline * dt),
+        ("+ 2 × 320x240 RGB at 10 Hz, in a renderer process", apart * dt),
     ]
-    text = table(f"cameras: {seconds:g} s sim, best of {args.repeat}", ("", "× real time"), rows)
+    text = table(
+        f"cameras: recorded runs, {seconds:g} s sim, best of {args.repeat}", ("", "× real time"), rows
+    )
     doc = {
         "sim_seconds": seconds,
-        "x_real_time": {"no_cameras": without * dt, "cameras_in_sim_process": with_cams * dt},
-        "targets": {"two cameras >= 10x real time": with_cams * dt >= 10},
+        "x_real_time": {
+            "no_cameras": without * dt,
+            "cameras_in_sim_process": inline * dt,
+            "cameras_in_renderer_process": apart * dt,
+        },
+        "targets": {"two cameras >= 10x real time": max(inline, apart) * dt >= 10},
     }
     return doc, text
 

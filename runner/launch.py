@@ -84,6 +84,8 @@ def run_plan(
     """Run a plan; with a `judge` (runner.checks.judge.Judge), feed it every message it asks for, live, and
     stop the world early when the plan's `stop_on` says so."""
     listen = list(listen) or [f"tcp/127.0.0.1:{free_port()}"]
+    if plan.renderers == "auto":
+        plan = plan.model_copy(update={"renderers": "process" if (os.cpu_count() or 1) > 1 else "world"})
     conf = make_config("router", listen=listen, connect=connect)
     try:
         session = zenoh.open(conf)
@@ -98,6 +100,8 @@ def run_plan(
     started = {"at": 0.0}
     subs: list[Any] = []
     child: subprocess.Popen[bytes] | None = None
+    renderer: subprocess.Popen[bytes] | None = None
+    rtail: _StderrTail | None = None
     reason = "completed"
     error: str | None = None
     wall0 = time.perf_counter()
@@ -136,15 +140,33 @@ def run_plan(
         with tempfile.NamedTemporaryFile("w", suffix=".plan.json", delete=False) as f:
             f.write(plan.model_dump_json())
             plan_file = f.name
-        cmd = [sys.executable, "-m", "runner.sim", plan_file, "--connect", _connectable(listen[0])]
+        endpoint = _connectable(listen[0])
+        cmd = [sys.executable, "-m", "runner.sim", plan_file, "--connect", endpoint]
+        renders_apart = plan.renderers == "process" and plan.renders()
+        if renders_apart:
+            # cameras render in a process of their own, fed the world's state (runner/sim/render.py)
+            rcmd = [sys.executable, "-m", "runner.sim.render", plan_file, "--connect", endpoint]
+            renderer = subprocess.Popen(
+                rcmd, stderr=subprocess.PIPE, start_new_session=True, env=_world_env(plan)
+            )
+            rtail = _StderrTail(renderer.stderr, "[render] ")
+            rtail.start()
+        world_env = dict(os.environ) if renders_apart else _world_env(plan)
         # A session of its own: a terminal's Ctrl-C reaches only us, and we stop the world in order.
-        child = subprocess.Popen(cmd, stderr=subprocess.PIPE, start_new_session=True, env=_world_env(plan))
+        child = subprocess.Popen(cmd, stderr=subprocess.PIPE, start_new_session=True, env=world_env)
         tail = _StderrTail(child.stderr, "[world] ")
         tail.start()
         wall0 = time.perf_counter()
         try:
             while child.poll() is None:
                 time.sleep(0.05)
+                if renderer is not None and renderer.poll() not in (None, 0, 130) and error is None:
+                    last = "\n".join(f"  | {ln}" for ln in list(rtail.lines)[-12:]) if rtail else ""
+                    error = f"the renderer process exited with code {renderer.returncode}" + (
+                        f":\n{last}" if last else ""
+                    )
+                    reason = "failed"
+                    _stop(child)
                 if on_progress is not None and ready.is_set():
                     sim_ns = recorder.latest_ns if recorder else latest["ns"]
                     on_progress(sim_ns, time.perf_counter() - started["at"])
@@ -157,7 +179,14 @@ def run_plan(
             reason = "interrupted"
             _stop(child)
         tail.join(timeout=1.0)
-        if child.returncode not in (0, 130) and reason != "interrupted":
+        if renderer is not None:
+            try:
+                renderer.wait(timeout=STOP_GRACE_S)  # the world told it to stop
+            except subprocess.TimeoutExpired:
+                _stop(renderer)
+            if rtail:
+                rtail.join(timeout=1.0)
+        if child.returncode not in (0, 130) and reason != "interrupted" and error is None:
             reason = "failed"
             last = "\n".join(f"  | {ln}" for ln in list(tail.lines)[-12:])
             error = f"the world process exited with code {child.returncode}" + (f":\n{last}" if last else "")
@@ -173,6 +202,8 @@ def run_plan(
     finally:
         if child is not None and child.poll() is None:
             child.kill()
+        if renderer is not None and renderer.poll() is None:
+            renderer.kill()
         for s in subs:
             with contextlib.suppress(Exception):
                 s.undeclare()

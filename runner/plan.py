@@ -69,6 +69,13 @@ class RunPlan(BaseModel):
     assertion_keys: list[str] = []  # the key each assertion reads
     contact_watch: list[str] = []  # robot/model names whose contacts the world publishes on <run>/_contacts
     stop_on: Literal["never", "first_failure", "all_decided"] = "never"
+    renderers: Literal["auto", "world", "process"] = "auto"  # the launcher resolves auto
+
+    def renders(self) -> bool:
+        """Whether any plugin of the run renders (cameras)."""
+        from runner.registry import load
+
+        return any(load(p.type).renders for r in self.robots for p in r.plugins)
 
     @property
     def clock_key(self) -> str:

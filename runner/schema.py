@@ -342,6 +342,12 @@ class Scenario(Strict):
     duration: PositiveFloat = Field(10.0, description="Sim seconds to run.")
     rate: Rate = "realtime"
     seed: int = Field(0, description="Seed of every random number (sensor noise...).")
+    renderers: Literal["auto", "world", "process"] = Field(
+        "auto",
+        description="Where cameras render: `world` (in the physics process), `process` (a renderer process "
+        "of its own, fed the world's state over Zenoh, rendering while physics goes on) or `auto` (a "
+        "renderer process on a machine with more than one core).",
+    )
     packages: dict[str, str] = Field(
         default_factory=dict,
         description="ROS packages by name -> folder (relative to the scenario), for `$(find pkg)` and "

@@ -143,6 +143,7 @@ def compile_plan(
         assertion_keys=keys,
         contact_watch=contact_watch,
         stop_on=sc.stop_on,
+        renderers=sc.renderers,
     )
 
 

@@ -59,6 +59,11 @@ def main(argv: list[str] | None = None) -> int:
                     return 130
                 time.sleep(0.005)
             world = World(plan, bus)
+            if world.remote_renders and not world.wait_for_renderers(READY_TIMEOUT_S, should_stop):
+                if should_stop():
+                    return 130
+                print("world: the renderer process is not listening; giving up", file=sys.stderr)
+                return 1
             session.put(meta_key(plan.name, "world", "ready"), b"{}")
             stats = world.run(should_stop=should_stop)
             reason = "completed" if stats.sim_ns >= plan.duration_ns else "stopped"

@@ -19,12 +19,16 @@ the next boundary: the loop costs nothing between boundaries, and nothing but th
 
 from __future__ import annotations
 
+import contextlib
+import json
 import math
 import queue
+import struct
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 import mujoco
 import numpy as np
@@ -133,9 +137,14 @@ class WorldStats:
 
 
 class World:
-    def __init__(self, plan: RunPlan, bus: Bus):
+    """The simulated world of a plan. `role="world"` steps physics and runs every plugin, except, with
+    `plan.renderers == "process"` on a Zenoh bus, the rendering ones: their frames are made by a renderer
+    process (`role="renderer"`, see runner/sim/render.py) from the state this world sends it."""
+
+    def __init__(self, plan: RunPlan, bus: Bus, *, role: Literal["world", "renderer"] = "world"):
         self.plan = plan
         self.bus = bus
+        self.role = role
         self.model = mujoco.MjModel.from_xml_string(plan.mjcf)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
@@ -152,26 +161,47 @@ class World:
         self.plugins: list[Plugin] = []
         self._before: list[_Hook] = []
         self._after: list[_Hook] = []
+        session = getattr(bus, "session", None)
+        remote = role == "world" and plan.renderers == "process" and session is not None
+        self.remote_renders: dict[int, RemoteRender] = {}  # plugin index -> its renderer link
+        self.render_plugins: dict[int, Plugin] = {}  # in a renderer: plugin index -> plugin
+        index = -1
         for handle in self.robots:
             for pp in handle.plan.plugins:
+                index += 1
                 cls = load(pp.type)
+                period = 0 if not pp.rate else round(1e9 / pp.rate)
+                if role == "renderer" and not cls.renders:
+                    continue
+                if remote and cls.renders:
+                    link = RemoteRender(session, plan.name, index)
+                    self.remote_renders[index] = link
+                    self._after.append(_Hook(self._render_hook(link), period))
+                    continue
                 params = cls.Params.model_validate(pp.params)
                 ctx = RuntimeContext(
                     model=self.model,
                     data=self.data,
                     robot=handle,
-                    rng=np.random.default_rng([plan.seed, len(self.plugins)]),
+                    # by the plugin's place in the plan, so a renderer process draws the same numbers
+                    rng=np.random.default_rng([plan.seed, index]),
                     run=plan.name,
                     _make_publisher=self._publisher_factory(handle.namespace),
                     _subscribe=self._subscriber_factory(handle.namespace),
                 )
                 plugin = cls(params, ctx, pp.name)
                 self.plugins.append(plugin)
-                period = 0 if not pp.rate else round(1e9 / pp.rate)
+                if role == "renderer":
+                    self.render_plugins[index] = plugin
+                    continue
                 if overrides(plugin, "before_step"):
                     self._before.append(_Hook(plugin.before_step, period))
                 if overrides(plugin, "after_step"):
                     self._after.append(_Hook(plugin.after_step, period, forward=plugin.needs_forward))
+        if role == "renderer":
+            for plugin in self.plugins:
+                plugin.setup()
+            return
         self._clock = self._make_publisher(plan.clock_key, "rosgraph_msgs/msg/Clock")
         self._clock_layout = Layout(
             self._clock.type, msgs.T[self._clock.type](clock=msgs.time_msg(0)), ["clock"]
@@ -322,6 +352,44 @@ class World:
         msg = msgs.T["gazebo_msgs/msg/ContactsState"](header=msgs.header(0, "world"), states=states)
         return Layout(self._contacts.type, msg, ["header.stamp"])
 
+    # ---------------------------------------------------------------------------- renderer processes
+    def _render_hook(self, link: RemoteRender) -> Callable[[int], None]:
+        def send(now: int) -> None:
+            link.send(now, self._state_bytes(), self._should_stop)
+
+        return send
+
+    def _state_bytes(self) -> bytes:
+        """What a renderer needs to pose the world: positions and mocap poses (velocities do not show)."""
+        d = self.data
+        return d.qpos.tobytes() + d.mocap_pos.tobytes() + d.mocap_quat.tobytes()
+
+    def wait_for_renderers(self, timeout_s: float, should_stop: Callable[[], bool]) -> bool:
+        """Until every renderer process listens (True), or the timeout or a stop (False)."""
+        deadline = time.monotonic() + timeout_s
+        while not all(link.listening() for link in self.remote_renders.values()):
+            if time.monotonic() > deadline or should_stop():
+                return False
+            time.sleep(0.02)
+        return True
+
+    def render(self, index: int, now_ns: int, state: bytes) -> None:
+        """In a renderer process: pose the world as the state says and run the plugin's hook."""
+        m, d = self.model, self.data
+        nq, nm = m.nq, m.nmocap
+        values = np.frombuffer(state, dtype=np.float64)
+        d.qpos[:] = values[:nq]
+        if nm:
+            d.mocap_pos[:] = values[nq : nq + 3 * nm].reshape(nm, 3)
+            d.mocap_quat[:] = values[nq + 3 * nm : nq + 7 * nm].reshape(nm, 4)
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_camlight(m, d)
+        self.now_ns = now_ns
+        self.render_plugins[index].after_step(now_ns)
+
+    def published(self) -> dict[str, int]:
+        return {k: o.seq for k, o in self._out.items()}
+
     def _publish_clock(self, now: int) -> None:
         self.publish_cdr(self._clock, self._clock_layout.encode(now), now)
 
@@ -342,6 +410,7 @@ class World:
     ) -> WorldStats:
         plan = self.plan
         m, d = self.model, self.data
+        self._should_stop = should_stop
         end_ns = plan.duration_ns
         factor = {"realtime": 1.0, "max": None}.get(plan.rate, plan.rate)  # type: ignore[arg-type]
         wall0 = time.perf_counter()
@@ -374,14 +443,89 @@ class World:
                     on_progress(self.now_ns)
                 if should_stop():
                     break
+        published = {k: o.seq for k, o in self._out.items()}
+        for link in self.remote_renders.values():
+            link.finish(should_stop)
+            published.update(link.published)
+        wall_s = time.perf_counter() - wall0
         for plugin in self.plugins:
             plugin.close()
-        return WorldStats(
-            steps=steps,
-            sim_ns=self.now_ns,
-            wall_s=time.perf_counter() - wall0,
-            published={k: o.seq for k, o in self._out.items()},
+        for link in self.remote_renders.values():
+            link.close()
+        return WorldStats(steps=steps, sim_ns=self.now_ns, wall_s=wall_s, published=published)
+
+
+class RemoteRender:
+    """The world's end of one rendering plugin that runs in a renderer process.
+
+    At the plugin's times the world sends the state (`<run>/@meta/render/<i>`: sim time + positions);
+    the renderer renders, publishes the frame under the plugin's own topics, and acknowledges
+    (`.../<i>/done`, with its message counts). At most `DEPTH` frames are in flight: the world simulates on
+    while a frame renders, and waits only when the renderer falls behind (lockstep, nothing dropped)."""
+
+    DEPTH = 1
+    TIMEOUT_S = 60.0
+
+    def __init__(self, session: Any, run: str, index: int):
+        import zenoh
+
+        from runner.transport import meta_key
+
+        self.session = session
+        self.alive_key = meta_key(run, "render", "alive")
+        self.index = index
+        self.sent = 0
+        self.acked = 0
+        self.published: dict[str, int] = {}
+        self._cond = threading.Condition()
+        self._pub = session.declare_publisher(
+            meta_key(run, "render", str(index)),
+            congestion_control=zenoh.CongestionControl.BLOCK,
+            reliability=zenoh.Reliability.RELIABLE,
         )
+        self._stop = session.declare_publisher(meta_key(run, "render", "stop"))
+        self._sub = session.declare_subscriber(meta_key(run, "render", str(index), "done"), self._on_done)
+
+    def listening(self) -> bool:
+        """The renderer process holds its liveliness token once it is subscribed and ready."""
+        replies = self.session.liveliness().get(self.alive_key, timeout=1.0)
+        return any(r.ok is not None for r in replies)
+
+    def _on_done(self, sample: Any) -> None:
+        info = json.loads(sample.payload.to_bytes())
+        with self._cond:
+            self.acked = max(self.acked, int(info["n"]))
+            self.published.update(info.get("published", {}))
+            self._cond.notify_all()
+
+    def _wait(self, acked: int, should_stop: Callable[[], bool]) -> None:
+        deadline = time.monotonic() + self.TIMEOUT_S
+        with self._cond:
+            while self.acked < acked:
+                if should_stop():
+                    return
+                if time.monotonic() > deadline:
+                    raise RuntimeError(f"the renderer process did not answer for {self.TIMEOUT_S:.0f} s")
+                self._cond.wait(0.05)
+
+    def send(self, now_ns: int, state: bytes, should_stop: Callable[[], bool]) -> None:
+        self._wait(self.sent - self.DEPTH + 1, should_stop)
+        self._pub.put(_STATE_HEAD.pack(now_ns, self.sent) + state)
+        self.sent += 1
+
+    def finish(self, should_stop: Callable[[], bool]) -> None:
+        """Wait for the frames in flight, so they are published before the world says it has ended."""
+        self._wait(self.sent, should_stop)
+
+    def close(self) -> None:
+        with contextlib.suppress(Exception):
+            self._stop.put(b"")
+        for ent in (self._sub, self._pub, self._stop):
+            with contextlib.suppress(Exception):
+                ent.undeclare()
+
+
+_STATE_HEAD = struct.Struct("<qQ")  # sim time ns, frame number
 
 
 def _next_due(h: _Hook, now: int) -> int:

@@ -87,6 +87,7 @@ class ZenohBus:
     def __init__(self, session: zenoh.Session):
         self.session = session
         self._keep: list[Any] = []
+        self._pubs: list[Any] = []
 
     def publisher(self, key: str, type_name: str) -> Callable[[bytes, bytes], None]:
         pub = self.session.declare_publisher(
@@ -96,6 +97,7 @@ class ZenohBus:
             reliability=zenoh.Reliability.RELIABLE,
         )
         self._keep.append(pub)
+        self._pubs.append(pub)
 
         def send(payload: bytes, attachment: bytes) -> None:
             pub.put(payload, attachment=attachment)
@@ -112,11 +114,16 @@ class ZenohBus:
             self.session.declare_subscriber(key, on_sample, allowed_origin=zenoh.Locality.REMOTE)
         )
 
+    def all_matched(self) -> bool:
+        """Whether every publisher declared so far has a subscriber somewhere."""
+        return all(p.matching_status.matching for p in self._pubs)
+
     def undeclare_all(self) -> None:
         for ent in self._keep:
             with contextlib.suppress(Exception):
                 ent.undeclare()
         self._keep.clear()
+        self._pubs.clear()
 
 
 class MemoryBus:

@@ -1,0 +1,110 @@
+"""A renderer process: `python -m runner.sim.render PLAN.json --connect ENDPOINT`.
+
+Started by `scenario run` when the plan's cameras render in a process of their own (`renderers: process`,
+or `auto` on a machine with more than one core). It builds the same world from the plan but runs only
+the rendering plugins; for each frame the world sends the state (sim time, positions), this process poses
+its copy of the world (`mj_kinematics`), runs the plugin (render, encode, publish under the plugin's own
+topics, stamped with the world's sim time) and acknowledges with its message counts. Rendering thus runs
+on another core while physics goes on; the world waits only when this process falls behind.
+
+It exits when the world says stop, on SIGINT/SIGTERM, or when its parent dies.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import os
+import queue
+import signal
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import zenoh
+
+from runner.plan import RunPlan
+from runner.sim.world import _STATE_HEAD, World
+from runner.transport import ZenohBus, make_config, meta_key
+
+MATCH_TIMEOUT_S = 5.0
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m runner.sim.render")
+    ap.add_argument("plan", type=Path)
+    ap.add_argument("--connect", action="append", default=[], help="Zenoh endpoint of the run's router")
+    args = ap.parse_args(argv)
+
+    plan = RunPlan.model_validate_json(args.plan.read_text())
+    stop = {"signal": None}
+
+    def on_signal(signum: int, _frame: object) -> None:
+        stop["signal"] = signum
+
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+    parent = os.getppid()
+
+    with zenoh.open(make_config("client", connect=args.connect)) as session:
+        bus = ZenohBus(session)
+        subs: list[Any] = []
+        world: World | None = None
+        try:
+            world = World(plan, bus, role="renderer")
+            if plan.record.enabled:
+                # the recorder subscribes before anything starts: wait until it sees our publishers, so the
+                # first frame is not published into the void
+                deadline = time.monotonic() + MATCH_TIMEOUT_S
+                while not bus.all_matched() and time.monotonic() < deadline:
+                    time.sleep(0.005)
+            inbox: queue.SimpleQueue[tuple[str, bytes]] = queue.SimpleQueue()
+
+            def on_state(sample: zenoh.Sample) -> None:
+                inbox.put((str(sample.key_expr), sample.payload.to_bytes()))
+
+            block = zenoh.CongestionControl.BLOCK
+
+            def ack_key(i: int) -> str:
+                return meta_key(plan.name, "render", str(i), "done")
+
+            acks = {
+                i: session.declare_publisher(ack_key(i), congestion_control=block)
+                for i in world.render_plugins
+            }
+            subs += list(acks.values())
+            subs.append(session.declare_subscriber(meta_key(plan.name, "render", "*"), on_state))
+            # last: the world starts stepping once it sees this token
+            subs.append(session.liveliness().declare_token(meta_key(plan.name, "render", "alive")))
+            prefix = meta_key(plan.name, "render", "")
+            frames = dict.fromkeys(world.render_plugins, 0)
+            while stop["signal"] is None and os.getppid() == parent:
+                try:
+                    key, payload = inbox.get(timeout=0.2)
+                except queue.Empty:
+                    continue
+                what = key[len(prefix) :]
+                if what == "stop":
+                    break
+                index = int(what)
+                now_ns, _frame = _STATE_HEAD.unpack_from(payload)
+                world.render(index, now_ns, payload[_STATE_HEAD.size :])
+                frames[index] += 1
+                acks[index].put(json.dumps({"n": frames[index], "published": world.published()}).encode())
+        except Exception as e:  # reported on stderr, which the runner shows
+            print(f"renderer: {type(e).__name__}: {e}", file=sys.stderr)
+            return 1
+        finally:
+            for s in subs:
+                with contextlib.suppress(Exception):
+                    s.undeclare()
+            for plugin in world.plugins if world else []:
+                plugin.close()
+            bus.undeclare_all()
+    return 0 if stop["signal"] is None else 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,104 @@
+"""Cameras rendered in a renderer process of their own (`renderers: process`) give the very frames the
+world process would render itself, on time, none lost; and a renderer that dies fails the run clearly."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+from mcap.reader import make_reader
+
+from tests.conftest import run_cli, scenario_cmd
+
+SCENE = """
+name: cams
+duration: 1.0
+rate: max
+seed: 3
+renderers: {mode}
+world:
+  models:
+    - {{name: crate, shape: box, size: [0.5, 0.5, 0.5], pose: {{xyz: [1.0, 0.2, 0.25]}}, rgba: [0.8, 0.3, 0.1, 1]}}
+robots:
+  - name: r1
+    description: {{file: "{{diffbot}}"}}
+    pose: {{xyz: [0, 0, 0.06]}}
+    plugins:
+      - {{type: diff_drive}}
+      - {{type: camera, params: {{link: lidar_link, pose: {{xyz: [0.04, 0, 0]}}, width: 64, height: 48, rate: 20,
+          noise_stddev: 2.0}}}}
+      - {{type: depth_camera, params: {{link: lidar_link, width: 32, height: 24, rate: 10,
+          image_topic: rgbd/image, info_topic: rgbd/camera_info}}}}
+timeline:
+  - {{t: 0.1, topic: r1/cmd_vel, type: geometry_msgs/msg/Twist, data: {{angular: {{z: 1.0}}}}}}
+"""
+
+
+def _frames(path: Path) -> dict[str, list[tuple[int, bytes]]]:
+    out: dict[str, list[tuple[int, bytes]]] = {}
+    with open(path, "rb") as f:
+        for _, channel, message in make_reader(f).iter_messages():
+            if "image" in channel.topic or "depth" in channel.topic or "camera_info" in channel.topic:
+                out.setdefault(channel.topic, []).append((message.log_time, bytes(message.data)))
+    return out
+
+
+@pytest.mark.timeout(120)
+def test_renderer_process_gives_the_frames_the_world_would(write_scenario, tmp_path: Path) -> None:
+    runs = {}
+    for mode in ("world", "process"):
+        path = write_scenario(SCENE.format(mode=mode), f"{mode}.yaml")
+        mcap = tmp_path / f"{mode}.mcap"
+        proc = run_cli("run", str(path), "--record", str(mcap), "-q", timeout=100)
+        assert proc.returncode == 0, proc.stderr
+        runs[mode] = _frames(mcap)
+    world, apart = runs["world"], runs["process"]
+    assert set(world) == set(apart) and "cams/r1/camera/image_raw" in world, sorted(world)
+    for topic, frames in world.items():
+        rate = 20 if topic in ("cams/r1/camera/image_raw", "cams/r1/camera/camera_info") else 10
+        assert [t for t, _ in frames] == [i * 10**9 // rate for i in range(rate + 1)], topic
+        # same pose, same seeded noise: the same bytes, frame by frame (the robot turns, so frames differ)
+        assert frames == apart[topic], topic
+    images = [data for _, data in world["cams/r1/camera/image_raw"]]
+    assert len(set(images)) > 5
+
+
+@pytest.mark.timeout(60)
+def test_a_renderer_that_dies_fails_the_run_and_keeps_the_recording(write_scenario, tmp_path: Path) -> None:
+    path = write_scenario(
+        SCENE.format(mode="process")
+        .replace("duration: 1.0", "duration: 600")
+        .replace("rate: max", "rate: realtime")
+    )
+    mcap = tmp_path / "run.mcap"
+    proc = subprocess.Popen(
+        scenario_cmd("run", str(path), "--record", str(mcap)),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=dict(os.environ, PYTHONUNBUFFERED="1"),
+    )
+    try:
+        renderer = None
+        deadline = time.monotonic() + 30
+        while renderer is None and time.monotonic() < deadline:
+            time.sleep(0.2)
+            out = subprocess.run(["pgrep", "-f", "runner.sim.render"], capture_output=True, text=True).stdout
+            pids = [int(p) for p in out.split()]
+            renderer = pids[0] if pids else None
+        assert renderer is not None, "no renderer process"
+        time.sleep(1.5)  # some frames first
+        os.kill(renderer, signal.SIGKILL)
+        _out, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode != 0
+    assert "renderer process exited" in err, err[-2000:]
+    assert "Traceback" not in err
+    frames = _frames(mcap)  # finished and readable
+    assert frames.get("cams/r1/camera/image_raw"), sorted(frames)
