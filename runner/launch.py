@@ -112,7 +112,9 @@ def run_plan(
                 recorder = Recorder(Path(plan.record.path), plan.record.include, plan.record.exclude)
             except OSError as e:
                 raise RunError(f"cannot write the recording {plan.record.path}: {e.strerror}") from None
-            subs.append(session.declare_subscriber(f"{plan.name}/**", recorder.on_sample))
+            # the recorder's own FIFO subscriber, drained by its thread; undeclared (after recording what
+            # it still queued) by recorder.close()
+            recorder.subscribe(session, f"{plan.name}/**")
         else:
 
             def on_clock(sample: zenoh.Sample) -> None:
