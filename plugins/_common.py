@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import struct
 from collections.abc import Sequence
 from typing import Any
 
@@ -103,6 +104,10 @@ def drive_topics(params: BaseDriveParams) -> list[Topic]:
     return topics
 
 
+_POSE = struct.Struct("<7d")  # position xyz, orientation xyzw
+_TWIST = struct.Struct("<6d")  # linear xyz, angular xyz
+
+
 class OdometryWriter:
     """Publishes nav_msgs/Odometry with fixed frames (and zero covariances), written in place into a
     fixed layout: a few microseconds a message instead of building message objects."""
@@ -110,11 +115,11 @@ class OdometryWriter:
     def __init__(self, pub: Publisher, frame_id: str, child: str):
         self.pub = pub
         zero = (0.0, 0.0, 0.0)
-        self.layout = pub.layout(
-            odometry(0, frame_id, child, zero, (1.0, 0.0, 0.0, 0.0), zero, zero), ["header.stamp"]
-        )
-        self.pose = self.layout.view("pose.pose")  # position xyz, orientation xyzw
-        self.twist = self.layout.view("twist.twist")  # linear xyz, angular xyz
+        template = odometry(0, frame_id, child, zero, (1.0, 0.0, 0.0, 0.0), zero, zero)
+        self.layout = pub.layout(template, ["header.stamp"])
+        self.buf = self.layout.buf
+        self.pose_at = self.layout.spans["pose.pose"].offset
+        self.twist_at = self.layout.spans["twist.twist"].offset
 
     def publish(
         self,
@@ -124,12 +129,10 @@ class OdometryWriter:
         lin: Sequence[float],
         ang: Sequence[float],
     ) -> None:
-        pose, twist = self.pose, self.twist
-        pose[0:3] = pos
-        pose[3:6] = quat_wxyz[1:4]
-        pose[6] = quat_wxyz[0]
-        twist[0:3] = lin
-        twist[3:6] = ang
+        x, y, z = pos[0], pos[1], pos[2]
+        w, qx, qy, qz = quat_wxyz[0], quat_wxyz[1], quat_wxyz[2], quat_wxyz[3]
+        _POSE.pack_into(self.buf, self.pose_at, x, y, z, qx, qy, qz, w)
+        _TWIST.pack_into(self.buf, self.twist_at, lin[0], lin[1], lin[2], ang[0], ang[1], ang[2])
         self.pub.publish_cdr(self.layout.encode(now_ns), now_ns)
 
 
@@ -154,15 +157,12 @@ class TransformWriter:
 
     def __init__(self, pub: Publisher, parent: str, child: str):
         self.pub = pub
-        self.layout = pub.layout(
-            tf_message(0, parent, child, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)),
-            ["transforms[0].header.stamp"],
-        )
-        self.transform = self.layout.view("transforms[0].transform")  # translation xyz, rotation xyzw
+        template = tf_message(0, parent, child, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0))
+        self.layout = pub.layout(template, ["transforms[0].header.stamp"])
+        self.buf = self.layout.buf
+        self.at = self.layout.spans["transforms[0].transform"].offset
 
     def publish(self, now_ns: int, pos: Sequence[float], quat_wxyz: Sequence[float]) -> None:
-        tf = self.transform
-        tf[0:3] = pos
-        tf[3:6] = quat_wxyz[1:4]
-        tf[6] = quat_wxyz[0]
+        w, qx, qy, qz = quat_wxyz[0], quat_wxyz[1], quat_wxyz[2], quat_wxyz[3]
+        _POSE.pack_into(self.buf, self.at, pos[0], pos[1], pos[2], qx, qy, qz, w)
         self.pub.publish_cdr(self.layout.encode(now_ns), now_ns)

@@ -107,6 +107,13 @@ class Lidar(Plugin):
         self.own = np.asarray(ctx.robot.geom_ids, dtype=np.int64)
         self.own_groups = m.geom_group[self.own].copy()
         self.geomgroup = np.array([1, 0, 1, 1, 1, 1], dtype=np.uint8)
+        self.geom_group = m.geom_group  # a view, looked up once
+        # Rays may stop on a geom they should pass (a visual-only geom outside the hidden group) only if
+        # the world has one: otherwise the per-scan check for it is skipped.
+        visible = m.geom_group != _HIDDEN_GROUP
+        visible[self.own] = False
+        self.may_recast = bool((skip & visible).any())
+        self.vec = np.zeros((n * nv, 3))
         self.pub = ctx.publisher(p.topic, "sensor_msgs/msg/LaserScan")
         template = msgs.T["sensor_msgs/msg/LaserScan"](
             header=msgs.header(0, self.frame_id),
@@ -129,10 +136,11 @@ class Lidar(Plugin):
         p = self.params
         origin = d.site_xpos[self.site].copy()
         rot = d.site_xmat[self.site].reshape(3, 3)
-        vec = (rot @ self.local).T.copy()  # n x 3
+        vec = self.vec  # n x 3, world frame
+        np.dot(self.local.T, rot.T, out=vec)
         # The robot's own geoms go to an excluded group for this one call, so rays pass through them in C
         # instead of being re-cast one by one in Python (a 3D lidar sees its own chassis a lot).
-        m.geom_group[self.own] = _HIDDEN_GROUP
+        self.geom_group[self.own] = _HIDDEN_GROUP
         try:
             mujoco.mj_multiRay(
                 m,
@@ -149,9 +157,13 @@ class Lidar(Plugin):
                 p.range_max,
             )
         finally:
-            m.geom_group[self.own] = self.own_groups
+            self.geom_group[self.own] = self.own_groups
         dist = self.dist.copy()
-        redo = np.nonzero((self.geomid >= 0) & self.skip[np.maximum(self.geomid, 0)])[0]
+        redo = (
+            np.nonzero((self.geomid >= 0) & self.skip[np.maximum(self.geomid, 0)])[0]
+            if self.may_recast
+            else ()
+        )
         if len(redo):
             gid = np.zeros(1, dtype=np.int32)
             for i in redo:
