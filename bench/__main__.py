@@ -48,6 +48,7 @@ from bench.common import (  # noqa: E402
     machine,
     plan_from_file,
     plan_from_text,
+    raw_driving_rate,
     raw_rate,
     say,
     table,
@@ -125,6 +126,7 @@ def two_robots(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str
     rep = args.repeat
     limit = max(raw_rate(plan, steps) for _ in range(rep))
     loop = max(raw_rate(plan, steps, batched=False) for _ in range(rep))
+    driving = max(raw_driving_rate(plan) for _ in range(rep))
     say("  raw MuJoCo done")
     quiet = max(s.steps / s.wall_s for s in (world_on_zenoh(plan) for _ in range(rep)))
     say("  world on Zenoh done")
@@ -137,6 +139,7 @@ def two_robots(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str
     rows = [
         ("raw MuJoCo, batched mj_step (the limit)", limit, limit * dt, 1.0),
         ("raw MuJoCo, mj_step per call from Python", loop, loop * dt, loop / limit),
+        ("raw MuJoCo replaying the run's controls (robots driving)", driving, driving * dt, driving / limit),
         ("world, all plugins publishing, nothing subscribed", quiet, quiet * dt, quiet / limit),
         ("scenario run: world process + Zenoh + MCAP recorder", recorded, recorded * dt, recorded / limit),
         ("  + an external subscriber process", external, external * dt, external / limit),

@@ -88,6 +88,32 @@ def raw_rate(plan: RunPlan, steps: int, *, batched: bool = True) -> float:
     return steps / (time.perf_counter() - t0)
 
 
+def raw_driving_rate(plan: RunPlan) -> float:
+    """Physics steps per second of the same model replaying the controls a run applied (the robots drive,
+    turn and touch as in the run), no plugins: what the physics of the run costs by itself."""
+    from runner.transport import MemoryBus
+
+    world = World(plan, MemoryBus())
+    controls: list[tuple[int, Any]] = []
+    boundary = world._boundary
+
+    def recording_boundary() -> None:
+        boundary()
+        controls.append((world.now_ns // plan.step_ns, world.data.ctrl.copy()))
+
+    world._boundary = recording_boundary  # type: ignore[method-assign]
+    world.run()
+    model = mujoco.MjModel.from_xml_string(plan.mjcf)
+    data = mujoco.MjData(model)
+    total = plan.duration_ns // plan.step_ns
+    t0 = time.perf_counter()
+    for (step, ctrl), nxt in zip(controls, [*[c[0] for c in controls[1:]], total], strict=True):
+        if nxt > step:
+            data.ctrl[:] = ctrl
+            mujoco.mj_step(model, data, nstep=nxt - step)
+    return total / (time.perf_counter() - t0)
+
+
 @contextlib.contextmanager
 def zenoh_session(mode: str = "peer") -> Iterator[Any]:
     """A real Zenoh session on loopback with nothing else on it."""
