@@ -346,7 +346,7 @@ class Scenario(Strict):
         "auto",
         description="Where cameras render: `world` (in the physics process), `process` (a renderer process "
         "of its own, fed the world's state over Zenoh, rendering while physics goes on) or `auto` (a "
-        "renderer process on a machine with more than one core).",
+        "renderer process on a machine with more than two cores).",
     )
     packages: dict[str, str] = Field(
         default_factory=dict,
