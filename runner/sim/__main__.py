@@ -7,17 +7,13 @@ published on each topic and exits.
 
 from __future__ import annotations
 
-import argparse
 import json
-import os
-import signal
 import sys
 import time
-from pathlib import Path
 
 import zenoh
 
-from runner.plan import RunPlan
+from runner.sim.child import StopFlag, parse
 from runner.sim.world import World
 from runner.transport import ZenohBus, make_config, meta_key
 
@@ -25,25 +21,10 @@ READY_TIMEOUT_S = 10.0
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m runner.sim")
-    ap.add_argument("plan", type=Path)
-    ap.add_argument("--connect", action="append", default=[], help="Zenoh endpoint of the run's router")
-    args = ap.parse_args(argv)
+    plan, connect = parse("python -m runner.sim", argv)
+    should_stop = StopFlag()
 
-    plan = RunPlan.model_validate_json(args.plan.read_text())
-    stop = {"signal": None}
-
-    def on_signal(signum: int, _frame: object) -> None:
-        stop["signal"] = signum
-
-    signal.signal(signal.SIGINT, on_signal)
-    signal.signal(signal.SIGTERM, on_signal)
-    parent = os.getppid()
-
-    def should_stop() -> bool:
-        return stop["signal"] is not None or os.getppid() != parent
-
-    with zenoh.open(make_config("client", connect=args.connect)) as session:
+    with zenoh.open(make_config("client", connect=connect)) as session:
         bus = ZenohBus(session)
         try:
             end_pub = session.declare_publisher(
@@ -81,7 +62,7 @@ def main(argv: list[str] | None = None) -> int:
             end_pub.undeclare()
         finally:
             bus.undeclare_all()
-    return 0 if stop["signal"] is None else 130
+    return should_stop.exit_code()
 
 
 if __name__ == "__main__":

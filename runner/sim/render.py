@@ -12,20 +12,16 @@ It exits when the world says stop, on SIGINT/SIGTERM, or when its parent dies.
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import json
-import os
 import queue
-import signal
 import sys
 import time
-from pathlib import Path
 from typing import Any
 
 import zenoh
 
-from runner.plan import RunPlan
+from runner.sim.child import StopFlag, parse
 from runner.sim.world import _STATE_HEAD, World
 from runner.transport import ZenohBus, make_config, meta_key
 
@@ -33,22 +29,10 @@ MATCH_TIMEOUT_S = 5.0
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m runner.sim.render")
-    ap.add_argument("plan", type=Path)
-    ap.add_argument("--connect", action="append", default=[], help="Zenoh endpoint of the run's router")
-    args = ap.parse_args(argv)
+    plan, connect = parse("python -m runner.sim.render", argv)
+    should_stop = StopFlag()
 
-    plan = RunPlan.model_validate_json(args.plan.read_text())
-    stop = {"signal": None}
-
-    def on_signal(signum: int, _frame: object) -> None:
-        stop["signal"] = signum
-
-    signal.signal(signal.SIGINT, on_signal)
-    signal.signal(signal.SIGTERM, on_signal)
-    parent = os.getppid()
-
-    with zenoh.open(make_config("client", connect=args.connect)) as session:
+    with zenoh.open(make_config("client", connect=connect)) as session:
         bus = ZenohBus(session)
         subs: list[Any] = []
         world: World | None = None
@@ -80,7 +64,7 @@ def main(argv: list[str] | None = None) -> int:
             subs.append(session.liveliness().declare_token(meta_key(plan.name, "render", "alive")))
             prefix = meta_key(plan.name, "render", "")
             frames = dict.fromkeys(world.render_plugins, 0)
-            while stop["signal"] is None and os.getppid() == parent:
+            while not should_stop():
                 try:
                     key, payload = inbox.get(timeout=0.2)
                 except queue.Empty:
@@ -103,7 +87,7 @@ def main(argv: list[str] | None = None) -> int:
             for plugin in world.plugins if world else []:
                 plugin.close()
             bus.undeclare_all()
-    return 0 if stop["signal"] is None else 130
+    return should_stop.exit_code()
 
 
 if __name__ == "__main__":
