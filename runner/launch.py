@@ -26,6 +26,7 @@ from typing import Any
 import zenoh
 
 from runner.errors import RunError
+from runner.nodes import NodeError, Nodes
 from runner.plan import RunPlan
 from runner.record import Recorder, TopicStats
 from runner.transport import free_port, make_config, meta_key, unpack_attachment
@@ -104,6 +105,7 @@ def run_plan(
     child: subprocess.Popen[bytes] | None = None
     renderer: subprocess.Popen[bytes] | None = None
     rtail: _StderrTail | None = None
+    nodes: Nodes | None = None
     reason = "completed"
     error: str | None = None
     wall0 = time.perf_counter()
@@ -155,6 +157,14 @@ def run_plan(
             )
             rtail = _StderrTail(renderer.stderr, "[render] ")
             rtail.start()
+        if plan.nodes:
+            # nodes first: they connect and subscribe while the world starts (lockstep nodes are waited for
+            # by the world itself, before its first step)
+            nodes = Nodes(plan, endpoint)
+            try:
+                nodes.start()
+            except NodeError as e:
+                raise RunError(str(e)) from None
         world_env = dict(os.environ) if renders_apart else _world_env(plan)
         # A session of its own: a terminal's Ctrl-C reaches only us, and we stop the world in order.
         child = subprocess.Popen(cmd, stderr=subprocess.PIPE, start_new_session=True, env=world_env)
@@ -164,6 +174,15 @@ def run_plan(
         try:
             while child.poll() is None:
                 time.sleep(0.05)
+                if nodes is not None and error is None and reason == "completed":
+                    ended_by = nodes.check()
+                    if ended_by is not None:
+                        reason, message = ended_by
+                        if reason == "failed":
+                            error = message
+                        # said at once (the full report follows once everything has stopped)
+                        print(message.splitlines()[0] + "; stopping the run", file=sys.stderr, flush=True)
+                        _stop(child)
                 if renderer is not None and renderer.poll() not in (None, 0, 130) and error is None:
                     last = "\n".join(f"  | {ln}" for ln in list(rtail.lines)[-12:]) if rtail else ""
                     error = f"the renderer process exited with code {renderer.returncode}" + (
@@ -204,6 +223,8 @@ def run_plan(
         if child is not None and child.poll() is None:
             _stop(child)
     finally:
+        if nodes is not None:
+            nodes.stop()
         if child is not None and child.poll() is None:
             child.kill()
         if renderer is not None and renderer.poll() is None:

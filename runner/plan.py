@@ -45,6 +45,19 @@ class TimelinePlan(BaseModel):
     data: dict[str, Any]
 
 
+class NodePlan(BaseModel):
+    """A process of the run, its command resolved (`argv[0]` an executable, `cwd` absolute)."""
+
+    name: str
+    argv: list[str]
+    env: dict[str, str] = {}
+    cwd: str
+    namespace: str | None = None
+    respawn: Literal["never", "on-failure"] = "never"
+    respawn_limit: int = 3
+    required: bool = False
+
+
 class RecordPlan(BaseModel):
     enabled: bool
     path: str
@@ -70,6 +83,8 @@ class RunPlan(BaseModel):
     contact_watch: list[str] = []  # robot/model names whose contacts the world publishes on <run>/_contacts
     stop_on: Literal["never", "first_failure", "all_decided"] = "never"
     renderers: Literal["auto", "world", "process"] = "auto"  # the launcher resolves auto
+    nodes: list[NodePlan] = []
+    lockstep: list[str] = []  # node names the world waits for at each step
 
     def renders(self) -> bool:
         """Whether any plugin of the run renders (cameras)."""

@@ -10,7 +10,15 @@ from __future__ import annotations
 import re
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, NonNegativeFloat, PositiveFloat, field_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    NonNegativeFloat,
+    NonNegativeInt,
+    PositiveFloat,
+    field_validator,
+)
 
 SCHEMA_VERSION = 1
 
@@ -327,6 +335,33 @@ Assertion = Annotated[
 ]
 
 
+class Node(Strict):
+    """A process of the run: a controller, a planner, a bridge. It gets the run's Zenoh endpoint, name,
+    its namespace and the clock key in its environment (`SCENARIO_ENDPOINT`, `SCENARIO_RUN`,
+    `SCENARIO_NAMESPACE`, `SCENARIO_CLOCK`, `SCENARIO_NODE`); `runner.node.Node()` reads them."""
+
+    name: Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_-]*$")] = Field(
+        description="Node name (letters, digits, '_', '-'): in logs, `lockstep:` and the run's report."
+    )
+    cmd: str | list[str] = Field(
+        description="The command: a string split like a shell would (`python nodes/go_to_goal.py`), or a "
+        "list. A leading `python` is this interpreter. Relative paths are relative to `cwd`."
+    )
+    args: list[str] = Field(default_factory=list, description="Extra arguments after the command.")
+    env: dict[str, str] = Field(default_factory=dict, description="Extra environment variables.")
+    cwd: str | None = Field(None, description="Working folder (default: the scenario's folder).")
+    namespace: Namespace | None = Field(
+        None, description="The robot namespace it works in (`SCENARIO_NAMESPACE`), e.g. `r1`."
+    )
+    respawn: Literal["never", "on-failure"] = Field(
+        "never", description="Start it again when it exits with an error (up to `respawn_limit` times)."
+    )
+    respawn_limit: NonNegativeInt = Field(3, description="Restarts allowed with `respawn: on-failure`.")
+    required: bool = Field(
+        False, description="The run fails (exit 1) and stops when this node exits before the run ends."
+    )
+
+
 class Scenario(Strict):
     """A robot-simulation scenario: a world, robots with plugins, a timeline, a recording."""
 
@@ -369,6 +404,15 @@ class Scenario(Strict):
     )
     stop_on: Literal["never", "first_failure", "all_decided"] = Field(
         "never", description="End the run early when an assertion fails, or when every one is decided."
+    )
+    nodes: list[Node] = Field(
+        default_factory=list, description="Processes started with the run (controllers, planners...)."
+    )
+    lockstep: list[str] = Field(
+        default_factory=list,
+        description="Nodes the world waits for: before acting on commands at each step, the world waits "
+        "until each of these nodes has handled the clock it last published (a node made with runner.node "
+        "says so when it sleeps). A slow controller cannot be outrun, and a `rate: max` run is repeatable.",
     )
 
     @field_validator("rate", mode="before")

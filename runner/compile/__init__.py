@@ -24,7 +24,16 @@ from runner.compile.xacro_expand import expand
 from runner.errors import Location, Notices, Problem, ScenarioError, SourceError
 from runner.geometry import rpy_to_quat
 from runner.loader import Document, PathKey
-from runner.plan import PluginPlan, RecordPlan, RobotPlan, RunPlan, TimelinePlan, TopicPlan, topic_key
+from runner.plan import (
+    NodePlan,
+    PluginPlan,
+    RecordPlan,
+    RobotPlan,
+    RunPlan,
+    TimelinePlan,
+    TopicPlan,
+    topic_key,
+)
 from runner.plugin import BuildContext, PluginConfigError
 from runner.registry import PluginLookupError, load
 from runner.schema import NoCollision, PluginEntry, Robot, Scenario, WorldModel
@@ -144,7 +153,77 @@ def compile_plan(
         contact_watch=contact_watch,
         stop_on=sc.stop_on,
         renderers=sc.renderers,
+        nodes=_nodes(sc, doc, base),
+        lockstep=list(sc.lockstep),
     )
+
+
+def _nodes(sc: Scenario, doc: Document, base: Path) -> list[NodePlan]:
+    """Nodes with their commands resolved; names unique; `lockstep` names nodes of the scenario."""
+    import shlex
+    import sys
+
+    problems: list[Problem] = []
+    out: list[NodePlan] = []
+    seen: set[str] = set()
+    for i, node in enumerate(sc.nodes):
+        if node.name in seen:
+            where: PathKey = ("nodes", i, "name")
+            problems.append(Problem(f"two nodes named {node.name!r}", doc.locate(where), where))
+        seen.add(node.name)
+        try:
+            argv = shlex.split(node.cmd) if isinstance(node.cmd, str) else list(node.cmd)
+        except ValueError as e:
+            where = ("nodes", i, "cmd")
+            problems.append(Problem(f"cannot split the command: {e}", doc.locate(where), where))
+            continue
+        if not argv:
+            where = ("nodes", i, "cmd")
+            problems.append(
+                Problem("the command is empty", doc.locate(where), where, hint="cmd: python my_node.py")
+            )
+            continue
+        if argv[0] in ("python", "python3"):
+            argv[0] = sys.executable  # the interpreter the runner (and its packages) run in
+        cwd = (base / node.cwd) if node.cwd else base
+        if not cwd.is_dir():
+            where = ("nodes", i, "cwd")
+            problems.append(
+                Problem(
+                    f"folder {str(cwd)!r} does not exist",
+                    doc.locate(where),
+                    where,
+                    hint="relative to the scenario",
+                )
+            )
+        out.append(
+            NodePlan(
+                name=node.name,
+                argv=argv + list(node.args),
+                env=dict(node.env),
+                cwd=str(cwd.resolve()),
+                namespace=node.namespace,
+                respawn=node.respawn,
+                respawn_limit=node.respawn_limit,
+                required=node.required,
+            )
+        )
+    for j, name in enumerate(sc.lockstep):
+        if name not in seen:
+            where = ("lockstep", j)
+            problems.append(
+                Problem(
+                    f"no node named {name!r}",
+                    doc.locate(where),
+                    where,
+                    expected="one of: " + ", ".join(sorted(seen))
+                    if seen
+                    else "a node of this scenario (nodes:)",
+                )
+            )
+    if problems:
+        raise ScenarioError(problems)
+    return out
 
 
 # ------------------------------------------------------------------------------------------------ world

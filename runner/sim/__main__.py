@@ -45,6 +45,8 @@ def main(argv: list[str] | None = None) -> int:
                     return 130
                 print("world: the renderer process is not listening; giving up", file=sys.stderr)
                 return 1
+            # subscribed and set up: nodes (runner.node) wait for this before they publish anything
+            alive = session.liveliness().declare_token(meta_key(plan.name, "world", "alive"))
             session.put(meta_key(plan.name, "world", "ready"), b"{}")
             stats = world.run(should_stop=should_stop)
             reason = "completed" if stats.sim_ns >= plan.duration_ns else "stopped"
@@ -60,6 +62,7 @@ def main(argv: list[str] | None = None) -> int:
                 ).encode()
             )
             end_pub.undeclare()
+            alive.undeclare()
         finally:
             bus.undeclare_all()
     return should_stop.exit_code()

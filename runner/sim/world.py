@@ -25,6 +25,7 @@ import json
 import math
 import queue
 import struct
+import sys
 import threading
 import time
 from collections.abc import Callable
@@ -158,6 +159,8 @@ class World:
         self._local: dict[str, list[tuple[str, Callable[[Any, int], None]]]] = {}
         self._remote_subscribed: set[str] = set()
         self._inbox: queue.SimpleQueue[tuple[str, bytes, bytes | None]] = queue.SimpleQueue()
+        self._received: dict[str, int] = {}  # messages from other processes, per key
+        self._lockstep: Lockstep | None = None
         self.robots = [RobotHandle(self.model, r) for r in plan.robots]
         self.plugins: list[Plugin] = []
         self._before: list[_Hook] = []
@@ -203,6 +206,10 @@ class World:
             for plugin in self.plugins:
                 plugin.setup()
             return
+        self._clock_sent = -1  # the last clock value published
+        if plan.lockstep and session is not None:
+            keys = self._remote_subscribed  # the same set: keys subscribed later count too
+            self._lockstep = Lockstep(session, plan.name, plan.lockstep, self._received, keys)
         self._clock = self._make_publisher(plan.clock_key, "rosgraph_msgs/msg/Clock")
         self._clock_layout = Layout(
             self._clock.type, msgs.T[self._clock.type](clock=msgs.time_msg(0)), ["clock"]
@@ -249,9 +256,18 @@ class World:
             self._local.setdefault(key, []).append((msgs.normalize_type(type_name), callback))
             if key not in self._remote_subscribed:
                 self._remote_subscribed.add(key)
-                self.bus.subscribe(key, lambda k, p, a: self._inbox.put((k, p, a)))
+                self.bus.subscribe(key, self._on_remote)
 
         return subscribe
+
+    def _on_remote(self, key: str, payload: bytes, att: bytes | None) -> None:
+        """A message from another process (a Zenoh thread): queued for the next boundary, and counted, so
+        lockstep knows when everything a node sent has arrived."""
+        self._inbox.put((key, payload, att))
+        self._received[key] = self._received.get(key, 0) + 1
+        lockstep = self._lockstep
+        if lockstep is not None:
+            lockstep.poke()
 
     def _drain_inbox(self) -> None:
         while True:
@@ -280,6 +296,9 @@ class World:
             _t, key, type_name, msg = self._timeline[self._timeline_i]
             self.publish(self._make_publisher(key, type_name), msg, now)
             self._timeline_i += 1
+        if self._lockstep is not None:
+            # the nodes' answers to the clocks published so far come before their next wait message
+            self._lockstep.wait(self._clock_sent, self._should_stop)
         self._drain_inbox()
         for h in self._before:
             if now >= h.next_ns:
@@ -393,6 +412,7 @@ class World:
 
     def _publish_clock(self, now: int) -> None:
         self.publish_cdr(self._clock, self._clock_layout.encode(now), now)
+        self._clock_sent = now
 
     def _next_boundary(self, end_ns: int) -> int:
         nxt = min(end_ns, self.now_ns + MAX_BATCH_NS, self._clock_hook.next_ns)
@@ -414,6 +434,9 @@ class World:
         self._should_stop = should_stop
         # everything built so far lives for the whole run: out of the collector's way (shorter GC pauses)
         gc.freeze()
+        if self._lockstep is not None:
+            # every lockstep node set up (subscribed) and waiting, before the first sensor message
+            self._lockstep.wait(-1, should_stop)
         end_ns = plan.duration_ns
         factor = {"realtime": 1.0, "max": None}.get(plan.rate, plan.rate)  # type: ignore[arg-type]
         wall0 = time.perf_counter()
@@ -446,6 +469,10 @@ class World:
                     on_progress(self.now_ns)
                 if should_stop():
                     break
+        if self._lockstep is not None:
+            # their answers to the last clock are part of the run (recorded), as every earlier one
+            self._lockstep.wait(self._clock_sent, should_stop)
+            self._lockstep.close()
         published = {k: o.seq for k, o in self._out.items()}
         for link in self.remote_renders.values():
             link.finish(should_stop)
@@ -529,6 +556,89 @@ class RemoteRender:
 
 
 _STATE_HEAD = struct.Struct("<qQ")  # sim time ns, frame number
+
+
+class Lockstep:
+    """The world's side of `lockstep:`. Each node named there says, whenever it goes to sleep, the sim
+    time it sleeps until (`<run>/@meta/lockstep/<node>`, int64 ns; runner.node does it in `sleep()`).
+    Before the world takes in commands at a boundary, it waits until every such node sleeps past the last
+    clock it published: the node has seen that instant and answered it. A node whose liveliness token goes
+    away (it died) is no longer waited for; one that never answers stops the run after `TIMEOUT_S`."""
+
+    TIMEOUT_S = 30.0
+
+    def __init__(self, session: Any, run: str, names: list[str], received: dict[str, int], keys: set[str]):
+        from runner.transport import meta_key
+
+        self.waiting: dict[str, int] = {}  # node -> sim time it sleeps until
+        self.sent: dict[str, dict[str, int]] = {}  # node -> messages it had published per key by then
+        self.received = received  # the world's count of messages received per key
+        self.keys = keys  # the keys the world subscribes to
+        self.names = set(names)
+        self._cond = threading.Condition()
+        self._prefix = meta_key(run, "lockstep", "")
+        self._node_prefix = meta_key(run, "node", "")
+        self._seen: set[str] = set()
+        self._subs = [
+            session.declare_subscriber(meta_key(run, "lockstep", "*"), self._on_wait),
+            session.liveliness().declare_subscriber(meta_key(run, "node", "*"), self._on_alive, history=True),
+        ]
+
+    def _on_wait(self, sample: Any) -> None:
+        name = str(sample.key_expr)[len(self._prefix) :]
+        data = sample.payload.to_bytes()
+        (until,) = _WAIT.unpack_from(data)
+        sent = json.loads(data[_WAIT.size :] or b"{}")
+        with self._cond:
+            if until >= self.waiting.get(name, until):
+                self.waiting[name] = until
+                self.sent[name] = sent
+            self._cond.notify_all()
+
+    def poke(self) -> None:
+        with self._cond:
+            self._cond.notify_all()
+
+    def _answered(self, name: str, clock_sent: int) -> bool:
+        """The node sleeps past the last clock and everything it published by then has arrived."""
+        if self.waiting.get(name, -1) <= clock_sent:
+            return False
+        received = self.received
+        return all(received.get(k, 0) >= n for k, n in self.sent.get(name, {}).items() if k in self.keys)
+
+    def _on_alive(self, sample: Any) -> None:
+        import zenoh
+
+        name = str(sample.key_expr)[len(self._node_prefix) :]
+        with self._cond:
+            if sample.kind == zenoh.SampleKind.PUT:
+                self._seen.add(name)
+            elif name in self.names:
+                self.names.discard(name)  # gone: not waited for any more
+                print(
+                    f"world: lockstep node {name!r} is gone; not waiting for it", file=sys.stderr, flush=True
+                )
+            self._cond.notify_all()
+
+    def wait(self, clock_sent: int, should_stop: Callable[[], bool]) -> None:
+        deadline = time.monotonic() + self.TIMEOUT_S
+        with self._cond:
+            while True:
+                late = [n for n in self.names if not self._answered(n, clock_sent)]
+                if not late or should_stop():
+                    return
+                if time.monotonic() > deadline:
+                    who = ", ".join(sorted(late))
+                    raise RuntimeError(f"lockstep node(s) {who} did not answer for {self.TIMEOUT_S:.0f} s")
+                self._cond.wait(0.05)
+
+    def close(self) -> None:
+        for sub in self._subs:
+            with contextlib.suppress(Exception):
+                sub.undeclare()
+
+
+_WAIT = struct.Struct("<q")
 
 
 # The OS may oversleep by a fraction of a millisecond: sleep to just before the deadline, then yield until it.

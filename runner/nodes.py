@@ -1,0 +1,147 @@
+"""The run's node processes (`nodes:`): started before the world, watched while it runs, stopped in order.
+
+Each node gets the run in its environment (`SCENARIO_ENDPOINT`, `SCENARIO_RUN`, `SCENARIO_NAMESPACE`,
+`SCENARIO_NODE`, `SCENARIO_CLOCK`), its output is shown prefixed with its name, and its exit is noticed
+within one poll of the runner (50 ms): a `required` node ends the run (exit 1 unless it ended with 0),
+`respawn: on-failure` starts a failed node again up to `respawn_limit` times.
+"""
+
+from __future__ import annotations
+
+import collections
+import contextlib
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from typing import Any
+
+from runner.plan import NodePlan, RunPlan
+
+STOP_GRACE_S = 3.0
+
+
+class _Output(threading.Thread):
+    """Forwards a node's output line by line, prefixed, and keeps the last lines for a report."""
+
+    def __init__(self, stream: Any, prefix: str):
+        super().__init__(daemon=True)
+        self.stream = stream
+        self.prefix = prefix
+        self.lines: collections.deque[str] = collections.deque(maxlen=30)
+
+    def run(self) -> None:
+        for raw in iter(self.stream.readline, b""):
+            line = raw.decode(errors="replace").rstrip()
+            self.lines.append(line)
+            print(f"{self.prefix}{line}", file=sys.stderr, flush=True)
+
+
+class NodeProcess:
+    def __init__(self, plan: NodePlan, env: dict[str, str]):
+        self.plan = plan
+        self.env = env
+        self.restarts = 0
+        self.finished: int | None = None  # exit code once it is over for good
+        self.proc: subprocess.Popen[bytes] | None = None
+        self.output: _Output | None = None
+
+    def start(self) -> None:
+        try:
+            self.proc = subprocess.Popen(
+                self.plan.argv,
+                cwd=self.plan.cwd,
+                env=self.env,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,  # Ctrl-C reaches the runner only; it stops the nodes in order
+            )
+        except OSError as e:
+            what = f"node {self.plan.name!r} cannot start {self.plan.argv[0]!r}"
+            raise NodeError(f"{what}: {e.strerror}") from None
+        self.output = _Output(self.proc.stdout, f"[{self.plan.name}] ")
+        self.output.start()
+
+    def last_lines(self, n: int = 12) -> str:
+        lines = list(self.output.lines)[-n:] if self.output else []
+        return "\n".join(f"  | {ln}" for ln in lines)
+
+
+class NodeError(RuntimeError):
+    pass
+
+
+class Nodes:
+    def __init__(self, plan: RunPlan, endpoint: str):
+        self.procs: list[NodeProcess] = []
+        for node in plan.nodes:
+            env = dict(os.environ)
+            env.update(
+                {
+                    "SCENARIO_ENDPOINT": endpoint,
+                    "SCENARIO_RUN": plan.name,
+                    "SCENARIO_NAMESPACE": node.namespace or "",
+                    "SCENARIO_NODE": node.name,
+                    "SCENARIO_CLOCK": plan.clock_key,
+                    "PYTHONUNBUFFERED": "1",
+                    # runner.node keeps the world's message order for a node the world waits for
+                    "SCENARIO_LOCKSTEP": "1" if node.name in plan.lockstep else "0",
+                }
+            )
+            env.update(node.env)
+            self.procs.append(NodeProcess(node, env))
+
+    def start(self) -> None:
+        for p in self.procs:
+            p.start()
+
+    def check(self) -> tuple[str, str] | None:
+        """Exits since the last check: restarts what may be restarted; (reason, message) when a required
+        node ended, which ends the run ("failed", or "stopped" if it ended with 0)."""
+        for p in self.procs:
+            if p.finished is not None or p.proc is None or p.proc.poll() is None:
+                continue
+            code = p.proc.returncode
+            if p.output:
+                p.output.join(timeout=0.5)
+            name = p.plan.name
+            if p.plan.required:
+                p.finished = code
+                if code == 0:
+                    return "stopped", f"node {name!r} finished; it is required, so the run ends"
+                last = p.last_lines()
+                message = f"required node {name!r} exited with code {code}"
+                return "failed", message + (f":\n{last}" if last else "")
+            if code != 0 and p.plan.respawn == "on-failure" and p.restarts < p.plan.respawn_limit:
+                p.restarts += 1
+                print(
+                    f"node {name!r} exited with code {code}; starting it again "
+                    f"({p.restarts}/{p.plan.respawn_limit})",
+                    file=sys.stderr,
+                    flush=True,
+                )
+                p.start()
+                continue
+            p.finished = code
+            if code != 0:
+                print(f"node {name!r} exited with code {code}", file=sys.stderr, flush=True)
+        return None
+
+    def stop(self) -> None:
+        """SIGINT to every node still running, then SIGKILL to those still there after a grace period."""
+        running = [p.proc for p in self.procs if p.proc is not None and p.proc.poll() is None]
+        for proc in running:
+            with contextlib.suppress(ProcessLookupError):
+                proc.send_signal(signal.SIGINT)
+        deadline = time.monotonic() + STOP_GRACE_S
+        for proc in running:
+            try:
+                proc.wait(timeout=max(0.0, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+        for p in self.procs:
+            if p.output:
+                p.output.join(timeout=1.0)
