@@ -202,18 +202,22 @@ def run_plan(
             reason = "interrupted"
             _stop(child)
         tail.join(timeout=1.0)
+        world_died = child.returncode not in (0, 130) and reason != "interrupted"
+        if world_died and error is None:
+            reason = "failed"
+            last = "\n".join(f"  | {ln}" for ln in list(tail.lines)[-12:])
+            error = f"the world process exited with code {child.returncode}" + (f":\n{last}" if last else "")
+            # said at once (the full report follows once everything has stopped)
+            print(error.splitlines()[0] + "; stopping the run", file=sys.stderr, flush=True)
         if renderer is not None:
             try:
-                renderer.wait(timeout=STOP_GRACE_S)  # the world told it to stop
+                # the world told it to stop; a world that died could not
+                renderer.wait(timeout=0.0 if world_died else STOP_GRACE_S)
             except subprocess.TimeoutExpired:
                 _stop(renderer)
             if rtail:
                 rtail.join(timeout=1.0)
-        if child.returncode not in (0, 130) and reason != "interrupted" and error is None:
-            reason = "failed"
-            last = "\n".join(f"  | {ln}" for ln in list(tail.lines)[-12:])
-            error = f"the world process exited with code {child.returncode}" + (f":\n{last}" if last else "")
-        if recorder is not None:
+        if recorder is not None and not world_died:
             try:
                 _drain(recorder, ended, end_info)
             except KeyboardInterrupt:

@@ -240,13 +240,16 @@ def test_a_dead_world_process_fails_the_run_and_keeps_the_recording(tmp_path: Pa
     try:
         children = _children(proc.pid)
         assert len(children) == 1
+        killed = time.monotonic()
         os.kill(children[0], signal.SIGKILL)
         out, err = proc.communicate(timeout=10)
+        ended = time.monotonic()
     finally:
         if proc.poll() is None:
             proc.kill()
     assert proc.returncode == 1
     assert "world process exited with code -9" in err
+    assert ended - killed < 1.0, ended - killed  # noticed, reported, recording finished: within a second
     assert "Traceback" not in err
     assert "failed" in out
     assert any(topic == "two_robots/r1/scan" for topic, _, _, _ in read_mcap(mcap))
