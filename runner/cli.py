@@ -91,6 +91,28 @@ def validate(
     for t in plan.topics():
         topics.add_row(t.key, t.type, t.direction, f"{t.rate:g}" if t.rate else "-", t.owner)
     out.print(topics)
+    if plan.nodes:
+        nodes = Table(
+            "node",
+            "command",
+            "namespace",
+            "required",
+            "respawn",
+            "lockstep",
+            title="Nodes",
+            title_justify="left",
+        )
+        for n in plan.nodes:
+            argv = [Path(n.argv[0]).name, *n.argv[1:]]
+            nodes.add_row(
+                n.name,
+                " ".join(argv),
+                n.namespace or "-",
+                "yes" if n.required else "no",
+                n.respawn if n.respawn == "never" else f"{n.respawn} (up to {n.respawn_limit})",
+                "yes" if n.name in plan.lockstep else "no",
+            )
+        out.print(nodes)
     if plan.timeline:
         out.print(
             f"timeline: {len(plan.timeline)} message(s) from t={plan.timeline[0].t_ns / 1e9:g} s "

@@ -195,6 +195,20 @@ def test_node_mistakes_point_at_the_scenario_line(write_scenario, tmp_path: Path
     assert "Traceback" not in proc.stderr
 
 
+@pytest.mark.timeout(60)
+def test_a_command_that_does_not_exist_is_a_validation_error(write_scenario, tmp_path: Path) -> None:
+    path = _scene(write_scenario, tmp_path)
+    path.write_text(path.read_text().replace("cmd: python node.py", "cmd: no_such_program_xyz --fast"))
+    for command in ("validate", "run"):
+        proc = run_cli(command, str(path))
+        assert proc.returncode != 0
+        said = proc.stderr + proc.stdout
+        assert re.search(
+            r"scenario\.yaml:\d+:\d+: nodes\[0\]\.cmd: command 'no_such_program_xyz' not found", said
+        ), said
+        assert "Traceback" not in said
+
+
 @pytest.mark.timeout(120)
 def test_the_go_to_goal_example_reaches_its_goal(tmp_path: Path) -> None:
     proc = run_cli(

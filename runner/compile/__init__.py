@@ -161,6 +161,7 @@ def compile_plan(
 def _nodes(sc: Scenario, doc: Document, base: Path) -> list[NodePlan]:
     """Nodes with their commands resolved; names unique; `lockstep` names nodes of the scenario."""
     import shlex
+    import shutil
     import sys
 
     problems: list[Problem] = []
@@ -186,6 +187,18 @@ def _nodes(sc: Scenario, doc: Document, base: Path) -> list[NodePlan]:
         if argv[0] in ("python", "python3"):
             argv[0] = sys.executable  # the interpreter the runner (and its packages) run in
         cwd = (base / node.cwd) if node.cwd else base
+        exe = argv[0]
+        if cwd.is_dir() and shutil.which(exe) is None and shutil.which(str(cwd / exe)) is None:
+            where = ("nodes", i, "cmd")
+            problems.append(
+                Problem(
+                    f"command {exe!r} not found",
+                    doc.locate(where),
+                    where,
+                    expected="a program on PATH, or an executable file relative to the node's cwd",
+                    hint="for a Python script: cmd: python my_node.py",
+                )
+            )
         if not cwd.is_dir():
             where = ("nodes", i, "cwd")
             problems.append(
