@@ -14,6 +14,7 @@ Sections (in order):
 - cameras: the demo plus one 320x240 RGB camera per robot at 10 Hz, recorded.
 - realtime: `rate: realtime` for 60 s (10 s with --quick): the factor overall and over its worst second,
   and the delay from a `cmd_vel` put by another process to the controller acting on it.
+- lockstep: the go-to-goal example with its controller node in lockstep with the world, and free-running.
 - recorder: messages/s the recorder sustains from another process, with sequence numbers checked.
 - plugins: per-plugin cost per call, camera frames/s, lidar rays/s (bench/plugins.py).
 
@@ -58,7 +59,7 @@ from runner.launch import run_plan  # noqa: E402
 from runner.plan import RunPlan  # noqa: E402
 from runner.transport import free_port  # noqa: E402
 
-SECTIONS = ("two_robots", "scaling", "messages", "cameras", "realtime", "recorder", "plugins")
+SECTIONS = ("two_robots", "scaling", "messages", "cameras", "realtime", "lockstep", "recorder", "plugins")
 
 
 # ------------------------------------------------------------------------------------------- helpers
@@ -496,6 +497,32 @@ def realtime(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     return doc, text
 
 
+def lockstep(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
+    """The go-to-goal example: its controller node in lockstep with the world, and free-running."""
+    from bench.common import REPO as repo
+
+    seconds = 15.0
+    path = repo / "scenarios" / "go_to_goal.yaml"
+    stepped = plan_from_file(path, seconds=seconds)
+    free = plan_from_file(path, seconds=seconds)
+    free.lockstep = []
+    dt = stepped.step_ns / 1e9
+    rates = {}
+    for label, plan in (("lockstep", stepped), ("free", free)):
+        rates[label] = max(_full_run(plan, tmp, f"{label}{i}")[0] for i in range(args.repeat)) * dt
+    rows = [
+        ("controller node in lockstep (repeatable)", rates["lockstep"]),
+        ("controller node free-running (rate: max outruns it)", rates["free"]),
+    ]
+    text = table(
+        f"lockstep: go_to_goal, a robot and its controller node at 10 Hz, {seconds:g} s sim, "
+        f"best of {args.repeat}",
+        ("", "× real time"),
+        rows,
+    )
+    return {"sim_seconds": seconds, "x_real_time": rates}, text
+
+
 def recorder(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     from bench import recorder as rec
 
@@ -520,6 +547,7 @@ RUNNERS = {
     "messages": messages,
     "cameras": cameras,
     "realtime": realtime,
+    "lockstep": lockstep,
     "recorder": recorder,
     "plugins": plugins,
 }

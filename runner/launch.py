@@ -174,7 +174,8 @@ def run_plan(
         try:
             while child.poll() is None:
                 time.sleep(0.05)
-                if nodes is not None and error is None and reason == "completed":
+                # once the world has ended, nodes leave on their own (runner.node sees the end): not a failure
+                if nodes is not None and error is None and reason == "completed" and not ended.is_set():
                     ended_by = nodes.check()
                     if ended_by is not None:
                         reason, message = ended_by
