@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+from importlib.metadata import EntryPoint
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 import pytest
 
-from runner import msgs
+from runner import msgs, registry
 from runner.cdr import Layout, LayoutError
+from runner.plugin import Plugin, Topic
 from runner.sim.world import World
 from runner.transport import MemoryBus
 from tests.helpers import messages, plan_of
@@ -217,3 +219,56 @@ def test_every_builtin_publisher_sends_what_rosbags_would_encode() -> None:
         assert by_type.get(type_name, 0) > 0, type_name
     stamps = [t for t, _m in messages(bus, "r1/imu")]
     assert stamps == list(range(0, 1_000_000_001, 10_000_000))  # 100 Hz, on the dot, from 0 to 1 s
+
+
+# ------------------------------------------------------------------- local subscribers of fixed layouts
+class ScanListener(Plugin):
+    """A plugin of the same world that subscribes to the lidar's scan (published through a fixed layout)."""
+
+    heard: ClassVar[list[tuple[int, Any]]] = []
+
+    @classmethod
+    def build(cls, params: Any, ctx: Any, name: str) -> list[Topic]:
+        return [Topic("scan", "sensor_msgs/msg/LaserScan", "sub")]
+
+    def setup(self) -> None:
+        self.ctx.subscribe(
+            "scan", "sensor_msgs/msg/LaserScan", lambda msg, t: ScanListener.heard.append((t, msg))
+        )
+
+
+def test_a_local_subscriber_gets_the_fixed_layout_messages_decoded(
+    monkeypatch: pytest.MonkeyPatch, write_scenario: Any
+) -> None:
+    group = registry.GROUP
+    builtin = list(registry.entry_points(group=group))
+    extra = EntryPoint(name="scan_listener", value="tests.test_cdr:ScanListener", group=group)
+    monkeypatch.setattr(registry, "entry_points", lambda group: [*builtin, extra])
+    registry._entry_points.cache_clear()
+    registry.load.cache_clear()
+    ScanListener.heard.clear()
+    try:
+        path = write_scenario(
+            """
+            name: local
+            duration: 0.5
+            rate: max
+            robots:
+              - name: r1
+                description: "{diffbot}"
+                pose: {xyz: [0, 0, 0.06]}
+                plugins:
+                  - {type: lidar, params: {link: lidar_link, samples: 90, rate: 10}}
+                  - {type: scan_listener}
+            """
+        )
+        bus = MemoryBus()
+        World(plan_of(path), bus).run()
+    finally:
+        registry._entry_points.cache_clear()
+        registry.load.cache_clear()
+    sent = [(t, m) for t, m in messages(bus, "r1/scan")]
+    assert len(sent) == 6 and len(ScanListener.heard) == 6
+    for (t1, a), (t2, b) in zip(sent, ScanListener.heard, strict=True):
+        assert t1 == t2
+        assert msgs.encode(a, "sensor_msgs/msg/LaserScan") == msgs.encode(b, "sensor_msgs/msg/LaserScan")
