@@ -141,7 +141,7 @@ def run_plan(
         subs.append(session.declare_subscriber(meta_key(plan.name, "**"), on_meta))
         stop_early = threading.Event()
         if judge is not None:
-            subs += _judge_subscribers(session, plan, judge, stop_early)
+            subs += _judge_subscribers(session, plan, judge, stop_early, recorder)
 
         with tempfile.NamedTemporaryFile("w", suffix=".plan.json", delete=False) as f:
             f.write(plan.model_dump_json())
@@ -256,29 +256,39 @@ def run_plan(
     )
 
 
-def _judge_subscribers(session: Any, plan: RunPlan, judge: Any, stop_early: threading.Event) -> list[Any]:
-    """Decode what the judge reads and feed it; with `stop_on`, say when the run can end."""
+def _judge_subscribers(
+    session: Any, plan: RunPlan, judge: Any, stop_early: threading.Event, recorder: Recorder | None = None
+) -> list[Any]:
+    """Decode what the judge reads and feed it; with `stop_on`, say when the run can end. Keys the recorder
+    records come from it, in its order and thread (no subscription of their own); others are subscribed."""
     from runner import msgs
     from runner.checks.judge import judged_types
 
     types = judged_types(plan)
     lock = threading.Lock()
-    subs = []
-    for key in sorted(judge.keys):
-        type_name = types[key]
 
-        def on_sample(sample: zenoh.Sample, type_name: str = type_name) -> None:
+    def feed(key: str, stamp_ns: int, payload: bytes) -> None:
+        msg = msgs.decode(payload, types[key])
+        with lock:
+            judge.feed(key, stamp_ns, msg)
+            if (plan.stop_on == "first_failure" and judge.failed()) or (
+                plan.stop_on == "all_decided" and judge.all_decided()
+            ):
+                stop_early.set()
+
+    keys = sorted(judge.keys)
+    if recorder is not None:
+        tapped = [k for k in keys if recorder.wanted(k)]
+        recorder.tap(tapped, feed)
+        keys = [k for k in keys if k not in tapped]
+    subs = []
+    for key in keys:
+
+        def on_sample(sample: zenoh.Sample) -> None:
             att = sample.attachment
             parsed = unpack_attachment(att.to_bytes()) if att is not None else None
-            if parsed is None:
-                return
-            msg = msgs.decode(sample.payload.to_bytes(), type_name)
-            with lock:
-                judge.feed(str(sample.key_expr), parsed[1], msg)
-                if (plan.stop_on == "first_failure" and judge.failed()) or (
-                    plan.stop_on == "all_decided" and judge.all_decided()
-                ):
-                    stop_early.set()
+            if parsed is not None:
+                feed(str(sample.key_expr), parsed[1], sample.payload.to_bytes())
 
         subs.append(session.declare_subscriber(key, on_sample))
     return subs

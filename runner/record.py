@@ -24,6 +24,7 @@ import sys
 import threading
 import zlib
 from array import array
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
@@ -311,6 +312,14 @@ class Recorder:
         self.rejected = 0  # samples the drain thread could not record (an exception each)
         self._subscriber: Any = None
         self._drainer: threading.Thread | None = None
+        self._taps: dict[str, Callable[[str, int, bytes], None]] = {}
+        self.tap_errors = 0
+
+    def tap(self, keys: Iterable[str], fn: Callable[[str, int, bytes], None]) -> None:
+        """Also hand each recorded message of `keys` to `fn(key, sim time ns, payload)`, in order, as it is
+        recorded (the live judge reads the run this way: no subscriptions, threads or copies of its own)."""
+        for key in keys:
+            self._taps[key] = fn
 
     # ------------------------------------------------------------------------------------------- input
     def wanted(self, key: str) -> bool:
@@ -424,6 +433,15 @@ class Recorder:
         if st.first_ns is None:
             st.first_ns = stamp
         st.last_ns = stamp
+        if self._taps:
+            tap = self._taps.get(st.key)
+            if tap is not None:
+                try:
+                    tap(st.key, stamp, payload)
+                except Exception as e:  # the reader's mistake must not stop the recording
+                    self.tap_errors += 1
+                    if self.tap_errors == 1:
+                        print(f"recorder: a reader of {st.key} failed: {e!r}", file=sys.stderr, flush=True)
 
     def _register(self, key: str, type_name: str) -> _Channel:
         schema_id = self._schemas.get(type_name)

@@ -329,7 +329,8 @@ class World:
         names = sorted(set(owners))  # ids in name order: pairs (lo, hi) by id are sorted by name
         self._owner_names = names
         self._owner_ids = np.array([names.index(o) for o in owners], dtype=np.int64)
-        self._watched = np.array([n in watch for n in names])
+        self._owner_list: list[int] = self._owner_ids.tolist()
+        self._watched_list = [n in watch for n in names]
         self._contact_layouts: dict[tuple[int, ...], Layout] = {}
         self._contacts = self._make_publisher(contacts_key(self.plan.name), "gazebo_msgs/msg/ContactsState")
         self._after.append(_Hook(self._publish_contacts, round(1e9 / CONTACTS_RATE)))
@@ -340,13 +341,15 @@ class World:
         d = self.data
         pairs: tuple[int, ...] = ()
         if d.ncon:
-            ids = self._owner_ids
-            o1, o2 = ids[d.contact.geom1], ids[d.contact.geom2]
-            keep = (o1 != o2) & (self._watched[o1] | self._watched[o2])
-            if keep.any():
-                o1, o2 = o1[keep], o2[keep]
-                k = len(self._owner_names)
-                pairs = tuple(sorted(set((np.minimum(o1, o2) * k + np.maximum(o1, o2)).tolist())))
+            # a few dozen contacts at most: plain Python over the list beats numpy's per-call overhead
+            owner, watched, k = self._owner_list, self._watched_list, len(self._owner_names)
+            found = set()
+            for a, b in d.contact.geom.tolist():
+                oa, ob = owner[a], owner[b]
+                if oa != ob and (watched[oa] or watched[ob]):
+                    found.add(oa * k + ob if oa < ob else ob * k + oa)
+            if found:
+                pairs = tuple(sorted(found))
         layout = self._contact_layouts.get(pairs)
         if layout is None:
             layout = self._contact_layouts[pairs] = self._contacts_layout(pairs)
