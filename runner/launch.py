@@ -74,6 +74,94 @@ class _StderrTail(threading.Thread):
             print(f"{self.prefix}{line}", file=sys.stderr, flush=True)
 
 
+class _WorldPart:
+    """One world of the run: its plan, its process (and renderer process), what it announced."""
+
+    def __init__(self, plan: RunPlan, label: str):
+        self.plan = plan
+        self.label = label  # "world" or "world <name>"
+        self.plan_file: str | None = None
+        self.child: subprocess.Popen[bytes] | None = None
+        self.tail: _StderrTail | None = None
+        self.renderer: subprocess.Popen[bytes] | None = None
+        self.rtail: _StderrTail | None = None
+        self.ended = threading.Event()
+        self.ready = threading.Event()
+        self.end_info: dict[str, Any] = {}
+        self.died = False
+
+    def on_meta(self, sample: zenoh.Sample) -> None:
+        key = str(sample.key_expr)
+        if key.endswith("/world/end"):
+            self.end_info.update(json.loads(sample.payload.to_bytes()))
+            self.ended.set()
+        elif key.endswith("/world/ready"):
+            self.ready.set()
+
+    def start(self, endpoint: str) -> None:
+        plan = self.plan
+        with tempfile.NamedTemporaryFile("w", suffix=".plan.json", delete=False) as f:
+            f.write(plan.model_dump_json())
+            self.plan_file = f.name
+        renders_apart = plan.renderers == "process" and plan.renders()
+        if renders_apart:
+            # cameras render in a process of their own, fed the world's state (runner/sim/render.py)
+            rcmd = [sys.executable, "-m", "runner.sim.render", self.plan_file, "--connect", endpoint]
+            self.renderer = subprocess.Popen(
+                rcmd, stderr=subprocess.PIPE, start_new_session=True, env=_world_env(plan)
+            )
+            self.rtail = _StderrTail(self.renderer.stderr, f"[{self.label.replace('world', 'render')}] ")
+            self.rtail.start()
+        world_env = dict(os.environ) if renders_apart else _world_env(plan)
+        cmd = [sys.executable, "-m", "runner.sim", self.plan_file, "--connect", endpoint]
+        # A session of its own: a terminal's Ctrl-C reaches only us, and we stop the world in order.
+        self.child = subprocess.Popen(cmd, stderr=subprocess.PIPE, start_new_session=True, env=world_env)
+        self.tail = _StderrTail(self.child.stderr, f"[{self.label}] ")
+        self.tail.start()
+
+    def running(self) -> bool:
+        return self.child is not None and self.child.poll() is None
+
+    def stop(self) -> None:
+        if self.running():
+            _stop(self.child)  # type: ignore[arg-type]
+
+    def renderer_error(self) -> str | None:
+        r = self.renderer
+        if r is None or r.poll() in (None, 0, 130):
+            return None
+        last = "\n".join(f"  | {ln}" for ln in list(self.rtail.lines)[-12:]) if self.rtail else ""
+        return f"the renderer process exited with code {r.returncode}" + (f":\n{last}" if last else "")
+
+    def finish(self, interrupted: bool) -> str | None:
+        """After the world process exited: its error if it died, and the renderer stopped."""
+        assert self.child is not None and self.tail is not None
+        self.tail.join(timeout=1.0)
+        error = None
+        self.died = self.child.returncode not in (0, 130) and not interrupted
+        if self.died:
+            last = "\n".join(f"  | {ln}" for ln in list(self.tail.lines)[-12:])
+            error = f"the {self.label} process exited with code {self.child.returncode}" + (
+                f":\n{last}" if last else ""
+            )
+        if self.renderer is not None:
+            try:
+                # the world told it to stop; a world that died could not
+                self.renderer.wait(timeout=0.0 if self.died else STOP_GRACE_S)
+            except subprocess.TimeoutExpired:
+                _stop(self.renderer)
+            if self.rtail:
+                self.rtail.join(timeout=1.0)
+        return error
+
+    def cleanup(self) -> None:
+        for proc in (self.child, self.renderer):
+            if proc is not None and proc.poll() is None:
+                proc.kill()
+        if self.plan_file:
+            os.unlink(self.plan_file)
+
+
 def run_plan(
     plan: RunPlan,
     *,
@@ -82,34 +170,36 @@ def run_plan(
     on_progress: Callable[[int, float], None] | None = None,
     judge: Any = None,
 ) -> RunResult:
-    """Run a plan; with a `judge` (runner.checks.judge.Judge), feed it every message it asks for, live, and
-    stop the world early when the plan's `stop_on` says so."""
+    """Run a plan (one world, or `plan.worlds`, each a process of its own behind one router and one
+    recorder); with a `judge` (runner.checks.judge.Judge), feed it every message it asks for, live, and
+    stop the worlds early when the plan's `stop_on` says so."""
     listen = list(listen) or [f"tcp/127.0.0.1:{free_port()}"]
     if plan.renderers == "auto":
         # A renderer process pays where rendering does not already take every core: Mesa's llvmpipe renders
         # on all cores of a 2-core machine, and the two placements measure the same there (bench cameras).
-        plan = plan.model_copy(update={"renderers": "process" if (os.cpu_count() or 1) > 2 else "world"})
+        renderers = "process" if (os.cpu_count() or 1) > 2 else "world"
+        plan = plan.model_copy(update={"renderers": renderers})
+        if plan.worlds:
+            plan.worlds = [w.model_copy(update={"renderers": renderers}) for w in plan.worlds]
     conf = make_config("router", listen=listen, connect=connect)
     try:
         session = zenoh.open(conf)
     except zenoh.ZError as e:
         raise RunError(f"cannot open the Zenoh network on {', '.join(listen)}: {e}") from None
 
+    parts = (
+        [_WorldPart(w, f"world {w.name.rsplit('/', 1)[-1]}") for w in plan.worlds]
+        if plan.worlds
+        else [_WorldPart(plan, "world")]
+    )
     recorder: Recorder | None = None
     latest = {"ns": 0}
-    end_info: dict[str, Any] = {}
-    ended = threading.Event()
-    ready = threading.Event()
     started = {"at": 0.0}
     subs: list[Any] = []
-    child: subprocess.Popen[bytes] | None = None
-    renderer: subprocess.Popen[bytes] | None = None
-    rtail: _StderrTail | None = None
     nodes: Nodes | None = None
     reason = "completed"
     error: str | None = None
     wall0 = time.perf_counter()
-    plan_file = None
     try:
         if plan.record.enabled:
             try:
@@ -125,38 +215,17 @@ def run_plan(
                 att = sample.attachment
                 parsed = unpack_attachment(att.to_bytes()) if att is not None else None
                 if parsed:
-                    latest["ns"] = parsed[1]
+                    latest["ns"] = max(latest["ns"], parsed[1])
 
-            subs.append(session.declare_subscriber(plan.clock_key, on_clock))
-
-        def on_meta(sample: zenoh.Sample) -> None:
-            key = str(sample.key_expr)
-            if key.endswith("/world/end"):
-                end_info.update(json.loads(sample.payload.to_bytes()))
-                ended.set()
-            elif key.endswith("/world/ready"):
-                started["at"] = time.perf_counter()
-                ready.set()
-
-        subs.append(session.declare_subscriber(meta_key(plan.name, "**"), on_meta))
+            for part in parts:
+                subs.append(session.declare_subscriber(part.plan.clock_key, on_clock))
+        for part in parts:
+            subs.append(session.declare_subscriber(meta_key(part.plan.name, "**"), part.on_meta))
         stop_early = threading.Event()
         if judge is not None:
             subs += _judge_subscribers(session, plan, judge, stop_early, recorder)
 
-        with tempfile.NamedTemporaryFile("w", suffix=".plan.json", delete=False) as f:
-            f.write(plan.model_dump_json())
-            plan_file = f.name
         endpoint = _connectable(listen[0])
-        cmd = [sys.executable, "-m", "runner.sim", plan_file, "--connect", endpoint]
-        renders_apart = plan.renderers == "process" and plan.renders()
-        if renders_apart:
-            # cameras render in a process of their own, fed the world's state (runner/sim/render.py)
-            rcmd = [sys.executable, "-m", "runner.sim.render", plan_file, "--connect", endpoint]
-            renderer = subprocess.Popen(
-                rcmd, stderr=subprocess.PIPE, start_new_session=True, env=_world_env(plan)
-            )
-            rtail = _StderrTail(renderer.stderr, "[render] ")
-            rtail.start()
         if plan.nodes:
             # nodes first: they connect and subscribe while the world starts (lockstep nodes are waited for
             # by the world itself, before its first step)
@@ -165,92 +234,96 @@ def run_plan(
                 nodes.start()
             except NodeError as e:
                 raise RunError(str(e)) from None
-        world_env = dict(os.environ) if renders_apart else _world_env(plan)
-        # A session of its own: a terminal's Ctrl-C reaches only us, and we stop the world in order.
-        child = subprocess.Popen(cmd, stderr=subprocess.PIPE, start_new_session=True, env=world_env)
-        tail = _StderrTail(child.stderr, "[world] ")
-        tail.start()
+        for part in parts:
+            part.start(endpoint)
         wall0 = time.perf_counter()
+        interrupted = False
+
+        def stop_all() -> None:
+            for p in parts:
+                p.stop()
+
         try:
-            while child.poll() is None:
+            while any(p.running() for p in parts):
                 time.sleep(0.05)
-                # once the world has ended, nodes leave on their own (runner.node sees the end): not a failure
-                if nodes is not None and error is None and reason == "completed" and not ended.is_set():
-                    ended_by = nodes.check()
+                all_ready = all(p.ready.is_set() for p in parts)
+                if all_ready and not started["at"]:
+                    started["at"] = time.perf_counter()
+                # once the worlds have ended, nodes leave on their own (runner.node sees the end): no failure
+                nodes_may_fail = nodes is not None and error is None and reason == "completed"
+                if nodes_may_fail and not any(p.ended.is_set() for p in parts):
+                    ended_by = nodes.check()  # type: ignore[union-attr]
                     if ended_by is not None:
                         reason, message = ended_by
                         if reason == "failed":
                             error = message
                         # said at once (the full report follows once everything has stopped)
                         print(message.splitlines()[0] + "; stopping the run", file=sys.stderr, flush=True)
-                        _stop(child)
-                if renderer is not None and renderer.poll() not in (None, 0, 130) and error is None:
-                    last = "\n".join(f"  | {ln}" for ln in list(rtail.lines)[-12:]) if rtail else ""
-                    error = f"the renderer process exited with code {renderer.returncode}" + (
-                        f":\n{last}" if last else ""
-                    )
-                    reason = "failed"
-                    _stop(child)
-                if on_progress is not None and ready.is_set():
+                        stop_all()
+                for p in parts:
+                    died = p.child is not None and p.child.poll() not in (None, 0, 130)
+                    if died and error is None and reason == "completed" and len(parts) > 1:
+                        stop_all()  # one world died: the others stop too (its report follows)
+                    rerr = p.renderer_error()
+                    if rerr is not None and error is None:
+                        error, reason = rerr, "failed"
+                        stop_all()
+                if on_progress is not None and all_ready:
                     sim_ns = recorder.latest_ns if recorder else latest["ns"]
                     on_progress(sim_ns, time.perf_counter() - started["at"])
-                if not ready.is_set() and time.perf_counter() - wall0 > START_TIMEOUT_S:
+                if not all_ready and time.perf_counter() - wall0 > START_TIMEOUT_S:
                     raise RunError(f"the world process did not start within {START_TIMEOUT_S:.0f} s")
-                if stop_early.is_set():
+                if stop_early.is_set() and reason == "completed":
                     reason = "stopped"
-                    _stop(child)
+                    stop_all()
         except KeyboardInterrupt:
             reason = "interrupted"
-            _stop(child)
-        tail.join(timeout=1.0)
-        world_died = child.returncode not in (0, 130) and reason != "interrupted"
-        if world_died and error is None:
-            reason = "failed"
-            last = "\n".join(f"  | {ln}" for ln in list(tail.lines)[-12:])
-            error = f"the world process exited with code {child.returncode}" + (f":\n{last}" if last else "")
-            # said at once (the full report follows once everything has stopped)
-            print(error.splitlines()[0] + "; stopping the run", file=sys.stderr, flush=True)
-        if renderer is not None:
+            interrupted = True
+            stop_all()
+        for part in parts:
+            perr = part.finish(interrupted or reason == "interrupted")
+            if perr is not None and (error is None or reason == "completed"):
+                reason, error = "failed", perr
+                # said at once (the full report follows once everything has stopped)
+                print(perr.splitlines()[0] + "; stopping the run", file=sys.stderr, flush=True)
+            elif perr is not None and reason == "failed" and not error:
+                error = perr
+        if recorder is not None and not any(p.died for p in parts):
             try:
-                # the world told it to stop; a world that died could not
-                renderer.wait(timeout=0.0 if world_died else STOP_GRACE_S)
-            except subprocess.TimeoutExpired:
-                _stop(renderer)
-            if rtail:
-                rtail.join(timeout=1.0)
-        if recorder is not None and not world_died:
-            try:
-                _drain(recorder, ended, end_info)
+                for part in parts:
+                    _drain(recorder, part.ended, part.end_info)
             except KeyboardInterrupt:
                 reason = "interrupted"
     except KeyboardInterrupt:
         reason = "interrupted"
-        if child is not None and child.poll() is None:
-            _stop(child)
+        for part in parts:
+            part.stop()
     finally:
         if nodes is not None:
             nodes.stop()
-        if child is not None and child.poll() is None:
-            child.kill()
-        if renderer is not None and renderer.poll() is None:
-            renderer.kill()
+        for part in parts:
+            part.cleanup()
         for s in subs:
             with contextlib.suppress(Exception):
                 s.undeclare()
         if recorder is not None:
             recorder.close()
         session.close()
-        if plan_file:
-            os.unlink(plan_file)
 
-    sim_ns = int(end_info.get("sim_ns", recorder.latest_ns if recorder else latest["ns"]))
+    infos = [p.end_info for p in parts]
+    fallback = recorder.latest_ns if recorder else latest["ns"]
+    sim_ns = min(int(i.get("sim_ns", fallback)) for i in infos)
+    walls = [float(i["wall_s"]) for i in infos if "wall_s" in i]
+    published: dict[str, int] = {}
+    for i in infos:
+        published.update(i.get("published", {}))
     return RunResult(
         reason=reason,
         sim_ns=sim_ns,
-        wall_s=float(end_info.get("wall_s", time.perf_counter() - wall0)),
+        wall_s=max(walls) if len(walls) == len(infos) else time.perf_counter() - wall0,
         mcap=Path(plan.record.path) if recorder else None,
         topics=recorder.stats() if recorder else [],
-        published=dict(end_info.get("published", {})),
+        published=published,
         error=error,
         endpoints=listen,
     )

@@ -50,6 +50,7 @@ class NodePlan(BaseModel):
 
     name: str
     argv: list[str]
+    world: str | None = None  # with several worlds: the world whose key space it works in
     env: dict[str, str] = {}
     cwd: str
     namespace: str | None = None
@@ -85,6 +86,9 @@ class RunPlan(BaseModel):
     renderers: Literal["auto", "world", "process"] = "auto"  # the launcher resolves auto
     nodes: list[NodePlan] = []
     lockstep: list[str] = []  # node names the world waits for at each step
+    # Several worlds: each its own plan, named `<run>/<world>` (so its keys are `<run>/<world>/<ns>/...`),
+    # run by a process of its own; this plan then holds the run-wide parts (record, nodes, stop_on).
+    worlds: list[RunPlan] = []
 
     def renders(self) -> bool:
         """Whether any plugin of the run renders (cameras)."""
