@@ -71,25 +71,33 @@ def validate(
         out.print_json(plan.model_dump_json(exclude={"mjcf"}))
         return
     rate = plan.rate if isinstance(plan.rate, str) else f"{plan.rate:g}× real time"
+    parts = plan.worlds or [plan]
+    robots_n = sum(len(p.robots) for p in parts)
+    worlds = f"{len(parts)} worlds, " if plan.worlds else ""
     out.print(
         f"[bold]{plan.name}[/]: {plan.duration_ns / 1e9:g} s sim at {rate}, step {plan.step_ns / 1e6:g} ms, "
-        f"{len(plan.robots)} robot(s), seed {plan.seed}"
+        f"{worlds}{robots_n} robot(s), seed {plan.seed}"
     )
     robots = Table(
         "robot", "namespace", "description", "links", "plugins", title="Robots", title_justify="left"
     )
-    for r in plan.robots:
-        robots.add_row(
-            r.name,
-            r.namespace,
-            Path(r.description_file).name,
-            str(len(r.links)),
-            ", ".join(f"{p.name}" + (f" @{p.rate:g} Hz" if p.rate else "") for p in r.plugins),
-        )
+    if plan.worlds:
+        robots.add_column("world")
+    for part in parts:
+        for r in part.robots:
+            row = [
+                r.name,
+                r.namespace,
+                Path(r.description_file).name,
+                str(len(r.links)),
+                ", ".join(f"{p.name}" + (f" @{p.rate:g} Hz" if p.rate else "") for p in r.plugins),
+            ]
+            robots.add_row(*row, *([part.name.rsplit("/", 1)[-1]] if plan.worlds else []))
     out.print(robots)
     topics = Table("key", "type", "dir", "rate (sim Hz)", "from", title="Topics", title_justify="left")
-    for t in plan.topics():
-        topics.add_row(t.key, t.type, t.direction, f"{t.rate:g}" if t.rate else "-", t.owner)
+    for part in parts:
+        for t in part.topics():
+            topics.add_row(t.key, t.type, t.direction, f"{t.rate:g}" if t.rate else "-", t.owner)
     out.print(topics)
     if plan.nodes:
         nodes = Table(
@@ -339,7 +347,7 @@ def check(
     if len(plans) > 1:
         raise _fail(RunError(f"{scenario} has {len(plans)} variants: say which one with --variant"))
     plan = plans[0][1]
-    if not plan.assertions:
+    if not any(part.assertions for part in plan.worlds or [plan]):
         raise _fail(RunError(f"{scenario} has no assertions to judge"))
     if not mcap.is_file():
         raise _fail(RunError(f"{mcap}: file not found"))

@@ -78,16 +78,18 @@ class Nodes:
         self.procs: list[NodeProcess] = []
         for node in plan.nodes:
             env = dict(os.environ)
+            # with several worlds, a node works in its world's key space (`<run>/<world>/...`)
+            world = next((w for w in plan.worlds if node.world and w.name.endswith("/" + node.world)), plan)
             env.update(
                 {
                     "SCENARIO_ENDPOINT": endpoint,
-                    "SCENARIO_RUN": plan.name,
+                    "SCENARIO_RUN": world.name,
                     "SCENARIO_NAMESPACE": node.namespace or "",
                     "SCENARIO_NODE": node.name,
-                    "SCENARIO_CLOCK": plan.clock_key,
+                    "SCENARIO_CLOCK": world.clock_key,
                     "PYTHONUNBUFFERED": "1",
                     # runner.node keeps the world's message order for a node the world waits for
-                    "SCENARIO_LOCKSTEP": "1" if node.name in plan.lockstep else "0",
+                    "SCENARIO_LOCKSTEP": "1" if node.name in world.lockstep else "0",
                 }
             )
             env.update(node.env)

@@ -125,6 +125,14 @@ class World(Strict):
     )
 
 
+class NamedWorld(World):
+    """One of several worlds: simulated by a process of its own, in a key space of its own."""
+
+    name: Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")] = Field(
+        description="World name (letters, digits, '_'): the second chunk of its keys (`run/arena/r1/scan`)."
+    )
+
+
 XacroArg = str | int | float | bool
 
 
@@ -165,6 +173,9 @@ class Robot(Strict):
         default_factory=list,
         description="Plugins of this robot. They add to the sensors and plugins its description declares in "
         "<gazebo> tags, and replace those of the same name (or type).",
+    )
+    world: str | None = Field(
+        None, description="With `worlds:`, the world this robot is in (default: the first world)."
     )
     plugins_from_description: bool = Field(
         True, description="Use the plugins and sensors declared in the description's <gazebo> tags."
@@ -360,6 +371,11 @@ class Node(Strict):
     required: bool = Field(
         False, description="The run fails (exit 1) and stops when this node exits before the run ends."
     )
+    world: str | None = Field(
+        None,
+        description="With `worlds:`, the world whose key space the node works in (`SCENARIO_RUN` is "
+        "`<run>/<world>`; default: the world of the robot named by its namespace, else the first).",
+    )
 
 
 class Scenario(Strict):
@@ -389,6 +405,12 @@ class Scenario(Strict):
         "`package://pkg/...`. Folders with a package.xml beside the scenario are found without this.",
     )
     world: World = Field(default_factory=World, description="Physics, ground and primitive models.")
+    worlds: list[NamedWorld] = Field(
+        default_factory=list,
+        description="Several worlds instead of one `world:`: each is simulated by a process of its own, in a "
+        "key space of its own (`<run>/<world>/<ns>/...`); robots and nodes say which world they are in, and "
+        "timeline and assertion topics start with the world's name (`arena/r1/cmd_vel`).",
+    )
     robots: list[Robot] = Field(default_factory=list, description="Robots and their plugins.")
     timeline: list[TimelineEntry] = Field(
         default_factory=list, description="Messages to publish at sim times."

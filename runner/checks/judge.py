@@ -44,8 +44,10 @@ def contacts_key(run: str) -> str:
 
 def judged_types(plan: Any) -> dict[str, str]:
     """The ROS type of every key a judge of `plan` may read (the plan's topics and the world's contacts)."""
-    types = {t.key: t.type for t in plan.topics()}
-    types[contacts_key(plan.name)] = "gazebo_msgs/msg/ContactsState"
+    types: dict[str, str] = {}
+    for part in plan.worlds or [plan]:  # several worlds: every world's keys (full keys, distinct)
+        types.update({t.key: t.type for t in part.topics()})
+        types[contacts_key(part.name)] = "gazebo_msgs/msg/ContactsState"
     return types
 
 

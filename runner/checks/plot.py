@@ -91,7 +91,7 @@ def trajectory_plot(plan: Any, mcap: Path, results: list[Result], out: Path) -> 
 
     from runner import msgs
 
-    keys = {truth_key(plan.name, r.namespace): r.name for r in plan.robots}
+    keys = {truth_key(part.name, r.namespace): r.name for part in plan.worlds or [plan] for r in part.robots}
     paths: dict[str, list[tuple[int, float, float]]] = {}
     with open(mcap, "rb") as f:
         for _s, channel, message in make_reader(f).iter_messages(topics=list(keys)):
@@ -100,7 +100,7 @@ def trajectory_plot(plan: Any, mcap: Path, results: list[Result], out: Path) -> 
             paths.setdefault(keys[channel.topic], []).append((message.log_time, float(p.x), float(p.y)))
     if not paths:
         return None
-    specs = specs_from_plan(plan.assertions)
+    specs = specs_from_plan([a for part in plan.worlds or [plan] for a in part.assertions])
     pts = [np.array([(x, y) for _, x, y in path]) for path in paths.values()]
     for s in specs:
         region = getattr(s, "region", None)

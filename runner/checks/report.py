@@ -13,9 +13,11 @@ from runner.checks.judge import Judge, Result, judged_types
 def judge_for(plan: Any) -> Judge | None:
     from runner.checks import specs_from_plan
 
-    if not plan.assertions:
+    parts = plan.worlds or [plan]  # several worlds: one judge over all (their keys are distinct)
+    assertions = [a for part in parts for a in part.assertions]
+    if not assertions:
         return None
-    return Judge(specs_from_plan(plan.assertions), plan.assertion_keys)
+    return Judge(specs_from_plan(assertions), [k for part in parts for k in part.assertion_keys])
 
 
 def judge_recording(plan: Any, mcap: Path) -> tuple[list[Result], int]:

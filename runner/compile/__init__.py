@@ -57,6 +57,10 @@ def compile_plan(
     sc: Scenario, doc: Document, *, record_path: str | None = None, notices: Notices | None = None
 ) -> RunPlan:
     notices = notices if notices is not None else Notices()
+    if sc.worlds:
+        from runner.compile.worlds import compile_worlds
+
+        return compile_worlds(sc, doc, record_path, notices)
     base = doc.base_dir
     packages = PackageMap.for_scenario(base, {k: (base / v) for k, v in sc.packages.items()})
     for name, folder in packages.explicit.items():
@@ -113,20 +117,7 @@ def compile_plan(
     timeline = [_timeline_entry(sc, i, doc) for i in range(len(sc.timeline))]
     timeline.sort(key=lambda ev: ev.t_ns)
 
-    rec = sc.record
-    if record_path is not None:
-        path = Path(record_path)
-    elif rec.path is not None:
-        path = base / rec.path
-    else:
-        path = Path("runs") / f"{sc.name}.mcap"
-    record = RecordPlan(
-        enabled=rec.enabled,
-        path=str(path),
-        include=[_full_expr(sc.name, e) for e in rec.include],
-        exclude=[_full_expr(sc.name, e) for e in rec.exclude],
-    )
-    _check_key_exprs(record, doc)
+    record = _record_plan(sc, doc, record_path)
 
     published = {t.key: t.type for r in robots for p in r.plugins for t in p.topics if t.direction == "pub"}
     published.update({f"{sc.name}/{ev.topic.strip('/')}": msgs.normalize_type(ev.type) for ev in sc.timeline})
@@ -156,6 +147,24 @@ def compile_plan(
         nodes=_nodes(sc, doc, base),
         lockstep=list(sc.lockstep),
     )
+
+
+def _record_plan(sc: Scenario, doc: Document, record_path: str | None) -> RecordPlan:
+    rec = sc.record
+    if record_path is not None:
+        path = Path(record_path)
+    elif rec.path is not None:
+        path = doc.base_dir / rec.path
+    else:
+        path = Path("runs") / f"{sc.name}.mcap"
+    record = RecordPlan(
+        enabled=rec.enabled,
+        path=str(path),
+        include=[_full_expr(sc.name, e) for e in rec.include],
+        exclude=[_full_expr(sc.name, e) for e in rec.exclude],
+    )
+    _check_key_exprs(record, doc)
+    return record
 
 
 def _nodes(sc: Scenario, doc: Document, base: Path) -> list[NodePlan]:

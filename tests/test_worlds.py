@@ -1,0 +1,141 @@
+"""Several worlds in one scenario (`worlds:`): each a process and a key space of its own, one router, one
+recording, one judge; errors point at the user's lines; a world that dies ends the run."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import SCENARIOS, read_mcap, run_cli, scenario_cmd
+
+TWO = """
+name: pair
+duration: {duration}
+rate: {rate}
+worlds:
+  - name: a
+    models:
+      - {{name: wall, shape: box, size: [0.2, 4, 0.5], pose: {{xyz: [3, 0, 0.25]}}}}
+  - name: b
+robots:
+  - name: r1
+    world: a
+    description: "{{diffbot}}"
+    pose: {{xyz: [0, 0, 0.06]}}
+    plugins: [{{type: diff_drive}}, {{type: lidar, params: {{link: lidar_link, samples: 36, rate: 10}}}}]
+  - name: r2
+    world: b
+    description: "{{diffbot}}"
+    pose: {{xyz: [0, 0, 0.06]}}
+    plugins: [{{type: diff_drive, params: {{rate: 50}}}}]
+timeline:
+  - {{t: 0.0, topic: a/r1/cmd_vel, type: geometry_msgs/msg/Twist, data: {{linear: {{x: 0.5}}}}}}
+  - {{t: 0.0, topic: b/r2/cmd_vel, type: geometry_msgs/msg/Twist, data: {{angular: {{z: 1.0}}}}}}
+assertions:
+  - {{name: r1_goes_forward, type: distance_traveled, robot: r1, min: 0.5}}
+  - {{name: b_clock, type: topic_rate, topic: b/r2/odom, min: 45, max: 55}}
+  - {{name: r2_turns_in_place, type: max_speed, robot: r2, max: 0.1}}
+"""
+
+
+@pytest.mark.timeout(120)
+def test_two_worlds_run_apart_and_are_recorded_together(write_scenario, tmp_path: Path) -> None:
+    path = write_scenario(TWO.format(duration=2.0, rate="max"))
+    mcap = tmp_path / "pair.mcap"
+    proc = run_cli("run", str(path), "--record", str(mcap), "--junit", str(tmp_path / "j.xml"), timeout=100)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    msgs = read_mcap(mcap)
+    topics = {topic for topic, _, _, _ in msgs}
+    assert {"pair/a/clock", "pair/b/clock", "pair/a/r1/scan", "pair/a/r1/odom", "pair/b/r2/odom"} <= topics
+    assert not any(t.startswith("pair/a/r2") or t.startswith("pair/b/r1") for t in topics)
+    last = {}
+    for topic, _, _t, m in msgs:
+        if topic.endswith("/_truth"):
+            last[topic] = m.pose.pose
+    # r1 drove forward in world a; r2 turned on the spot in world b: each world simulated its own robot
+    assert last["pair/a/r1/_truth"].position.x > 0.7
+    assert (
+        abs(last["pair/b/r2/_truth"].position.x) < 0.05 and abs(last["pair/b/r2/_truth"].orientation.z) > 0.3
+    )
+    # the recording re-judged offline agrees with the live verdicts
+    check = run_cli("check", str(mcap), "--scenario", str(path), timeout=60)
+    assert check.returncode == 0, check.stdout + check.stderr
+    assert "3 passed" in check.stdout and "3 passed" in proc.stdout
+
+
+@pytest.mark.timeout(60)
+def test_world_mistakes_point_at_the_users_lines(write_scenario) -> None:
+    text = TWO.format(duration=1.0, rate="max")
+    cases = {
+        # a plugin mistake of the second world's robot: robots[1], as the user wrote it
+        text.replace("{type: diff_drive, params: {rate: 50}}", "{type: diff_drive, params: {rate: -5}}"): (
+            r"robots\[1\]\.plugins\[0\]\.params\.rate"
+        ),
+        text.replace(
+            "topic: b/r2/cmd_vel", "topic: r2/cmd_vel"
+        ): r"timeline\[1\]\.topic: 'r2/cmd_vel' names no world",
+        text.replace("world: b\n", "world: c\n"): r"robots\[1\]\.world: no world named 'c'",
+        text.replace("worlds:", "world: {}\nworlds:"): r"world: both `world:` and `worlds:`",
+        text.replace(
+            "topic: b/r2/odom", "topic: r2/odom"
+        ): r"assertions\[1\]\.topic: 'r2/odom' names no world",
+    }
+    for i, (scenario, pattern) in enumerate(cases.items()):
+        path = write_scenario(scenario, f"bad{i}.yaml")
+        proc = run_cli("validate", str(path))
+        said = proc.stdout + proc.stderr
+        assert proc.returncode != 0, scenario
+        assert re.search(rf"bad{i}\.yaml:\d+:\d+: {pattern}", said), said
+        assert "Traceback" not in said
+
+
+@pytest.mark.timeout(60)
+def test_a_world_that_dies_ends_the_run(write_scenario, tmp_path: Path) -> None:
+    path = write_scenario(TWO.format(duration=600, rate="realtime"))
+    mcap = tmp_path / "run.mcap"
+    proc = subprocess.Popen(
+        scenario_cmd("run", str(path), "--record", str(mcap), "--no-judge"),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=dict(os.environ, PYTHONUNBUFFERED="1"),
+        start_new_session=True,
+    )
+    try:
+        worlds: list[int] = []
+        deadline = time.monotonic() + 30
+        while len(worlds) < 2 and time.monotonic() < deadline:
+            time.sleep(0.2)
+            out = subprocess.run(["pgrep", "-f", r"runner\.sim /"], capture_output=True, text=True)
+            worlds = [int(p) for p in out.stdout.split()]
+        assert len(worlds) == 2, "two world processes"
+        time.sleep(1.0)
+        killed = time.monotonic()
+        os.kill(worlds[0], signal.SIGKILL)
+        _out, err = proc.communicate(timeout=30)
+        took = time.monotonic() - killed
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 1
+    assert re.search(r"the world [ab] process exited with code -9", err), err
+    assert took < 3.0, took  # noticed within a second; the other world stopped in order
+    assert "Traceback" not in err
+    topics = {topic for topic, _, _, _ in read_mcap(mcap)}  # finished and readable
+    assert {"pair/a/clock", "pair/b/clock"} <= topics
+
+
+@pytest.mark.timeout(120)
+def test_the_two_worlds_example_passes(tmp_path: Path) -> None:
+    proc = run_cli(
+        "run", str(SCENARIOS / "two_worlds.yaml"), "--record", str(tmp_path / "w.mcap"), timeout=100
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "[controller] arrived at" in proc.stderr
+    assert "3 passed, 0 failed" in proc.stdout
