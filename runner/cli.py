@@ -167,13 +167,22 @@ def run(
     variant: Annotated[
         int | None, typer.Option(help="Run only this variant of the scenario's matrix (0-based).", min=0)
     ] = None,
+    host: Annotated[
+        str | None,
+        typer.Option(help="With `hosts:` in the scenario: run this host's part and join the main host."),
+    ] = None,
+    local: Annotated[
+        bool, typer.Option("--local", help="Run every part on this machine, whatever `hosts:` says.")
+    ] = False,
 ) -> None:
     """Validate, compile and run a scenario; record every message to MCAP; judge its assertions. With a
-    `matrix:`, every variant runs and is judged on its own.
+    `matrix:`, every variant runs and is judged on its own. With `hosts:`, this plays the first (main)
+    host; `--host NAME` on another machine plays that one.
 
     Examples:
       scenario run scenarios/two_robots.yaml
       scenario run scenarios/two_robots.yaml --rate realtime --listen tcp/127.0.0.1:7447
+      scenario run fleet.yaml --host gpu_box
     """
     parsed_rate = _parse_rate(rate)
     try:
@@ -185,10 +194,17 @@ def run(
     suites = []
     code = 0
     for i, (label, plan) in enumerate(plans):
-        if duration is not None:
-            plan.duration_ns = round(duration * 1e9)
-        if parsed_rate is not None:
-            plan.rate = parsed_rate
+        for part in {id(p): p for p in [plan, *plan.parts()]}.values():  # every world of the run
+            if duration is not None:
+                part.duration_ns = round(duration * 1e9)
+            if parsed_rate is not None:
+                part.rate = parsed_rate
+            if local:
+                part.hosts = {}
+        if host is not None and not local and host not in plan.hosts:
+            raise _fail(
+                RunError(f"no host named {host!r}; hosts: {', '.join(plan.hosts) or '(none declared)'}")
+            )
         if no_record:
             plan.record.enabled = False
         elif len(plans) > 1:
@@ -196,7 +212,7 @@ def run(
             plan.record.path = str(path.with_name(f"{path.stem}-{i}{path.suffix}"))
         if label and not quiet:
             err.print(f"variant {i}: {label}", markup=False)
-        suite, rc = _run_one(plan, label, quiet, listen, connect, no_judge)
+        suite, rc = _run_one(plan, label, quiet, listen, connect, no_judge, None if local else host)
         suites.append(suite)
         code = max(code, rc)
         if rc == 130:
@@ -231,7 +247,13 @@ def _load_variants(file: Path, record: str | None, variant: int | None) -> list[
 
 
 def _run_one(
-    plan: Any, label: str, quiet: bool, listen: list[str] | None, connect: list[str] | None, no_judge: bool
+    plan: Any,
+    label: str,
+    quiet: bool,
+    listen: list[str] | None,
+    connect: list[str] | None,
+    no_judge: bool,
+    host: str | None = None,
 ) -> tuple[Any, int]:
     from runner.checks.report import Suite, judge_for
     from runner.launch import run_plan
@@ -261,12 +283,21 @@ def _run_one(
 
     if not quiet:
         _print_notices(plan.notices, verbose=False)
-    endpoints = list(listen or []) or [f"tcp/127.0.0.1:{free_port()}"]
+    member = bool(plan.hosts) and host not in (None, plan.main_host)
+    if plan.hosts:
+        endpoints = list(listen or []) or [plan.hosts[host or plan.main_host]]
+    else:
+        endpoints = list(listen or []) or [f"tcp/127.0.0.1:{free_port()}"]
     if not quiet:
-        err.print(f"running {plan.name} ({total:g} s sim), Zenoh on {', '.join(endpoints)}", markup=False)
-    judge = None if no_judge else judge_for(plan)
+        who = f" as host {host!r}" if member else ""
+        err.print(
+            f"running {plan.name}{who} ({total:g} s sim), Zenoh on {', '.join(endpoints)}", markup=False
+        )
+    judge = None if no_judge or member else judge_for(plan)  # the main host judges
     try:
-        result = run_plan(plan, listen=endpoints, connect=connect or (), on_progress=on_progress, judge=judge)
+        result = run_plan(
+            plan, listen=endpoints, connect=connect or (), on_progress=on_progress, judge=judge, host=host
+        )
     except RunError as e:
         raise _fail(e) from None
     finally:

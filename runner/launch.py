@@ -77,9 +77,12 @@ class _StderrTail(threading.Thread):
 class _WorldPart:
     """One world of the run: its plan, its process (and renderer process), what it announced."""
 
-    def __init__(self, plan: RunPlan, label: str):
+    def __init__(self, plan: RunPlan, label: str, remote_host: str | None = None):
         self.plan = plan
         self.label = label  # "world" or "world <name>"
+        self.remote_host = remote_host  # run by the runner of another host: watched by its liveliness
+        self.gone = threading.Event()  # a remote world's liveliness token went away
+        self.session: Any = None  # the runner's session, to acknowledge the world's end
         self.plan_file: str | None = None
         self.child: subprocess.Popen[bytes] | None = None
         self.tail: _StderrTail | None = None
@@ -95,6 +98,8 @@ class _WorldPart:
         if key.endswith("/world/end"):
             self.end_info.update(json.loads(sample.payload.to_bytes()))
             self.ended.set()
+            if self.session is not None:  # all it published before has arrived: it may close
+                self.session.put(meta_key(self.plan.name, "world", "end_ack"), b"")
         elif key.endswith("/world/ready"):
             self.ready.set()
 
@@ -119,11 +124,23 @@ class _WorldPart:
         self.tail = _StderrTail(self.child.stderr, f"[{self.label}] ")
         self.tail.start()
 
+    def on_alive(self, sample: zenoh.Sample) -> None:
+        if sample.kind != zenoh.SampleKind.PUT:
+            self.gone.set()
+
     def running(self) -> bool:
+        if self.remote_host is not None:
+            return not self.ended.is_set() and not self.gone.is_set()
         return self.child is not None and self.child.poll() is None
 
+    def dead(self) -> bool:
+        """Gone without saying it ended."""
+        if self.remote_host is not None:
+            return self.gone.is_set() and not self.ended.is_set()
+        return self.child is not None and self.child.poll() not in (None, 0, 130)
+
     def stop(self) -> None:
-        if self.running():
+        if self.remote_host is None and self.running():
             _stop(self.child)  # type: ignore[arg-type]
 
     def renderer_error(self) -> str | None:
@@ -135,6 +152,11 @@ class _WorldPart:
 
     def finish(self, interrupted: bool) -> str | None:
         """After the world process exited: its error if it died, and the renderer stopped."""
+        if self.remote_host is not None:
+            self.died = self.dead() and not interrupted
+            if self.died:
+                return f"the {self.label} process on host {self.remote_host!r} went away (liveliness lost)"
+            return None
         assert self.child is not None and self.tail is not None
         self.tail.join(timeout=1.0)
         error = None
@@ -169,10 +191,18 @@ def run_plan(
     connect: Sequence[str] = (),
     on_progress: Callable[[int, float], None] | None = None,
     judge: Any = None,
+    host: str | None = None,
 ) -> RunResult:
     """Run a plan (one world, or `plan.worlds`, each a process of its own behind one router and one
     recorder); with a `judge` (runner.checks.judge.Judge), feed it every message it asks for, live, and
-    stop the worlds early when the plan's `stop_on` says so."""
+    stop the worlds early when the plan's `stop_on` says so.
+
+    With `plan.hosts`, this runner plays `host` (None: the first, main host, which records and judges);
+    the parts placed on other hosts are run by their own `scenario run FILE --host NAME`, and joined."""
+    if plan.hosts and host not in (None, plan.main_host):
+        return _run_member(plan, host, connect=connect, listen=listen)  # type: ignore[arg-type]
+    if plan.hosts and not listen:
+        listen = [plan.hosts[plan.main_host]]  # type: ignore[index]
     listen = list(listen) or [f"tcp/127.0.0.1:{free_port()}"]
     if plan.renderers == "auto":
         # A renderer process pays where rendering does not already take every core: Mesa's llvmpipe renders
@@ -187,11 +217,14 @@ def run_plan(
     except zenoh.ZError as e:
         raise RunError(f"cannot open the Zenoh network on {', '.join(listen)}: {e}") from None
 
-    parts = (
-        [_WorldPart(w, f"world {w.name.rsplit('/', 1)[-1]}") for w in plan.worlds]
-        if plan.worlds
-        else [_WorldPart(plan, "world")]
-    )
+    parts = [
+        _WorldPart(
+            w,
+            f"world {w.name.rsplit('/', 1)[-1]}" if plan.worlds else "world",
+            None if plan.on_host(None, w.host) else w.host,
+        )
+        for w in plan.parts()
+    ]
     recorder: Recorder | None = None
     latest = {"ns": 0}
     started = {"at": 0.0}
@@ -220,16 +253,20 @@ def run_plan(
             for part in parts:
                 subs.append(session.declare_subscriber(part.plan.clock_key, on_clock))
         for part in parts:
+            part.session = session
             subs.append(session.declare_subscriber(meta_key(part.plan.name, "**"), part.on_meta))
+            if part.remote_host is not None:
+                alive = meta_key(part.plan.name, "world", "alive")
+                subs.append(session.liveliness().declare_subscriber(alive, part.on_alive))
         stop_early = threading.Event()
         if judge is not None:
             subs += _judge_subscribers(session, plan, judge, stop_early, recorder)
 
         endpoint = _connectable(listen[0])
-        if plan.nodes:
+        if any(plan.on_host(None, n.host) for n in plan.nodes):
             # nodes first: they connect and subscribe while the world starts (lockstep nodes are waited for
             # by the world itself, before its first step)
-            nodes = Nodes(plan, endpoint)
+            nodes = Nodes(plan, endpoint, host=None)
             try:
                 nodes.start()
             except NodeError as e:
@@ -249,6 +286,8 @@ def run_plan(
                 all_ready = all(p.ready.is_set() for p in parts)
                 if all_ready and not started["at"]:
                     started["at"] = time.perf_counter()
+                    # every part is up (here and on other hosts): they start together, on this word
+                    subs.append(session.liveliness().declare_token(meta_key(plan.name, "go")))
                 # once the worlds have ended, nodes leave on their own (runner.node sees the end): no failure
                 nodes_may_fail = nodes is not None and error is None and reason == "completed"
                 if nodes_may_fail and not any(p.ended.is_set() for p in parts):
@@ -261,7 +300,7 @@ def run_plan(
                         print(message.splitlines()[0] + "; stopping the run", file=sys.stderr, flush=True)
                         stop_all()
                 for p in parts:
-                    died = p.child is not None and p.child.poll() not in (None, 0, 130)
+                    died = p.dead()
                     if died and error is None and reason == "completed" and len(parts) > 1:
                         stop_all()  # one world died: the others stop too (its report follows)
                     rerr = p.renderer_error()
@@ -272,7 +311,11 @@ def run_plan(
                     sim_ns = recorder.latest_ns if recorder else latest["ns"]
                     on_progress(sim_ns, time.perf_counter() - started["at"])
                 if not all_ready and time.perf_counter() - wall0 > START_TIMEOUT_S:
-                    raise RunError(f"the world process did not start within {START_TIMEOUT_S:.0f} s")
+                    late = [p.label + (f" on host {p.remote_host!r}" if p.remote_host else "") for p in parts]
+                    late = [w for w, p in zip(late, parts, strict=True) if not p.ready.is_set()]
+                    raise RunError(
+                        f"not every part started within {START_TIMEOUT_S:.0f} s: {', '.join(late)}"
+                    )
                 if stop_early.is_set() and reason == "completed":
                     reason = "stopped"
                     stop_all()
@@ -324,6 +367,81 @@ def run_plan(
         mcap=Path(plan.record.path) if recorder else None,
         topics=recorder.stats() if recorder else [],
         published=published,
+        error=error,
+        endpoints=listen,
+    )
+
+
+def _run_member(
+    plan: RunPlan, host: str, *, connect: Sequence[str] = (), listen: Sequence[str] = ()
+) -> RunResult:
+    """`scenario run FILE --host NAME`: run the worlds and nodes placed on this host, joined to the main
+    host's runner (which records and judges, and says when everything starts); end with them."""
+    if host not in plan.hosts:
+        raise RunError(f"no host named {host!r} in the scenario; hosts: {', '.join(plan.hosts)}")
+    listen = list(listen) or [plan.hosts[host]]
+    connect = list(connect) or [plan.hosts[plan.main_host]]  # type: ignore[index]
+    try:
+        session = zenoh.open(make_config("router", listen=listen, connect=connect))
+    except zenoh.ZError as e:
+        raise RunError(f"cannot open the Zenoh network on {', '.join(listen)}: {e}") from None
+    parts = [
+        _WorldPart(w, f"world {w.name.rsplit('/', 1)[-1]}" if plan.worlds else "world")
+        for w in plan.parts()
+        if plan.on_host(host, w.host)
+    ]
+    subs = [session.declare_subscriber(meta_key(p.plan.name, "**"), p.on_meta) for p in parts]
+    nodes = (
+        Nodes(plan, _connectable(listen[0]), host=host) if any(n.host == host for n in plan.nodes) else None
+    )
+    reason, error = "completed", None
+    wall0 = time.perf_counter()
+    try:
+        if nodes is not None:
+            try:
+                nodes.start()
+            except NodeError as e:
+                raise RunError(str(e)) from None
+        for part in parts:
+            part.start(_connectable(listen[0]))
+        try:
+            while any(p.running() for p in parts) or (
+                not parts and nodes is not None and nodes.any_running()
+            ):
+                time.sleep(0.05)
+                if nodes is not None and error is None and not any(p.ended.is_set() for p in parts):
+                    ended_by = nodes.check()
+                    if ended_by is not None:
+                        reason, error = ended_by
+                        print(
+                            error.splitlines()[0] + "; stopping this host's part", file=sys.stderr, flush=True
+                        )
+                        for p in parts:
+                            p.stop()
+        except KeyboardInterrupt:
+            reason = "interrupted"
+            for p in parts:
+                p.stop()
+        for part in parts:
+            perr = part.finish(reason == "interrupted")
+            if perr is not None and error is None:
+                reason, error = "failed", perr
+    finally:
+        if nodes is not None:
+            nodes.stop()
+        for part in parts:
+            part.cleanup()
+        for sub in subs:
+            with contextlib.suppress(Exception):
+                sub.undeclare()
+        session.close()
+    infos = [p.end_info for p in parts]
+    return RunResult(
+        reason=reason if error is None or reason != "completed" else "failed",
+        sim_ns=min((int(i.get("sim_ns", 0)) for i in infos), default=0),
+        wall_s=max((float(i.get("wall_s", 0.0)) for i in infos), default=time.perf_counter() - wall0),
+        mcap=None,
+        published={k: v for i in infos for k, v in i.get("published", {}).items()},
         error=error,
         endpoints=listen,
     )

@@ -74,9 +74,13 @@ class NodeError(RuntimeError):
 
 
 class Nodes:
-    def __init__(self, plan: RunPlan, endpoint: str):
+    """The nodes of one host of the run (`host`: None is the main host)."""
+
+    def __init__(self, plan: RunPlan, endpoint: str, host: str | None = None):
         self.procs: list[NodeProcess] = []
         for node in plan.nodes:
+            if not plan.on_host(host, node.host):
+                continue
             env = dict(os.environ)
             # with several worlds, a node works in its world's key space (`<run>/<world>/...`)
             world = next((w for w in plan.worlds if node.world and w.name.endswith("/" + node.world)), plan)
@@ -130,6 +134,9 @@ class Nodes:
             if code != 0:
                 print(f"node {name!r} exited with code {code}", file=sys.stderr, flush=True)
         return None
+
+    def any_running(self) -> bool:
+        return any(p.proc is not None and p.proc.poll() is None for p in self.procs)
 
     def stop(self) -> None:
         """SIGINT to every node still running, then SIGKILL to those still there after a grace period."""

@@ -51,6 +51,7 @@ class NodePlan(BaseModel):
     name: str
     argv: list[str]
     world: str | None = None  # with several worlds: the world whose key space it works in
+    host: str | None = None  # with hosts: the host that runs it (None: the first)
     env: dict[str, str] = {}
     cwd: str
     namespace: str | None = None
@@ -89,6 +90,23 @@ class RunPlan(BaseModel):
     # Several worlds: each its own plan, named `<run>/<world>` (so its keys are `<run>/<world>/<ns>/...`),
     # run by a process of its own; this plan then holds the run-wide parts (record, nodes, stop_on).
     worlds: list[RunPlan] = []
+    hosts: dict[str, str] = {}  # host name -> Zenoh endpoint; the first is the main host
+    host: str | None = None  # with hosts: the host that simulates this world (None: the first)
+
+    def parts(self) -> list[RunPlan]:
+        """The world plans of the run: `worlds`, or this plan itself."""
+        return self.worlds or [self]
+
+    @property
+    def main_host(self) -> str | None:
+        return next(iter(self.hosts), None)
+
+    def on_host(self, host: str | None, placed: str | None) -> bool:
+        """Whether a part placed on `placed` (None: the main host) runs on `host` (None: the main host)."""
+        if not self.hosts:
+            return True  # everything here
+        main = self.main_host
+        return (placed or main) == (host or main)
 
     def renders(self) -> bool:
         """Whether any plugin of the run renders (cameras)."""

@@ -123,6 +123,7 @@ class World(Strict):
     clock_rate: PositiveFloat = Field(
         100.0, description="How often sim time is published on `<run>/clock`, in sim Hz."
     )
+    host: str | None = Field(None, description="With `hosts:`, the host simulating it (default: the first).")
 
 
 class NamedWorld(World):
@@ -346,6 +347,16 @@ Assertion = Annotated[
 ]
 
 
+class Host(Strict):
+    """A machine of the run, by the Zenoh endpoint its runner listens on."""
+
+    endpoint: str = Field(
+        description="Zenoh endpoint of this host's runner, e.g. `tcp/10.0.0.2:7447`. The first host of "
+        "`hosts:` is the main one: it records and judges; the others run `scenario run FILE --host NAME` "
+        "and join it."
+    )
+
+
 class Node(Strict):
     """A process of the run: a controller, a planner, a bridge. It gets the run's Zenoh endpoint, name,
     its namespace and the clock key in its environment (`SCENARIO_ENDPOINT`, `SCENARIO_RUN`,
@@ -371,6 +382,7 @@ class Node(Strict):
     required: bool = Field(
         False, description="The run fails (exit 1) and stops when this node exits before the run ends."
     )
+    host: str | None = Field(None, description="With `hosts:`, the host that runs it (default: the first).")
     world: str | None = Field(
         None,
         description="With `worlds:`, the world whose key space the node works in (`SCENARIO_RUN` is "
@@ -429,6 +441,12 @@ class Scenario(Strict):
     )
     nodes: list[Node] = Field(
         default_factory=list, description="Processes started with the run (controllers, planners...)."
+    )
+    hosts: dict[Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_-]*$")], Host] = Field(
+        default_factory=dict,
+        description="Machines of the run by name; worlds and nodes say where they run (`host:`). Without "
+        "it, everything runs on this machine. `scenario run FILE` plays the first host (it records and "
+        "judges), `scenario run FILE --host NAME` another one, `--local` all of them here.",
     )
     lockstep: list[str] = Field(
         default_factory=list,

@@ -146,7 +146,23 @@ def compile_plan(
         renderers=sc.renderers,
         nodes=_nodes(sc, doc, base),
         lockstep=list(sc.lockstep),
+        hosts={name: h.endpoint for name, h in sc.hosts.items()},
+        host=_host(sc, doc, sc.world.host, ("world", "host")),
     )
+
+
+def _host(sc: Scenario, doc: Document, name: str | None, where: PathKey) -> str | None:
+    """A `host:` that must name one of `hosts:`."""
+    if name is not None and name not in sc.hosts:
+        raise ScenarioError(
+            Problem(
+                f"no host named {name!r}",
+                doc.locate(where),
+                where,
+                expected="one of: " + ", ".join(sc.hosts) if sc.hosts else "a host declared in `hosts:`",
+            )
+        )
+    return name
 
 
 def _record_plan(sc: Scenario, doc: Document, record_path: str | None) -> RecordPlan:
@@ -228,6 +244,7 @@ def _nodes(sc: Scenario, doc: Document, base: Path) -> list[NodePlan]:
                 respawn=node.respawn,
                 respawn_limit=node.respawn_limit,
                 required=node.required,
+                host=_host(sc, doc, node.host, ("nodes", i, "host")),
             )
         )
     for j, name in enumerate(sc.lockstep):

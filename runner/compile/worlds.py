@@ -205,6 +205,7 @@ def compile_worlds(sc: Scenario, doc: Document, record_path: str | None, notices
         stop_on=sc.stop_on,
         renderers=sc.renderers,
         nodes=nodes,
+        hosts={name: h.endpoint for name, h in sc.hosts.items()},
         lockstep=list(sc.lockstep),
         worlds=plans,
     )

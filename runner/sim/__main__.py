@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import sys
+import threading
 import time
 
 import zenoh
@@ -18,6 +19,8 @@ from runner.sim.world import World
 from runner.transport import ZenohBus, make_config, meta_key
 
 READY_TIMEOUT_S = 10.0
+START_TIMEOUT_S = 60.0  # every part of the run up (other hosts included)
+END_ACK_TIMEOUT_S = 10.0
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -48,8 +51,36 @@ def main(argv: list[str] | None = None) -> int:
             # subscribed and set up: nodes (runner.node) wait for this before they publish anything
             alive = session.liveliness().declare_token(meta_key(plan.name, "world", "alive"))
             session.put(meta_key(plan.name, "world", "ready"), b"{}")
-            stats = world.run(should_stop=should_stop)
+            # Every part of the run (worlds here and on other hosts) starts on the runner's word, and stops
+            # when that word is withdrawn (the runner stopped, or its host went away): together.
+            go, gone = threading.Event(), threading.Event()
+
+            def on_go(sample: zenoh.Sample) -> None:
+                (go if sample.kind == zenoh.SampleKind.PUT else gone).set()
+
+            run = plan.name.split("/", 1)[0]  # a world of several is named <run>/<world>
+            go_sub = session.liveliness().declare_subscriber(meta_key(run, "go"), on_go, history=True)
+            deadline = time.monotonic() + START_TIMEOUT_S
+            while not go.wait(0.01):
+                if should_stop():
+                    return 130
+                if time.monotonic() > deadline:
+                    print("world: the runner did not say go; giving up", file=sys.stderr)
+                    return 1
+            stats = world.run(should_stop=lambda: should_stop() or gone.is_set())
+            go_sub.undeclare()
             reason = "completed" if stats.sim_ns >= plan.duration_ns else "stopped"
+            if reason == "stopped" and gone.is_set() and not should_stop():
+                print(
+                    f"world: the runner went away at {stats.sim_ns / 1e9:.2f} s sim; stopping",
+                    file=sys.stderr,
+                )
+            # The runner acknowledges the end message, which comes after everything published before it: once
+            # acknowledged, nothing of this world is still in flight, and the session may close.
+            acked = threading.Event()
+            ack_sub = session.declare_subscriber(
+                meta_key(plan.name, "world", "end_ack"), lambda _s: acked.set()
+            )
             end_pub.put(
                 json.dumps(
                     {
@@ -61,6 +92,9 @@ def main(argv: list[str] | None = None) -> int:
                     }
                 ).encode()
             )
+            if not acked.wait(END_ACK_TIMEOUT_S) and not should_stop():
+                print("world: the runner did not acknowledge the end; closing anyway", file=sys.stderr)
+            ack_sub.undeclare()
             end_pub.undeclare()
             alive.undeclare()
         finally:
