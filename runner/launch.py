@@ -177,7 +177,7 @@ class _WorldPart:
         return error
 
     def cleanup(self) -> None:
-        for proc in (self.child, self.renderer):
+        for proc in (self.child, self.renderer):  # (none for a remote part)
             if proc is not None and proc.poll() is None:
                 proc.kill()
         if self.plan_file:
@@ -272,7 +272,8 @@ def run_plan(
             except NodeError as e:
                 raise RunError(str(e)) from None
         for part in parts:
-            part.start(endpoint)
+            if part.remote_host is None:  # the others are started by their own host's runner
+                part.start(endpoint)
         wall0 = time.perf_counter()
         interrupted = False
 

@@ -64,6 +64,8 @@ def make_config(
     conf = zenoh.Config()
     conf.insert_json5("mode", json.dumps(mode))
     conf.insert_json5("scouting/multicast/enabled", "false")
+    # No gossip either: sessions meet only through the endpoints given (a run's topology is explicit).
+    conf.insert_json5("scouting/gossip/enabled", "false")
     conf.insert_json5("scouting/delay", "0")
     if listen:
         conf.insert_json5("listen/endpoints", json.dumps(list(listen)))

@@ -1,0 +1,205 @@
+"""Hosts: a run split across two machines joined by Zenoh, tested for real on one machine with two Linux
+network namespaces (a veth pair between them, each side with its own address): the main host records and
+judges, the other runs its world with `scenario run FILE --host NAME`. The recording holds the same topics
+as the one-host run of the same scenario (`--local`)."""
+
+from __future__ import annotations
+
+import os
+import random
+import shutil
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+from mcap.reader import make_reader
+
+from tests.conftest import REPO, scenario_cmd
+
+SCENE = """
+name: spread
+duration: 3.0
+rate: max
+hosts:
+  main: {{endpoint: "tcp/{a}:7447"}}
+  far: {{endpoint: "tcp/{b}:7448"}}
+worlds:
+  - name: near
+  - name: yonder
+    host: far
+robots:
+  - name: r1
+    world: near
+    description: "{diffbot}"
+    pose: {{xyz: [0, 0, 0.06]}}
+    plugins: [{{type: diff_drive}}, {{type: imu, params: {{rate: 100}}}}]
+  - name: r2
+    world: yonder
+    description: "{diffbot}"
+    pose: {{xyz: [0, 0, 0.06]}}
+    plugins: [{{type: diff_drive}}, {{type: lidar, params: {{link: lidar_link, samples: 90, rate: 10}}}}]
+timeline:
+  - {{t: 0.0, topic: near/r1/cmd_vel, type: geometry_msgs/msg/Twist, data: {{linear: {{x: 0.3}}}}}}
+  - {{t: 0.0, topic: yonder/r2/cmd_vel, type: geometry_msgs/msg/Twist, data: {{linear: {{x: 0.4}}}}}}
+assertions:
+  - {{name: r2_drives_far_away, type: distance_traveled, robot: r2, min: 0.9, max: 1.3}}
+"""
+
+
+def _sh(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(list(args), capture_output=True, text=True, timeout=30)
+
+
+@pytest.fixture
+def two_namespaces():
+    """Two network namespaces joined by a veth pair: (name_a, addr_a, name_b, addr_b)."""
+    if os.geteuid() != 0 or shutil.which("ip") is None:
+        pytest.skip("network namespaces need root and iproute2 (`ip`): the two-host test cannot run here")
+    tag = f"sc{os.getpid() % 100000}"
+    a, b = f"{tag}a", f"{tag}b"
+    net = random.randint(10, 250)
+    addr_a, addr_b = f"10.{net}.77.1", f"10.{net}.77.2"
+    steps = [
+        ("ip", "netns", "add", a),
+        ("ip", "netns", "add", b),
+        ("ip", "link", "add", f"{tag}va", "type", "veth", "peer", "name", f"{tag}vb"),
+        ("ip", "link", "set", f"{tag}va", "netns", a),
+        ("ip", "link", "set", f"{tag}vb", "netns", b),
+        ("ip", "-n", a, "addr", "add", f"{addr_a}/24", "dev", f"{tag}va"),
+        ("ip", "-n", b, "addr", "add", f"{addr_b}/24", "dev", f"{tag}vb"),
+        ("ip", "-n", a, "link", "set", f"{tag}va", "up"),
+        ("ip", "-n", b, "link", "set", f"{tag}vb", "up"),
+        ("ip", "-n", a, "link", "set", "lo", "up"),
+        ("ip", "-n", b, "link", "set", "lo", "up"),
+    ]
+    try:
+        for step in steps:
+            proc = _sh(*step)
+            if proc.returncode != 0:
+                pytest.skip(
+                    f"cannot set up network namespaces here ({' '.join(step)}: {proc.stderr.strip()})"
+                )
+        yield a, addr_a, b, addr_b
+    finally:
+        _sh("ip", "netns", "del", a)
+        _sh("ip", "netns", "del", b)
+
+
+def _topics(path: Path) -> dict[str, int]:
+    out: dict[str, int] = {}
+    with open(path, "rb") as f:
+        for _, channel, _message in make_reader(f).iter_messages():
+            out[channel.topic] = out.get(channel.topic, 0) + 1
+    return out
+
+
+@pytest.mark.timeout(180)
+def test_a_two_host_run_records_what_the_one_host_run_does(
+    two_namespaces, write_scenario, tmp_path: Path
+) -> None:
+    ns_a, addr_a, ns_b, addr_b = two_namespaces
+    path = write_scenario(SCENE.format(a=addr_a, b=addr_b, diffbot="{diffbot}"))
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    spread = tmp_path / "spread.mcap"
+    main = subprocess.Popen(
+        ["ip", "netns", "exec", ns_a, *scenario_cmd("run", str(path), "--record", str(spread))],
+        cwd=REPO,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    far = subprocess.Popen(
+        ["ip", "netns", "exec", ns_b, *scenario_cmd("run", str(path), "--host", "far")],
+        cwd=REPO,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        main_out, main_err = main.communicate(timeout=120)
+        far_out, far_err = far.communicate(timeout=60)
+    finally:
+        for p in (main, far):
+            if p.poll() is None:
+                p.kill()
+    assert main.returncode == 0, main_out + main_err
+    assert far.returncode == 0, far_out + far_err
+    assert f"Zenoh on tcp/{addr_b}:7448" in far_err  # the far part ran on its own address
+    assert "1 passed, 0 failed" in main_out  # judged on the main host, from the far world's messages
+
+    local = tmp_path / "local.mcap"
+    proc = subprocess.run(
+        [*scenario_cmd("run", str(path), "--local", "--record", str(local), "-q")],
+        cwd=REPO,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    spread_topics, local_topics = _topics(spread), _topics(local)
+    assert set(spread_topics) == set(local_topics)
+    assert "spread/yonder/r2/scan" in spread_topics and "spread/near/r1/imu" in spread_topics
+    assert spread_topics == local_topics  # every message of both worlds, wherever they ran
+
+
+@pytest.mark.timeout(120)
+def test_a_world_lost_on_the_other_host_fails_the_run(two_namespaces, write_scenario, tmp_path: Path) -> None:
+    ns_a, addr_a, ns_b, addr_b = two_namespaces
+    text = SCENE.format(a=addr_a, b=addr_b, diffbot="{diffbot}").replace("duration: 3.0", "duration: 600")
+    path = write_scenario(text.replace("rate: max", "rate: realtime"))
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    mcap = tmp_path / "spread.mcap"
+    main = subprocess.Popen(
+        ["ip", "netns", "exec", ns_a, *scenario_cmd("run", str(path), "--record", str(mcap), "--no-judge")],
+        cwd=REPO,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    far = subprocess.Popen(
+        ["ip", "netns", "exec", ns_b, *scenario_cmd("run", str(path), "--host", "far")],
+        cwd=REPO,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        worlds: list[int] = []
+        deadline = time.monotonic() + 40
+        while len(worlds) < 2 and time.monotonic() < deadline:
+            time.sleep(0.3)
+            out = subprocess.run(["pgrep", "-f", r"runner\.sim /"], capture_output=True, text=True).stdout
+            worlds = [int(p) for p in out.split()]
+        assert len(worlds) == 2, "both worlds running"
+        time.sleep(1.0)
+        # the far host's world: the one whose runner is the `--host far` one
+        far_world = next(w for w in worlds if _ancestor(w, far.pid))
+        killed = time.monotonic()
+        os.kill(far_world, signal.SIGKILL)
+        main_out, main_err = main.communicate(timeout=30)
+        took = time.monotonic() - killed
+        far.communicate(timeout=30)
+    finally:
+        for p in (main, far):
+            if p.poll() is None:
+                p.kill()
+    assert main.returncode == 1, main_out + main_err
+    assert "the world yonder process on host 'far' went away" in main_err, main_err
+    assert took < 5.0, took
+    assert "spread/near/clock" in _topics(mcap)  # finished and readable
+
+
+def _ancestor(pid: int, ancestor: int) -> bool:
+    while pid > 1:
+        status = Path(f"/proc/{pid}/status").read_text()
+        pid = int(next(ln.split()[1] for ln in status.splitlines() if ln.startswith("PPid:")))
+        if pid == ancestor:
+            return True
+    return False
