@@ -27,7 +27,7 @@ import zenoh
 
 from runner.errors import RunError
 from runner.nodes import NodeError, Nodes
-from runner.plan import RunPlan
+from runner.plan import NodePlan, RunPlan
 from runner.record import Recorder, TopicStats
 from runner.transport import free_port, make_config, meta_key, unpack_attachment
 
@@ -100,8 +100,6 @@ class _WorldPart:
             self.ended.set()
             if self.session is not None:  # all it published before has arrived: it may close
                 self.session.put(meta_key(self.plan.name, "world", "end_ack"), b"")
-        elif key.endswith("/world/ready"):
-            self.ready.set()
 
     def start(self, endpoint: str) -> None:
         plan = self.plan
@@ -125,7 +123,11 @@ class _WorldPart:
         self.tail.start()
 
     def on_alive(self, sample: zenoh.Sample) -> None:
-        if sample.kind != zenoh.SampleKind.PUT:
+        """The world's liveliness token: up once it is set up and listening (state, so a late subscriber
+        still sees it, unlike a message), gone when its process is."""
+        if sample.kind == zenoh.SampleKind.PUT:
+            self.ready.set()
+        else:
             self.gone.set()
 
     def running(self) -> bool:
@@ -255,14 +257,25 @@ def run_plan(
         for part in parts:
             part.session = session
             subs.append(session.declare_subscriber(meta_key(part.plan.name, "**"), part.on_meta))
-            if part.remote_host is not None:
-                alive = meta_key(part.plan.name, "world", "alive")
-                subs.append(session.liveliness().declare_subscriber(alive, part.on_alive))
+            alive = meta_key(part.plan.name, "world", "alive")
+            subs.append(session.liveliness().declare_subscriber(alive, part.on_alive, history=True))
         stop_early = threading.Event()
         if judge is not None:
             subs += _judge_subscribers(session, plan, judge, stop_early, recorder)
 
         endpoint = _connectable(listen[0])
+        # required nodes of other hosts: their runner supervises them; here, their liveliness is watched
+        lost_nodes: list[str] = []
+        for n in plan.nodes:
+            if n.required and not plan.on_host(None, n.host):
+                world = next((w for w in plan.worlds if n.world and w.name.endswith("/" + n.world)), plan)
+
+                def on_node(sample: zenoh.Sample, n: NodePlan = n) -> None:
+                    if sample.kind != zenoh.SampleKind.PUT:
+                        lost_nodes.append(f"required node {n.name!r} on host {n.host!r} went away")
+
+                alive_key = meta_key(world.name, "node", n.name)
+                subs.append(session.liveliness().declare_subscriber(alive_key, on_node))
         if any(plan.on_host(None, n.host) for n in plan.nodes):
             # nodes first: they connect and subscribe while the world starts (lockstep nodes are waited for
             # by the world itself, before its first step)
@@ -277,7 +290,13 @@ def run_plan(
         wall0 = time.perf_counter()
         interrupted = False
 
+        go: dict[str, Any] = {}
+
         def stop_all() -> None:
+            token = go.pop("token", None)
+            if token is not None:  # the word withdrawn: the worlds of other hosts stop too
+                with contextlib.suppress(Exception):
+                    token.undeclare()
             for p in parts:
                 p.stop()
 
@@ -288,7 +307,8 @@ def run_plan(
                 if all_ready and not started["at"]:
                     started["at"] = time.perf_counter()
                     # every part is up (here and on other hosts): they start together, on this word
-                    subs.append(session.liveliness().declare_token(meta_key(plan.name, "go")))
+                    go["token"] = session.liveliness().declare_token(meta_key(plan.name, "go"))
+                    subs.append(go["token"])
                 # once the worlds have ended, nodes leave on their own (runner.node sees the end): no failure
                 nodes_may_fail = nodes is not None and error is None and reason == "completed"
                 if nodes_may_fail and not any(p.ended.is_set() for p in parts):
@@ -300,6 +320,15 @@ def run_plan(
                         # said at once (the full report follows once everything has stopped)
                         print(message.splitlines()[0] + "; stopping the run", file=sys.stderr, flush=True)
                         stop_all()
+                if (
+                    lost_nodes
+                    and error is None
+                    and reason == "completed"
+                    and not any(p.ended.is_set() for p in parts)
+                ):
+                    reason, error = "failed", lost_nodes[0]
+                    print(error + "; stopping the run", file=sys.stderr, flush=True)
+                    stop_all()
                 for p in parts:
                     died = p.dead()
                     if died and error is None and reason == "completed" and len(parts) > 1:
@@ -423,6 +452,12 @@ def _run_member(
             reason = "interrupted"
             for p in parts:
                 p.stop()
+        if nodes is not None and error is None and reason != "interrupted":
+            # a required node that died while the world was being stopped (by the main host) still fails
+            ended_by = nodes.check()
+            if ended_by is not None and ended_by[0] == "failed":
+                reason, error = ended_by
+                print(error.splitlines()[0], file=sys.stderr, flush=True)
         for part in parts:
             perr = part.finish(reason == "interrupted")
             if perr is not None and error is None:

@@ -126,7 +126,7 @@ def test_a_two_host_run_records_what_the_one_host_run_does(
         for p in (main, far):
             if p.poll() is None:
                 p.kill()
-    assert main.returncode == 0, main_out + main_err
+    assert main.returncode == 0, main_out + main_err + "\n--- far:\n" + far_out + far_err
     assert far.returncode == 0, far_out + far_err
     assert f"Zenoh on tcp/{addr_b}:7448" in far_err  # the far part ran on its own address
     assert "1 passed, 0 failed" in main_out  # judged on the main host, from the far world's messages
@@ -171,16 +171,15 @@ def test_a_world_lost_on_the_other_host_fails_the_run(two_namespaces, write_scen
         text=True,
     )
     try:
-        worlds: list[int] = []
+        far_world = None
         deadline = time.monotonic() + 40
-        while len(worlds) < 2 and time.monotonic() < deadline:
+        while far_world is None and time.monotonic() < deadline:
             time.sleep(0.3)
             out = subprocess.run(["pgrep", "-f", r"runner\.sim /"], capture_output=True, text=True).stdout
-            worlds = [int(p) for p in out.split()]
-        assert len(worlds) == 2, "both worlds running"
+            # this run's far world (not a process some other test left behind)
+            far_world = next((int(w) for w in out.split() if _ancestor(int(w), far.pid)), None)
+        assert far_world is not None, "the far world did not start"
         time.sleep(1.0)
-        # the far host's world: the one whose runner is the `--host far` one
-        far_world = next(w for w in worlds if _ancestor(w, far.pid))
         killed = time.monotonic()
         os.kill(far_world, signal.SIGKILL)
         main_out, main_err = main.communicate(timeout=30)
@@ -197,9 +196,76 @@ def test_a_world_lost_on_the_other_host_fails_the_run(two_namespaces, write_scen
 
 
 def _ancestor(pid: int, ancestor: int) -> bool:
-    while pid > 1:
-        status = Path(f"/proc/{pid}/status").read_text()
-        pid = int(next(ln.split()[1] for ln in status.splitlines() if ln.startswith("PPid:")))
-        if pid == ancestor:
-            return True
+    """Whether `ancestor` is a parent, grandparent... of `pid` (False if either is gone)."""
+    try:
+        while pid > 1:
+            status = Path(f"/proc/{pid}/status").read_text()
+            pid = int(next(ln.split()[1] for ln in status.splitlines() if ln.startswith("PPid:")))
+            if pid == ancestor:
+                return True
+    except (OSError, StopIteration, ValueError):
+        pass
     return False
+
+
+NODE = """
+from runner.node import Node
+
+with Node() as node:
+    cmd = node.publisher("cmd_vel", "geometry_msgs/msg/Twist")
+    while node.ok():
+        cmd.publish({"linear": {"x": 0.2}})
+        node.sleep(0.1)
+"""
+
+
+@pytest.mark.timeout(120)
+def test_a_required_node_lost_on_the_other_host_fails_the_run(
+    two_namespaces, write_scenario, tmp_path: Path
+) -> None:
+    ns_a, addr_a, ns_b, addr_b = two_namespaces
+    (tmp_path / "node.py").write_text(NODE)
+    text = SCENE.format(a=addr_a, b=addr_b, diffbot="{diffbot}").replace("duration: 3.0", "duration: 600")
+    text = text.replace("rate: max", "rate: realtime") + (
+        "nodes:\n  - {name: driver, host: far, namespace: r2, cmd: python node.py, required: true}\n"
+    )
+    path = write_scenario(text)
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    mcap = tmp_path / "spread.mcap"
+    main = subprocess.Popen(
+        ["ip", "netns", "exec", ns_a, *scenario_cmd("run", str(path), "--record", str(mcap), "--no-judge")],
+        cwd=REPO,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    far = subprocess.Popen(
+        ["ip", "netns", "exec", ns_b, *scenario_cmd("run", str(path), "--host", "far")],
+        cwd=REPO,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        node = None
+        deadline = time.monotonic() + 40
+        while node is None and time.monotonic() < deadline:
+            time.sleep(0.3)
+            out = subprocess.run(["pgrep", "-f", "python.* node.py"], capture_output=True, text=True).stdout
+            node = next((int(p) for p in out.split() if _ancestor(int(p), far.pid)), None)
+        assert node is not None, "the node did not start"
+        time.sleep(1.5)
+        os.kill(node, signal.SIGKILL)
+        main_out, main_err = main.communicate(timeout=30)
+        _far_out, far_err = far.communicate(timeout=30)
+    finally:
+        for p in (main, far):
+            if p.poll() is None:
+                p.kill()
+    assert main.returncode == 1, main_out + main_err
+    assert "required node 'driver' on host 'far' went away" in main_err, main_err
+    assert far.returncode == 1 and "required node 'driver' exited with code -9" in far_err, far_err
+    topics = _topics(mcap)  # finished and readable, with the far node's commands in it
+    assert topics.get("spread/yonder/r2/cmd_vel", 0) >= 5

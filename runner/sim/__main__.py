@@ -18,7 +18,7 @@ from runner.sim.child import StopFlag, parse
 from runner.sim.world import World
 from runner.transport import ZenohBus, make_config, meta_key
 
-READY_TIMEOUT_S = 10.0
+READY_TIMEOUT_S = 60.0  # the runner (of this host) listening; parts of other hosts may come late
 START_TIMEOUT_S = 60.0  # every part of the run up (other hosts included)
 END_ACK_TIMEOUT_S = 10.0
 
@@ -48,9 +48,9 @@ def main(argv: list[str] | None = None) -> int:
                     return 130
                 print("world: the renderer process is not listening; giving up", file=sys.stderr)
                 return 1
-            # subscribed and set up: nodes (runner.node) wait for this before they publish anything
+            # subscribed and set up: the runner counts the world ready, and nodes (runner.node) wait for this
+            # before they publish anything
             alive = session.liveliness().declare_token(meta_key(plan.name, "world", "alive"))
-            session.put(meta_key(plan.name, "world", "ready"), b"{}")
             # Every part of the run (worlds here and on other hosts) starts on the runner's word, and stops
             # when that word is withdrawn (the runner stopped, or its host went away): together.
             go, gone = threading.Event(), threading.Event()
@@ -92,8 +92,13 @@ def main(argv: list[str] | None = None) -> int:
                     }
                 ).encode()
             )
-            if not acked.wait(END_ACK_TIMEOUT_S) and not should_stop():
-                print("world: the runner did not acknowledge the end; closing anyway", file=sys.stderr)
+            deadline = time.monotonic() + END_ACK_TIMEOUT_S
+            while not acked.wait(0.02):
+                if should_stop():  # the runner is gone (or stops us): nobody will acknowledge
+                    break
+                if time.monotonic() > deadline:
+                    print("world: the runner did not acknowledge the end; closing anyway", file=sys.stderr)
+                    break
             ack_sub.undeclare()
             end_pub.undeclare()
             alive.undeclare()

@@ -71,6 +71,12 @@ def make_config(
         conf.insert_json5("listen/endpoints", json.dumps(list(listen)))
     if connect:
         conf.insert_json5("connect/endpoints", json.dumps(list(connect)))
+    if connect:
+        # A router or client started before the one it joins (another host's runner, say) retries often,
+        # not on Zenoh's default back-off of up to 4 s.
+        conf.insert_json5(
+            "connect/retry", '{"period_init_ms": 100, "period_max_ms": 500, "period_increase_factor": 2}'
+        )
     if mode == "client":
         # A client started a moment before its router keeps retrying instead of failing at once.
         conf.insert_json5("connect/timeout_ms", "10000")
