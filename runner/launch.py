@@ -332,7 +332,9 @@ def run_plan(
                 for p in parts:
                     died = p.dead()
                     if died and error is None and reason == "completed" and len(parts) > 1:
-                        stop_all()  # one world died: the others stop too (its report follows)
+                        # one world died: said at once, the others stop too (the full report follows)
+                        print(f"the {p.label} process died; stopping the run", file=sys.stderr, flush=True)
+                        stop_all()
                     rerr = p.renderer_error()
                     if rerr is not None and error is None:
                         error, reason = rerr, "failed"
