@@ -8,7 +8,6 @@ the recorder waits for the messages the world says it published, and the MCAP fi
 
 from __future__ import annotations
 
-import collections
 import contextlib
 import json
 import os
@@ -26,7 +25,7 @@ from typing import Any
 import zenoh
 
 from runner.errors import RunError
-from runner.nodes import NodeError, Nodes
+from runner.nodes import NodeError, Nodes, OutputTail
 from runner.plan import NodePlan, RunPlan
 from runner.record import Recorder, TopicStats
 from runner.transport import free_port, make_config, meta_key, unpack_attachment
@@ -58,22 +57,6 @@ class RunResult:
         return {k: n - got[k] for k, n in self.published.items() if k in got and n > got[k]}
 
 
-class _StderrTail(threading.Thread):
-    """Forwards a child's stderr and keeps its last lines for the error report."""
-
-    def __init__(self, stream: Any, prefix: str):
-        super().__init__(daemon=True)
-        self.stream = stream
-        self.prefix = prefix
-        self.lines: collections.deque[str] = collections.deque(maxlen=30)
-
-    def run(self) -> None:
-        for raw in iter(self.stream.readline, b""):
-            line = raw.decode(errors="replace").rstrip()
-            self.lines.append(line)
-            print(f"{self.prefix}{line}", file=sys.stderr, flush=True)
-
-
 class _WorldPart:
     """One world of the run: its plan, its process (and renderer process), what it announced."""
 
@@ -85,9 +68,9 @@ class _WorldPart:
         self.session: Any = None  # the runner's session, to acknowledge the world's end
         self.plan_file: str | None = None
         self.child: subprocess.Popen[bytes] | None = None
-        self.tail: _StderrTail | None = None
+        self.tail: OutputTail | None = None
         self.renderer: subprocess.Popen[bytes] | None = None
-        self.rtail: _StderrTail | None = None
+        self.rtail: OutputTail | None = None
         self.ended = threading.Event()
         self.ready = threading.Event()
         self.end_info: dict[str, Any] = {}
@@ -113,13 +96,13 @@ class _WorldPart:
             self.renderer = subprocess.Popen(
                 rcmd, stderr=subprocess.PIPE, start_new_session=True, env=_world_env(plan)
             )
-            self.rtail = _StderrTail(self.renderer.stderr, f"[{self.label.replace('world', 'render')}] ")
+            self.rtail = OutputTail(self.renderer.stderr, f"[{self.label.replace('world', 'render')}] ")
             self.rtail.start()
         world_env = dict(os.environ) if renders_apart else _world_env(plan)
         cmd = [sys.executable, "-m", "runner.sim", self.plan_file, "--connect", endpoint]
         # A session of its own: a terminal's Ctrl-C reaches only us, and we stop the world in order.
         self.child = subprocess.Popen(cmd, stderr=subprocess.PIPE, start_new_session=True, env=world_env)
-        self.tail = _StderrTail(self.child.stderr, f"[{self.label}] ")
+        self.tail = OutputTail(self.child.stderr, f"[{self.label}] ")
         self.tail.start()
 
     def on_alive(self, sample: zenoh.Sample) -> None:

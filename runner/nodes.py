@@ -23,8 +23,9 @@ from runner.plan import NodePlan, RunPlan
 STOP_GRACE_S = 3.0
 
 
-class _Output(threading.Thread):
-    """Forwards a node's output line by line, prefixed, and keeps the last lines for a report."""
+class OutputTail(threading.Thread):
+    """Forwards a child process's output (a node's, a world's stderr) line by line, prefixed with its
+    name, and keeps the last lines for the error report."""
 
     def __init__(self, stream: Any, prefix: str):
         super().__init__(daemon=True)
@@ -46,7 +47,7 @@ class NodeProcess:
         self.restarts = 0
         self.finished: int | None = None  # exit code once it is over for good
         self.proc: subprocess.Popen[bytes] | None = None
-        self.output: _Output | None = None
+        self.output: OutputTail | None = None
 
     def start(self) -> None:
         try:
@@ -61,7 +62,7 @@ class NodeProcess:
         except OSError as e:
             what = f"node {self.plan.name!r} cannot start {self.plan.argv[0]!r}"
             raise NodeError(f"{what}: {e.strerror}") from None
-        self.output = _Output(self.proc.stdout, f"[{self.plan.name}] ")
+        self.output = OutputTail(self.proc.stdout, f"[{self.plan.name}] ")
         self.output.start()
 
     def last_lines(self, n: int = 12) -> str:

@@ -87,6 +87,26 @@ def two_namespaces():
         _sh("ip", "netns", "del", b)
 
 
+def _start_hosts(path: Path, ns_a: str, ns_b: str, *main_args: str) -> tuple[subprocess.Popen[str], ...]:
+    """The main host's runner in one namespace, the far host's (`--host far`) in the other."""
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    runs = (
+        (ns_a, scenario_cmd("run", str(path), *main_args)),
+        (ns_b, scenario_cmd("run", str(path), "--host", "far")),
+    )
+    return tuple(
+        subprocess.Popen(
+            ["ip", "netns", "exec", ns, *cmd],
+            cwd=REPO,
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        for ns, cmd in runs
+    )
+
+
 def _topics(path: Path) -> dict[str, int]:
     out: dict[str, int] = {}
     with open(path, "rb") as f:
@@ -103,22 +123,7 @@ def test_a_two_host_run_records_what_the_one_host_run_does(
     path = write_scenario(SCENE.format(a=addr_a, b=addr_b, diffbot="{diffbot}"))
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     spread = tmp_path / "spread.mcap"
-    main = subprocess.Popen(
-        ["ip", "netns", "exec", ns_a, *scenario_cmd("run", str(path), "--record", str(spread))],
-        cwd=REPO,
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    far = subprocess.Popen(
-        ["ip", "netns", "exec", ns_b, *scenario_cmd("run", str(path), "--host", "far")],
-        cwd=REPO,
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    main, far = _start_hosts(path, ns_a, ns_b, "--record", str(spread))
     try:
         main_out, main_err = main.communicate(timeout=120)
         far_out, far_err = far.communicate(timeout=60)
@@ -152,24 +157,8 @@ def test_a_world_lost_on_the_other_host_fails_the_run(two_namespaces, write_scen
     ns_a, addr_a, ns_b, addr_b = two_namespaces
     text = SCENE.format(a=addr_a, b=addr_b, diffbot="{diffbot}").replace("duration: 3.0", "duration: 600")
     path = write_scenario(text.replace("rate: max", "rate: realtime"))
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
     mcap = tmp_path / "spread.mcap"
-    main = subprocess.Popen(
-        ["ip", "netns", "exec", ns_a, *scenario_cmd("run", str(path), "--record", str(mcap), "--no-judge")],
-        cwd=REPO,
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    far = subprocess.Popen(
-        ["ip", "netns", "exec", ns_b, *scenario_cmd("run", str(path), "--host", "far")],
-        cwd=REPO,
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    main, far = _start_hosts(path, ns_a, ns_b, "--record", str(mcap), "--no-judge")
     try:
         far_world = None
         deadline = time.monotonic() + 40
@@ -230,24 +219,8 @@ def test_a_required_node_lost_on_the_other_host_fails_the_run(
         "nodes:\n  - {name: driver, host: far, namespace: r2, cmd: python node.py, required: true}\n"
     )
     path = write_scenario(text)
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
     mcap = tmp_path / "spread.mcap"
-    main = subprocess.Popen(
-        ["ip", "netns", "exec", ns_a, *scenario_cmd("run", str(path), "--record", str(mcap), "--no-judge")],
-        cwd=REPO,
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    far = subprocess.Popen(
-        ["ip", "netns", "exec", ns_b, *scenario_cmd("run", str(path), "--host", "far")],
-        cwd=REPO,
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    main, far = _start_hosts(path, ns_a, ns_b, "--record", str(mcap), "--no-judge")
     try:
         node = None
         deadline = time.monotonic() + 40
