@@ -485,6 +485,7 @@ class World:
             plugin.close()
         for link in self.remote_renders.values():
             link.close()
+        gc.unfreeze()  # collectable again (a process that builds several worlds must not keep them all)
         return WorldStats(steps=steps, sim_ns=self.now_ns, wall_s=wall_s, published=published)
 
 
