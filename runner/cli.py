@@ -551,6 +551,212 @@ def schema(
     out.print(f"wrote {output}", markup=False)
 
 
+RunOpt = Annotated[str | None, typer.Option("--run", help="The run to join (default: the one running here).")]
+ConnectOpt = Annotated[
+    list[str] | None, typer.Option("--connect", help="Zenoh endpoint of the run (default: the local run's).")
+]
+
+
+@app.command()
+def echo(
+    topic: Annotated[str, typer.Argument(help="Topic inside the run, e.g. r1/scan (or a full key).")],
+    n: Annotated[int | None, typer.Option("-n", help="Stop after N messages.", min=1)] = None,
+    field: Annotated[
+        str | None, typer.Option(help="Print only this field, e.g. pose.pose.position.x.")
+    ] = None,
+    run_name: RunOpt = None,
+    connect: ConnectOpt = None,
+) -> None:
+    """Print a topic's messages, decoded, as YAML documents (like `ros2 topic echo`).
+
+    Examples:
+      scenario echo r1/scan -n 3
+      scenario echo r1/odom --field pose.pose.position
+    """
+    import queue
+
+    import yaml
+
+    from runner import msgs
+    from runner.tools import field_of, find_run, joined, key_of
+    from runner.transport import type_from_encoding, unpack_attachment
+
+    try:
+        name, endpoints = find_run(run_name, connect)
+        key = key_of(name, topic)
+        inbox: queue.SimpleQueue[tuple[str, str | None, bytes, int | None]] = queue.SimpleQueue()
+
+        def on_sample(sample: Any) -> None:
+            att = unpack_attachment(sample.attachment.to_bytes()) if sample.attachment is not None else None
+            stamp = att[1] if att else None
+            inbox.put(
+                (str(sample.key_expr), type_from_encoding(sample.encoding), sample.payload.to_bytes(), stamp)
+            )
+
+        count = 0
+        with joined(endpoints) as session:
+            sub = session.declare_subscriber(key, on_sample)
+            try:
+                while n is None or count < n:
+                    try:
+                        got, type_name, payload, stamp = inbox.get(timeout=0.2)
+                    except queue.Empty:
+                        continue
+                    if type_name is None:
+                        continue
+                    data = msgs.to_data(msgs.decode(payload, type_name))
+                    if field:
+                        data = field_of(data, field)
+                    head = f"# {got} ({type_name})" + (
+                        f" at {stamp / 1e9:.3f} s" if stamp is not None else ""
+                    )
+                    out.print(head, markup=False)
+                    out.print(
+                        yaml.safe_dump(data, sort_keys=False, default_flow_style=None).rstrip(), markup=False
+                    )
+                    out.print("---", markup=False)
+                    count += 1
+            except KeyboardInterrupt:
+                pass
+            finally:
+                sub.undeclare()
+    except RunError as e:
+        raise _fail(e) from None
+
+
+@app.command()
+def pub(
+    topic: Annotated[str, typer.Argument(help="Topic inside the run, e.g. r1/cmd_vel.")],
+    type_name: Annotated[
+        str, typer.Argument(metavar="TYPE", help="ROS 2 type, e.g. geometry_msgs/msg/Twist.")
+    ],
+    data: Annotated[
+        str, typer.Argument(metavar="YAML", help="The message's fields, e.g. '{linear: {x: 0.3}}'.")
+    ] = "{}",
+    rate: Annotated[
+        float | None, typer.Option("-r", "--rate", help="Publish at this rate (Hz, wall).")
+    ] = None,
+    n: Annotated[
+        int | None, typer.Option("-n", help="Publish N times (default: once, or forever with -r).")
+    ] = None,
+    run_name: RunOpt = None,
+    connect: ConnectOpt = None,
+) -> None:
+    """Publish a message on a topic of a running scenario (like `ros2 topic pub`).
+
+    Examples:
+      scenario pub r1/cmd_vel geometry_msgs/msg/Twist '{linear: {x: 0.3}}'
+      scenario pub r1/cmd_vel geometry_msgs/Twist '{angular: {z: 0.5}}' -r 10 -n 50
+    """
+    import time
+
+    import yaml
+    import zenoh
+
+    from runner import msgs
+    from runner.tools import find_run, joined, key_of, wait_matched
+    from runner.transport import encoding_for, pack_attachment, unpack_attachment
+
+    try:
+        full_type = msgs.normalize_type(type_name)
+        if not msgs.is_known(full_type):
+            near = msgs.similar_types(full_type)
+            raise RunError(
+                f"unknown message type {type_name!r}" + (f"; did you mean {', '.join(near)}?" if near else "")
+            )
+        try:
+            fields = yaml.safe_load(data) or {}
+            payload = msgs.encode(msgs.from_data(full_type, fields), full_type)
+        except (yaml.YAMLError, msgs.MessageDataError) as e:
+            raise RunError(f"the message does not fit {full_type}: {e}") from None
+        name, endpoints = find_run(run_name, connect)
+        count = n if n is not None else (None if rate else 1)
+        with joined(endpoints) as session:
+            sim = {"ns": 0}
+
+            def on_clock(sample: Any) -> None:
+                att = (
+                    unpack_attachment(sample.attachment.to_bytes()) if sample.attachment is not None else None
+                )
+                if att:
+                    sim["ns"] = att[1]
+
+            clock = session.declare_subscriber(f"{name}/clock", on_clock)
+            publisher = session.declare_publisher(
+                key_of(name, topic),
+                encoding=encoding_for(full_type),
+                congestion_control=zenoh.CongestionControl.BLOCK,
+            )
+            if not wait_matched(publisher):
+                err.print(f"note: nothing subscribes to {key_of(name, topic)} (yet)", markup=False)
+            sent = 0
+            try:
+                while count is None or sent < count:
+                    publisher.put(payload, attachment=pack_attachment(sent, sim["ns"]))
+                    sent += 1
+                    if count is not None and sent >= count:
+                        break
+                    time.sleep(1.0 / rate if rate else 0.0)
+            except KeyboardInterrupt:
+                pass
+            time.sleep(0.1)  # let the last put leave before the session closes
+            clock.undeclare()
+            publisher.undeclare()
+        err.print(f"published {sent} message(s) on {key_of(name, topic)}", markup=False)
+    except RunError as e:
+        raise _fail(e) from None
+
+
+@app.command()
+def topics(
+    seconds: Annotated[float, typer.Option(help="How long to listen, wall seconds.", min=0.1)] = 1.0,
+    run_name: RunOpt = None,
+    connect: ConnectOpt = None,
+) -> None:
+    """List the topics of a running scenario with their types and rates (like `ros2 topic list -t`).
+
+    Example: scenario topics --seconds 2
+    """
+    import time
+
+    from runner.tools import find_run, joined
+    from runner.transport import type_from_encoding, unpack_attachment
+
+    try:
+        name, endpoints = find_run(run_name, connect)
+        seen: dict[str, dict[str, Any]] = {}
+
+        def on_sample(sample: Any) -> None:
+            key = str(sample.key_expr)
+            entry = seen.setdefault(
+                key, {"type": type_from_encoding(sample.encoding) or "?", "n": 0, "t": []}
+            )
+            entry["n"] += 1
+            att = unpack_attachment(sample.attachment.to_bytes()) if sample.attachment is not None else None
+            if att:
+                entry["t"].append(att[1])
+
+        with joined(endpoints) as session:
+            sub = session.declare_subscriber(f"{name}/**", on_sample)
+            time.sleep(seconds)
+            sub.undeclare()
+    except RunError as e:
+        raise _fail(e) from None
+    table = Table(
+        "topic", "type", "messages", "rate (Hz, wall)", "rate (Hz, sim)", title=f"{name}: live topics"
+    )
+    for key in sorted(seen):
+        e = seen[key]
+        stamps = e["t"]
+        sim = (
+            (len(stamps) - 1) / ((stamps[-1] - stamps[0]) / 1e9)
+            if len(stamps) > 1 and stamps[-1] > stamps[0]
+            else 0
+        )
+        table.add_row(key, e["type"], str(e["n"]), f"{e['n'] / seconds:.1f}", f"{sim:.1f}" if sim else "-")
+    out.print(table)
+
+
 @app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
 def bench(ctx: typer.Context) -> None:
     """Run the benchmark suite (a checkout's bench/ folder): `scenario bench --quick`, `--only two_robots`,

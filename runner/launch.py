@@ -28,6 +28,7 @@ from runner.errors import RunError
 from runner.nodes import NodeError, Nodes, OutputTail
 from runner.plan import NodePlan, RunPlan
 from runner.record import Recorder, TopicStats
+from runner.tools import announce, withdraw
 from runner.transport import free_port, make_config, meta_key, unpack_attachment
 
 STOP_GRACE_S = 1.2  # after SIGINT, how long the world gets before SIGKILL
@@ -202,6 +203,7 @@ def run_plan(
     except zenoh.ZError as e:
         raise RunError(f"cannot open the Zenoh network on {', '.join(listen)}: {e}") from None
 
+    announced = announce(plan.name, listen)  # `scenario echo/pub/topics` find the local run by it
     parts = [
         _WorldPart(
             w,
@@ -367,6 +369,7 @@ def run_plan(
         if recorder is not None:
             recorder.close()
         session.close()
+        withdraw(announced)
 
     infos = [p.end_info for p in parts]
     fallback = recorder.latest_ns if recorder else latest["ns"]

@@ -1,0 +1,135 @@
+"""What `scenario echo`, `scenario pub` and `scenario topics` share: finding a running run, and joining it.
+
+A run announces itself in a small file while it runs (`<tmp>/scenario-runs/<run>.json`: its name, its
+endpoints and the runner's pid), so the tools find the local run without being told; `--connect` joins
+any run by endpoint (another host's, say) and `--run` picks one of several.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import tempfile
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import zenoh
+
+from runner.errors import RunError
+from runner.transport import make_config
+
+RUNS_DIR = Path(tempfile.gettempdir()) / "scenario-runs"
+
+
+@dataclass
+class RunInfo:
+    name: str
+    endpoints: list[str]
+    pid: int
+
+
+def announce(name: str, endpoints: list[str]) -> Path:
+    """Write the run's discovery file; the caller removes it at the end (`withdraw`)."""
+    RUNS_DIR.mkdir(parents=True, exist_ok=True)
+    path = RUNS_DIR / f"{name}.json"
+    path.write_text(json.dumps({"name": name, "endpoints": endpoints, "pid": os.getpid()}))
+    return path
+
+
+def withdraw(path: Path | None) -> None:
+    if path is not None:
+        with contextlib.suppress(OSError):
+            path.unlink()
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def running_runs() -> list[RunInfo]:
+    out = []
+    for path in sorted(RUNS_DIR.glob("*.json")) if RUNS_DIR.is_dir() else []:
+        try:
+            info = json.loads(path.read_text())
+            run = RunInfo(str(info["name"]), list(info["endpoints"]), int(info["pid"]))
+        except (OSError, ValueError, KeyError, TypeError):
+            continue
+        if _alive(run.pid):
+            out.append(run)
+    return out
+
+
+def find_run(run: str | None, connect: list[str] | None) -> tuple[str, list[str]]:
+    """(run name, endpoints): from `--connect` (then `--run` is needed unless one local run is known), else
+    the local run named `run`, else the only local run."""
+    runs = running_runs()
+    if connect:
+        if run is None:
+            if len(runs) != 1:
+                raise RunError("with --connect, say which run with --run NAME")
+            run = runs[0].name
+        return run, list(connect)
+    chosen = [r for r in runs if run is None or r.name == run]
+    if not chosen:
+        what = f"no run named {run!r}" if run else "no scenario is running on this machine"
+        raise RunError(
+            f"{what}; start one with `scenario run FILE`, or join one with --connect ENDPOINT --run NAME"
+        )
+    if len(chosen) > 1:
+        raise RunError(
+            "several runs are going: " + ", ".join(r.name for r in chosen) + "; pick one with --run"
+        )
+    return chosen[0].name, [e.replace("0.0.0.0", "127.0.0.1") for e in chosen[0].endpoints]
+
+
+@contextlib.contextmanager
+def joined(endpoints: list[str]) -> Iterator[Any]:
+    """A client session on the run's network."""
+    try:
+        session = zenoh.open(make_config("client", connect=endpoints))
+    except zenoh.ZError as e:
+        raise RunError(f"cannot reach {', '.join(endpoints)}: {e}") from None
+    try:
+        yield session
+    finally:
+        session.close()
+
+
+def key_of(run: str, topic: str) -> str:
+    """`r1/scan` -> `<run>/r1/scan` (a topic already starting with the run's name is kept)."""
+    topic = topic.strip("/")
+    return topic if topic == run or topic.startswith(run + "/") else f"{run}/{topic}"
+
+
+def field_of(data: Any, path: str) -> Any:
+    """`pose.pose.position.x` or `ranges[3]` inside plain message data."""
+    value = data
+    for part in path.replace("]", "").replace("[", ".").split("."):
+        if not part:
+            continue
+        if isinstance(value, list):
+            value = value[int(part)]
+        elif isinstance(value, dict) and part in value:
+            value = value[part]
+        else:
+            raise RunError(f"no field {part!r} in {path!r}")
+    return value
+
+
+def wait_matched(pub: Any, timeout_s: float = 5.0) -> bool:
+    deadline = time.monotonic() + timeout_s
+    while not pub.matching_status.matching:
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.01)
+    return True

@@ -1,0 +1,111 @@
+"""`scenario echo`, `pub` and `topics` against a real running scenario (found on this machine without
+being told, or joined by endpoint)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+from runner.transport import free_port
+from tests.conftest import run_cli, scenario_cmd
+
+SCENE = """
+name: toolrun
+duration: 120
+rate: realtime
+robots:
+  - name: r1
+    description: "{diffbot}"
+    pose: {xyz: [0, 0, 0.06]}
+    plugins:
+      - {type: diff_drive, params: {odometry_source: world}}
+      - {type: lidar, params: {link: lidar_link, samples: 8, rate: 10}}
+"""
+
+
+@pytest.fixture
+def live_run(write_scenario, tmp_path: Path):
+    path = write_scenario(SCENE)
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    proc = subprocess.Popen(
+        scenario_cmd("run", str(path), "--no-record", "--listen", endpoint, "-q"),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    try:
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline:
+            probe = run_cli("echo", "clock", "-n", "1", "--connect", endpoint, "--run", "toolrun", timeout=20)
+            if probe.returncode == 0:
+                break
+        yield endpoint
+    finally:
+        os.killpg(proc.pid, signal.SIGINT)
+        try:
+            proc.wait(timeout=15)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+
+
+def _docs(text: str) -> list[dict]:
+    return [d for d in yaml.safe_load_all(text) if d is not None]
+
+
+@pytest.mark.timeout(90)
+def test_echo_pub_and_topics_work_on_a_live_run(live_run: str) -> None:
+    # echo -n 3: three decoded scans, found without --connect (the local run announces itself)
+    proc = run_cli("echo", "r1/scan", "-n", "3", timeout=30)
+    assert proc.returncode == 0, proc.stderr
+    scans = _docs(proc.stdout)
+    assert len(scans) == 3 and all(len(s["ranges"]) == 8 for s in scans), proc.stdout
+    assert proc.stdout.count("# toolrun/r1/scan (sensor_msgs/msg/LaserScan) at ") == 3
+
+    def x() -> float:
+        got = run_cli("echo", "r1/odom", "-n", "1", "--field", "pose.pose.position.x", timeout=30)
+        assert got.returncode == 0, got.stderr
+        return float(_docs(got.stdout)[0])
+
+    start = x()
+    # pub moves the robot: 0.5 m/s for ~1 s
+    proc = run_cli(
+        "pub",
+        "r1/cmd_vel",
+        "geometry_msgs/Twist",
+        "{linear: {x: 0.5}}",
+        "-r",
+        "20",
+        "-n",
+        "20",
+        "--connect",
+        live_run,
+        "--run",
+        "toolrun",
+        timeout=30,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "published 20 message(s) on toolrun/r1/cmd_vel" in proc.stderr
+    time.sleep(0.5)
+    assert x() > start + 0.3
+
+    proc = run_cli("topics", "--seconds", "1.5", timeout=30)
+    assert proc.returncode == 0, proc.stderr
+    for key in ("toolrun/clock", "toolrun/r1/scan", "toolrun/r1/odom", "toolrun/r1/tf"):
+        assert key in proc.stdout, proc.stdout
+    assert "sensor_msgs/msg/LaserScan" in proc.stdout
+
+
+@pytest.mark.timeout(60)
+def test_tools_say_clearly_when_there_is_nothing_to_join() -> None:
+    proc = run_cli("echo", "r1/scan", "--run", "no_such_run_here", timeout=30)
+    assert proc.returncode == 1
+    assert "no run named 'no_such_run_here'" in proc.stderr and "Traceback" not in proc.stderr
+    proc = run_cli("pub", "r1/cmd_vel", "geometry_msgs/Twst", "{}", "--run", "x", timeout=30)
+    assert proc.returncode == 1 and "unknown message type" in proc.stderr and "Twist" in proc.stderr
