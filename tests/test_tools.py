@@ -109,3 +109,65 @@ def test_tools_say_clearly_when_there_is_nothing_to_join() -> None:
     assert "no run named 'no_such_run_here'" in proc.stderr and "Traceback" not in proc.stderr
     proc = run_cli("pub", "r1/cmd_vel", "geometry_msgs/Twst", "{}", "--run", "x", timeout=30)
     assert proc.returncode == 1 and "unknown message type" in proc.stderr and "Twist" in proc.stderr
+
+
+@pytest.mark.timeout(90)
+def test_teleop_key_presses_publish_the_right_twists(live_run: str) -> None:
+    """Through a pseudo-terminal, as a user's keyboard: i forward, j turn left, q faster, k stop."""
+    import pty
+
+    import zenoh
+
+    from runner import msgs
+    from runner.transport import make_config
+
+    got: list[tuple[float, float]] = []
+
+    def on_twist(sample: zenoh.Sample) -> None:
+        t = msgs.decode(sample.payload.to_bytes(), "geometry_msgs/msg/Twist")
+        got.append((round(t.linear.x, 4), round(t.angular.z, 4)))
+
+    with zenoh.open(make_config("client", connect=[live_run])) as session:
+        sub = session.declare_subscriber("toolrun/r1/cmd_vel", on_twist)
+        master, slave = pty.openpty()
+        proc = subprocess.Popen(
+            scenario_cmd(
+                "teleop", "r1", "--speed", "0.4", "--turn", "0.8", "--connect", live_run, "--run", "toolrun"
+            ),
+            stdin=slave,
+            stdout=slave,
+            stderr=slave,
+            start_new_session=True,
+        )
+        os.close(slave)
+        try:
+            screen = b""
+            deadline = time.monotonic() + 30
+            while b"publishing on toolrun/r1/cmd_vel" not in screen and time.monotonic() < deadline:
+                screen += os.read(master, 4096)
+            time.sleep(0.5)  # the subscriber is matched
+            for key in (b"i", b"j", b"q", b"i", b"k"):
+                os.write(master, key)
+                time.sleep(0.2)
+            os.write(master, b"\x03")  # Ctrl-C: quits, and stops the robot
+            proc.wait(timeout=15)
+            time.sleep(0.3)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+            os.close(master)
+        sub.undeclare()
+    assert proc.returncode == 0
+    assert got == [(0.4, 0.0), (0.0, 0.8), (0.44, 0.0), (0.0, 0.0), (0.0, 0.0)], got
+
+
+@pytest.mark.timeout(60)
+def test_teleop_needs_a_terminal(live_run: str) -> None:
+    proc = subprocess.run(
+        scenario_cmd("teleop", "r1", "--connect", live_run, "--run", "toolrun"),
+        stdin=subprocess.DEVNULL,
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
+    assert proc.returncode == 1 and "not one" in proc.stderr and "Traceback" not in proc.stderr
