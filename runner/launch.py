@@ -305,16 +305,24 @@ def run_plan(
                         # said at once (the full report follows once everything has stopped)
                         print(message.splitlines()[0] + "; stopping the run", file=sys.stderr, flush=True)
                         stop_all()
-                if (
-                    lost_nodes
-                    and error is None
-                    and reason == "completed"
-                    and not any(p.ended.is_set() for p in parts)
-                ):
+                all_completed = all(p.end_info.get("reason") == "completed" for p in parts)
+                if lost_nodes and error is None and reason == "completed" and not all_completed:
                     reason, error = "failed", lost_nodes[0]
                     print(error + "; stopping the run", file=sys.stderr, flush=True)
                     stop_all()
                 for p in parts:
+                    stopped_there = p.remote_host is not None and p.end_info.get("reason") == "stopped"
+                    if stopped_there and error is None and reason == "completed":
+                        # another host stopped its part (its node failed, it was interrupted): all stop
+                        time.sleep(0.2)  # the cause (a lost node's liveliness) may be just behind
+                        cause = (
+                            lost_nodes[0]
+                            if lost_nodes
+                            else f"the {p.label} on host {p.remote_host!r} stopped"
+                        )
+                        reason, error = "failed", cause
+                        print(cause + "; stopping the run", file=sys.stderr, flush=True)
+                        stop_all()
                     died = p.dead()
                     if died and error is None and reason == "completed" and len(parts) > 1:
                         # one world died: said at once, the others stop too (the full report follows)
