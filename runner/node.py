@@ -32,6 +32,7 @@ from typing import Any
 import zenoh
 
 from runner import msgs
+from runner.graph import GraphTokens
 from runner.plan import topic_key
 from runner.transport import ATTACHMENT, encoding_for, make_config, meta_key, unpack_attachment
 
@@ -115,6 +116,7 @@ class Node:
             meta_key(self.run, "lockstep", self.name), congestion_control=zenoh.CongestionControl.BLOCK
         )
         self._token = self.session.liveliness().declare_token(meta_key(self.run, "node", self.name))
+        self.graph = GraphTokens(self.session, self.run, self.name, "node")
         if wait_for_world:
             self._wait_for_world(wait_for_world)
 
@@ -141,6 +143,7 @@ class Node:
     def publisher(self, topic: str, type_name: str) -> NodePublisher:
         pub = NodePublisher(self, self.key(topic), msgs.normalize_type(type_name))
         self._publishers.append(pub)
+        self.graph.publisher(pub.key, pub.type)
         return pub
 
     def _waiting_message(self, until_ns: int) -> bytes:
@@ -157,6 +160,7 @@ class Node:
         type_name = msgs.normalize_type(type_name)
         first = key not in self._callbacks
         self._callbacks.setdefault(key, []).append((type_name, callback))
+        self.graph.subscriber(key, type_name)
         if first and not self.ordered:
 
             def on_sample(sample: zenoh.Sample, key: str = key) -> None:
@@ -236,6 +240,7 @@ class Node:
 
     # -------------------------------------------------------------------------------------- lifetime
     def close(self) -> None:
+        self.graph.close()
         for ent in (self._token, self._wait_pub, *self._keep):
             try:
                 ent.undeclare()

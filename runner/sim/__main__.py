@@ -14,7 +14,8 @@ import time
 
 import zenoh
 
-from runner.sim.child import StopFlag, parse
+from runner.graph import GraphTokens
+from runner.sim.child import StopFlag, parse, process_name
 from runner.sim.world import World
 from runner.transport import ZenohBus, make_config, meta_key
 
@@ -28,7 +29,8 @@ def main(argv: list[str] | None = None) -> int:
     should_stop = StopFlag()
 
     with zenoh.open(make_config("client", connect=connect)) as session:
-        bus = ZenohBus(session)
+        run = plan.name.split("/", 1)[0]  # a world of several is named <run>/<world>
+        bus = ZenohBus(session, GraphTokens(session, run, process_name(plan.name, "world"), "world"))
         try:
             end_pub = session.declare_publisher(
                 meta_key(plan.name, "world", "end"), congestion_control=zenoh.CongestionControl.BLOCK
@@ -58,7 +60,6 @@ def main(argv: list[str] | None = None) -> int:
             def on_go(sample: zenoh.Sample) -> None:
                 (go if sample.kind == zenoh.SampleKind.PUT else gone).set()
 
-            run = plan.name.split("/", 1)[0]  # a world of several is named <run>/<world>
             go_sub = session.liveliness().declare_subscriber(meta_key(run, "go"), on_go, history=True)
             deadline = time.monotonic() + START_TIMEOUT_S
             while not go.wait(0.01):

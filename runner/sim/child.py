@@ -36,3 +36,12 @@ class StopFlag:
 
     def exit_code(self, ok: int = 0) -> int:
         return ok if self.signal is None else 130
+
+
+def process_name(plan_name: str, role: str) -> str:
+    """How a process of this plan is named in the run's graph: `world` (or the world's name, in a run of
+    several worlds), `renderer` (or `<world>-renderer`)."""
+    _run, _, world = plan_name.partition("/")
+    if not world:
+        return role
+    return world if role == "world" else f"{world}-{role}"

@@ -21,7 +21,8 @@ from typing import Any
 
 import zenoh
 
-from runner.sim.child import StopFlag, parse
+from runner.graph import GraphTokens
+from runner.sim.child import StopFlag, parse, process_name
 from runner.sim.world import _STATE_HEAD, World
 from runner.transport import ZenohBus, make_config, meta_key
 
@@ -33,7 +34,8 @@ def main(argv: list[str] | None = None) -> int:
     should_stop = StopFlag()
 
     with zenoh.open(make_config("client", connect=connect)) as session:
-        bus = ZenohBus(session)
+        run = plan.name.split("/", 1)[0]
+        bus = ZenohBus(session, GraphTokens(session, run, process_name(plan.name, "renderer"), "renderer"))
         subs: list[Any] = []
         world: World | None = None
         try:

@@ -256,7 +256,7 @@ class World:
             self._local.setdefault(key, []).append((msgs.normalize_type(type_name), callback))
             if key not in self._remote_subscribed:
                 self._remote_subscribed.add(key)
-                self.bus.subscribe(key, self._on_remote)
+                self.bus.subscribe(key, self._on_remote, msgs.normalize_type(type_name))
 
         return subscribe
 

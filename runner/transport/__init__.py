@@ -88,16 +88,24 @@ class Bus(Protocol):
 
     def publisher(self, key: str, type_name: str) -> Callable[[bytes, bytes], None]: ...
 
-    def subscribe(self, key: str, callback: Callable[[str, bytes, bytes | None], None]) -> None: ...
+    def subscribe(
+        self, key: str, callback: Callable[[str, bytes, bytes | None], None], type_name: str | None = None
+    ) -> None: ...
 
 
 class ZenohBus:
-    def __init__(self, session: zenoh.Session):
+    """Publishers and subscribers on a session; with `graph` (a `runner.graph.GraphTokens`), each is also
+    announced in the run's graph."""
+
+    def __init__(self, session: zenoh.Session, graph: Any = None):
         self.session = session
+        self.graph = graph
         self._keep: list[Any] = []
         self._pubs: list[Any] = []
 
     def publisher(self, key: str, type_name: str) -> Callable[[bytes, bytes], None]:
+        if self.graph is not None:
+            self.graph.publisher(key, type_name)
         pub = self.session.declare_publisher(
             key,
             encoding=encoding_for(type_name),
@@ -112,7 +120,12 @@ class ZenohBus:
 
         return send
 
-    def subscribe(self, key: str, callback: Callable[[str, bytes, bytes | None], None]) -> None:
+    def subscribe(
+        self, key: str, callback: Callable[[str, bytes, bytes | None], None], type_name: str | None = None
+    ) -> None:
+        if self.graph is not None:
+            self.graph.subscriber(key, type_name)
+
         def on_sample(sample: zenoh.Sample) -> None:
             att = sample.attachment
             callback(str(sample.key_expr), sample.payload.to_bytes(), att.to_bytes() if att else None)
@@ -132,6 +145,8 @@ class ZenohBus:
                 ent.undeclare()
         self._keep.clear()
         self._pubs.clear()
+        if self.graph is not None:
+            self.graph.close()
 
 
 class MemoryBus:
@@ -147,7 +162,9 @@ class MemoryBus:
 
         return send
 
-    def subscribe(self, key: str, callback: Callable[[str, bytes, bytes | None], None]) -> None:
+    def subscribe(
+        self, key: str, callback: Callable[[str, bytes, bytes | None], None], type_name: str | None = None
+    ) -> None:
         self._subs.setdefault(key, []).append(callback)
 
     def inject(self, key: str, payload: bytes, attachment: bytes | None = None) -> None:

@@ -1,0 +1,138 @@
+"""The run's graph: which process publishes and subscribes to which key, told by Zenoh liveliness tokens.
+
+Every process of a run (worlds, renderers, nodes, bridges, the recorder, the command-line tools) declares
+one token for itself and one for each publisher and subscriber it holds, so anyone on the run's network
+can draw the graph (`scenario graph`) or count a topic's publishers (`scenario topics`) with one liveliness
+query, and the tokens vanish with the process, whatever way it ends.
+
+Token keys, under the run's verbatim `@meta` chunk:
+- `<run>/@meta/graph/<process>/<role>` for the process;
+- `<run>/@meta/graph/<process>/<role>/<pub|sub>/<key>/<type>` for an endpoint,
+where each part is percent-quoted into one chunk (a key's `/` and wildcards included) and `<type>` is the
+ROS 2 type or `-` when the endpoint does not say.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from dataclasses import dataclass, field
+from typing import Any
+from urllib.parse import quote, unquote
+
+import zenoh
+
+from runner.transport import meta_key
+
+ROLES = ("world", "renderer", "node", "bridge", "recorder", "tool")
+
+
+def _q(text: str) -> str:
+    return quote(text, safe="")
+
+
+@dataclass(frozen=True)
+class Endpoint:
+    process: str
+    kind: str  # "pub" | "sub"
+    key: str  # a key expression (subscribers may use wildcards)
+    type: str | None = None
+
+
+@dataclass
+class Graph:
+    run: str
+    processes: dict[str, str] = field(default_factory=dict)  # name -> role
+    endpoints: set[Endpoint] = field(default_factory=set)
+
+    def add_token(self, token: str) -> None:
+        """Take in one token key (anything not of the graph is ignored)."""
+        prefix = meta_key(self.run, "graph") + "/"
+        if not token.startswith(prefix):
+            return
+        parts = [unquote(p) for p in token[len(prefix) :].split("/")]
+        if len(parts) >= 2:
+            self.processes.setdefault(parts[0], parts[1])
+        if len(parts) == 5 and parts[2] in ("pub", "sub"):
+            self.endpoints.add(Endpoint(parts[0], parts[2], parts[3], None if parts[4] == "-" else parts[4]))
+
+    def topics(self) -> dict[str, str | None]:
+        """Every concrete key: published, or subscribed without wildcards; with its type when known."""
+        out: dict[str, str | None] = {}
+        for e in sorted(self.endpoints, key=lambda e: (e.key, e.kind != "pub")):
+            if "*" in e.key:
+                continue
+            if out.get(e.key) is None:
+                out[e.key] = e.type
+        return out
+
+    def publishers(self, key: str) -> list[str]:
+        return sorted({e.process for e in self.endpoints if e.kind == "pub" and e.key == key})
+
+    def subscribers(self, key: str) -> list[str]:
+        return sorted({e.process for e in self.endpoints if e.kind == "sub" and intersects(e.key, key)})
+
+
+def intersects(a: str, b: str) -> bool:
+    if a == b:
+        return True
+    try:
+        return bool(zenoh.KeyExpr(a).intersects(zenoh.KeyExpr(b)))
+    except Exception:
+        return False
+
+
+class GraphTokens:
+    """The tokens of one process. Declare endpoints as they are made; `close()` (or the process's end)
+    withdraws them all."""
+
+    def __init__(self, session: zenoh.Session, run: str, process: str, role: str):
+        self.session = session
+        self.base = f"{meta_key(run, 'graph')}/{_q(process)}/{_q(role)}"
+        self._tokens: dict[str, Any] = {}
+        self._declare(self.base)
+
+    def _declare(self, key: str) -> None:
+        if key not in self._tokens:
+            self._tokens[key] = self.session.liveliness().declare_token(key)
+
+    def publisher(self, key: str, type_name: str | None = None) -> None:
+        self._declare(f"{self.base}/pub/{_q(key)}/{_q(type_name or '-')}")
+
+    def subscriber(self, key: str, type_name: str | None = None) -> None:
+        self._declare(f"{self.base}/sub/{_q(key)}/{_q(type_name or '-')}")
+
+    def withdraw_subscriber(self, key: str, type_name: str | None = None) -> None:
+        token = self._tokens.pop(f"{self.base}/sub/{_q(key)}/{_q(type_name or '-')}", None)
+        if token is not None:
+            with contextlib.suppress(Exception):
+                token.undeclare()
+
+    def close(self) -> None:
+        for token in self._tokens.values():
+            with contextlib.suppress(Exception):
+                token.undeclare()
+        self._tokens.clear()
+
+    undeclare = close  # sits among a process's other Zenoh entities
+
+
+def query_graph(session: zenoh.Session, run: str, timeout_s: float = 2.0) -> Graph:
+    """The graph of a run as the network knows it now."""
+    graph = Graph(run)
+    replies = session.liveliness().get(meta_key(run, "graph", "**"), timeout=timeout_s)
+    for reply in replies:
+        with contextlib.suppress(Exception):
+            graph.add_token(str(reply.ok.key_expr))
+    return graph
+
+
+def wait_for(session: zenoh.Session, run: str, check: Any, timeout_s: float = 5.0) -> Graph:
+    """Query the graph until `check(graph)` holds (or the time is up): tokens of a process just started
+    take a moment to reach the router."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        graph = query_graph(session, run)
+        if check(graph) or time.monotonic() > deadline:
+            return graph
+        time.sleep(0.05)
