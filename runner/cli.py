@@ -121,6 +121,18 @@ def validate(
                 "yes" if n.name in plan.lockstep else "no",
             )
         out.print(nodes)
+    if plan.bridges:
+        bridges = Table(
+            "sim topic", "", "other side", "type", "options", title="Bridges", title_justify="left"
+        )
+        arrows = {"SIM_TO_ZENOH": "->", "ZENOH_TO_SIM": "<-", "BIDIRECTIONAL": "<->"}
+        for b in plan.bridges:
+            other = f"ROS 2 {b.ros_topic} (domain {b.ros2.domain})" if b.ros2 else str(b.key)
+            options = [b.encoding] if not b.ros2 else []
+            options += [f"<= {b.rate:g}/s"] if b.rate else []
+            options += ["lazy"] if b.lazy else []
+            bridges.add_row(b.sim_key, arrows[b.direction], other, b.type, ", ".join(options))
+        out.print(bridges)
     if plan.timeline:
         out.print(
             f"timeline: {len(plan.timeline)} message(s) from t={plan.timeline[0].t_ns / 1e9:g} s "
@@ -557,6 +569,16 @@ ConnectOpt = Annotated[
 ]
 
 
+def _tool_tokens(session: Any, run: str, tool: str) -> Any:
+    """This tool in the run's graph (`scenario graph` shows it, like rqt_graph shows `ros2 topic echo`);
+    the tokens go with the session."""
+    import os
+
+    from runner.graph import GraphTokens
+
+    return GraphTokens(session, run, f"{tool}-{os.getpid()}", "tool")
+
+
 @app.command()
 def echo(
     topic: Annotated[str, typer.Argument(help="Topic inside the run, e.g. r1/scan (or a full key).")],
@@ -595,6 +617,8 @@ def echo(
 
         count = 0
         with joined(endpoints) as session:
+            tool = _tool_tokens(session, name, "echo")  # (kept: a dropped token is withdrawn)
+            tool.subscriber(key)
             sub = session.declare_subscriber(key, on_sample)
             try:
                 while n is None or count < n:
@@ -681,6 +705,8 @@ def pub(
                 if att:
                     sim["ns"] = att[1]
 
+            tool = _tool_tokens(session, name, "pub")  # (kept: a dropped token is withdrawn)
+            tool.publisher(key_of(name, topic), full_type)
             clock = session.declare_subscriber(f"{name}/clock", on_clock)
             publisher = session.declare_publisher(
                 key_of(name, topic),
@@ -713,12 +739,14 @@ def topics(
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
 ) -> None:
-    """List the topics of a running scenario with their types and rates (like `ros2 topic list -t`).
+    """List the topics of a running scenario: type, publishers and subscribers (by process), rates (like
+    `ros2 topic list -t` and `ros2 topic info`).
 
     Example: scenario topics --seconds 2
     """
     import time
 
+    from runner.graph import query_graph
     from runner.tools import find_run, joined
     from runner.transport import type_from_encoding, unpack_attachment
 
@@ -740,10 +768,21 @@ def topics(
             sub = session.declare_subscriber(f"{name}/**", on_sample)
             time.sleep(seconds)
             sub.undeclare()
+            graph = query_graph(session, name)
     except RunError as e:
         raise _fail(e) from None
+    for key, type_name in graph.topics().items():  # declared, if silent while we listened
+        if key.startswith(name + "/") and key not in seen:
+            seen[key] = {"type": type_name or "?", "n": 0, "t": []}
     table = Table(
-        "topic", "type", "messages", "rate (Hz, wall)", "rate (Hz, sim)", title=f"{name}: live topics"
+        "topic",
+        "type",
+        "publishers",
+        "subscribers",
+        "messages",
+        "rate (Hz, wall)",
+        "rate (Hz, sim)",
+        title=f"{name}: live topics",
     )
     for key in sorted(seen):
         e = seen[key]
@@ -753,8 +792,58 @@ def topics(
             if len(stamps) > 1 and stamps[-1] > stamps[0]
             else 0
         )
-        table.add_row(key, e["type"], str(e["n"]), f"{e['n'] / seconds:.1f}", f"{sim:.1f}" if sim else "-")
+        table.add_row(
+            key,
+            e["type"],
+            ", ".join(graph.publishers(key)) or "-",
+            ", ".join(graph.subscribers(key)) or "-",
+            str(e["n"]),
+            f"{e['n'] / seconds:.1f}",
+            f"{sim:.1f}" if sim else "-",
+        )
     out.print(table)
+
+
+@app.command()
+def graph(
+    output: Annotated[
+        Path, typer.Option("--output", "-o", help="Write OUTPUT.dot and OUTPUT.png (default: <run>-graph).")
+    ] = Path(""),
+    run_name: RunOpt = None,
+    connect: ConnectOpt = None,
+) -> None:
+    """Draw a running scenario's graph (like rqt_graph): its processes (worlds, renderers, nodes, bridges,
+    the recorder, the tools), its topics, and who publishes and subscribes to what, as a Graphviz DOT file
+    and a PNG; the topics are listed on the terminal too.
+
+    Examples:
+      scenario graph
+      scenario graph -o docs/two_robots_graph --run two_robots
+    """
+    from runner.graph import query_graph
+    from runner.graph_draw import render_png, summary_lines, to_dot
+    from runner.tools import find_run, joined
+
+    try:
+        name, endpoints = find_run(run_name, connect)
+        with joined(endpoints) as session:
+            g = query_graph(session, name)
+    except RunError as e:
+        raise _fail(e) from None
+    if not g.processes:
+        raise _fail(RunError(f"run {name!r} announces no processes (is it still starting?)"))
+    stem = output if str(output) not in ("", ".") else Path(f"{name}-graph")
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    dot, png = stem.with_name(stem.name + ".dot"), stem.with_name(stem.name + ".png")
+    dot.write_text(to_dot(g))
+    render_png(g, png)
+    for line in summary_lines(g):
+        out.print(line, markup=False, highlight=False)
+    out.print(
+        f"{len(g.processes)} processes, {len(g.topics())} topics -> {dot}, {png}",
+        markup=False,
+        highlight=False,
+    )
 
 
 # teleop_twist_keyboard's layout: key -> (forward, turn) directions
@@ -810,6 +899,8 @@ def teleop(
             raise RunError("teleop reads keys from a terminal; stdin is not one")
         twist_type = "geometry_msgs/msg/Twist"
         with joined(endpoints) as session:
+            tool = _tool_tokens(session, name, "teleop")  # (kept: a dropped token is withdrawn)
+            tool.publisher(key, twist_type)
             pub = session.declare_publisher(
                 key, encoding=encoding_for(twist_type), congestion_control=zenoh.CongestionControl.BLOCK
             )

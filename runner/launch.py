@@ -25,6 +25,7 @@ from typing import Any
 import zenoh
 
 from runner.errors import RunError
+from runner.graph import GraphTokens
 from runner.nodes import NodeError, Nodes, OutputTail
 from runner.plan import NodePlan, RunPlan
 from runner.record import Recorder, TopicStats
@@ -244,6 +245,22 @@ def run_plan(
             subs.append(session.declare_subscriber(meta_key(part.plan.name, "**"), part.on_meta))
             alive = meta_key(part.plan.name, "world", "alive")
             subs.append(session.liveliness().declare_subscriber(alive, part.on_alive, history=True))
+        if recorder is not None:
+            graph = GraphTokens(session, plan.name, "recorder", "recorder")
+            graph.subscriber(f"{plan.name}/**")
+            subs.append(graph)
+        bridge_ready = threading.Event()
+        if plan.bridges:
+            # the bridge process (a node) subscribes before the worlds start, so it misses nothing
+
+            def on_bridge(sample: zenoh.Sample) -> None:
+                if sample.kind == zenoh.SampleKind.PUT:
+                    bridge_ready.set()
+
+            bridge_key = meta_key(plan.name, "bridge", "alive")
+            subs.append(session.liveliness().declare_subscriber(bridge_key, on_bridge, history=True))
+        else:
+            bridge_ready.set()
         stop_early = threading.Event()
         if judge is not None:
             subs += _judge_subscribers(session, plan, judge, stop_early, recorder)
@@ -288,7 +305,7 @@ def run_plan(
         try:
             while any(p.running() for p in parts):
                 time.sleep(0.05)
-                all_ready = all(p.ready.is_set() for p in parts)
+                all_ready = all(p.ready.is_set() for p in parts) and bridge_ready.is_set()
                 if all_ready and not started["at"]:
                     started["at"] = time.perf_counter()
                     # every part is up (here and on other hosts): they start together, on this word

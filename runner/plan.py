@@ -60,6 +60,28 @@ class NodePlan(BaseModel):
     required: bool = False
 
 
+class Ros2Plan(BaseModel):
+    domain: int = 0
+    node: str  # the ROS 2 node the simulation appears as
+    router: str | None = None  # a ROS 2 Zenoh router the bridge process joins as well
+    topics: Literal["all", "bridged"] = "all"
+
+
+class BridgePlan(BaseModel):
+    """One mapping, resolved: the sim key and type, and the key on the other side."""
+
+    where: str  # for messages: `bridges[0]`, `bridge.yaml:12`
+    sim_key: str
+    type: str
+    direction: Literal["SIM_TO_ZENOH", "ZENOH_TO_SIM", "BIDIRECTIONAL"]
+    key: str | None = None  # plain Zenoh key (None with ros2)
+    ros_topic: str | None = None  # ROS 2 fully qualified name, with ros2
+    ros2: Ros2Plan | None = None
+    encoding: Literal["cdr", "json"] = "cdr"
+    rate: float | None = None  # messages per sim second, at most
+    lazy: bool = False
+
+
 class RecordPlan(BaseModel):
     enabled: bool
     path: str
@@ -87,6 +109,8 @@ class RunPlan(BaseModel):
     renderers: Literal["auto", "world", "process"] = "auto"  # the launcher resolves auto
     nodes: list[NodePlan] = []
     lockstep: list[str] = []  # node names the world waits for at each step
+    bridges: list[BridgePlan] = []  # run by the bridge process (a node of the run)
+    ros2: Ros2Plan | None = None  # the run's rmw_zenoh settings, when it appears to ROS 2 as a whole
     # Several worlds: each its own plan, named `<run>/<world>` (so its keys are `<run>/<world>/<ns>/...`),
     # run by a process of its own; this plan then holds the run-wide parts (record, nodes, stop_on).
     worlds: list[RunPlan] = []

@@ -18,6 +18,7 @@ from pydantic import (
     NonNegativeInt,
     PositiveFloat,
     field_validator,
+    model_validator,
 )
 
 SCHEMA_VERSION = 1
@@ -390,6 +391,100 @@ class Node(Strict):
     )
 
 
+class Ros2(Strict):
+    """Be seen by ROS 2 over rmw_zenoh (no ROS needed here): topics under rmw_zenoh's keys
+    (`<domain>/<name>/<type>/<hash>`), with its liveliness tokens and attachments, so `ros2 topic list`,
+    `ros2 topic echo` and rclcpp/rclpy nodes running `RMW_IMPLEMENTATION=rmw_zenoh_cpp` see the run."""
+
+    domain: Annotated[int, Field(ge=0, le=232)] = Field(0, description="ROS_DOMAIN_ID.")
+    node: Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")] | None = Field(
+        None, description="The ROS 2 node name the simulation appears as (default: the run's name)."
+    )
+    router: str | None = Field(
+        None,
+        description="Zenoh endpoint of a ROS 2 Zenoh router to join (e.g. `tcp/127.0.0.1:7447`, where "
+        "`ros2 run rmw_zenoh_cpp rmw_zenohd` listens). Default: ROS 2 nodes join the run's own router "
+        "(`scenario run FILE --listen tcp/127.0.0.1:7447` puts it where rmw_zenoh looks by default).",
+    )
+    topics: Literal["all", "bridged"] = Field(
+        "all",
+        description="`all`: every topic of the simulation appears as `/<namespace>/<topic>` (and "
+        "`/clock`), in the directions the simulation uses it; `bridged`: only the `bridges:`.",
+    )
+
+
+BridgeDirection = Literal["SIM_TO_ZENOH", "ZENOH_TO_SIM", "BIDIRECTIONAL"]
+
+
+class Bridge(Strict):
+    """A sim topic re-exposed under another key, encoding or direction; or (`file:`) a ros_gz_bridge
+    configuration file, taken as it is."""
+
+    topic: str | None = Field(
+        None,
+        description="The sim topic, as in the timeline (`r1/scan`, `/clock`); from a `file:`, the gz "
+        "topic names resolve to the sim topic of the same name (in `robot`'s namespace, if given).",
+    )
+    file: str | None = Field(
+        None,
+        description="A ros_gz_bridge YAML file (relative to the scenario): `topic_name` / `ros_topic_name` "
+        "/ `gz_topic_name`, `ros_type_name`, `gz_type_name`, `direction` (GZ_TO_ROS, ROS_TO_GZ, "
+        "BIDIRECTIONAL), `lazy`. gz topics are our sim topics; ROS topics are Zenoh keys (or rmw_zenoh "
+        "topics with `ros2:`).",
+    )
+    robot: str | None = Field(
+        None,
+        description="With `file:`: the robot whose topics the gz names are, and whose namespace relative "
+        "ROS names go under (like ros_gz_bridge started in that namespace).",
+    )
+    key: str | None = Field(
+        None,
+        description="The Zenoh key expression on the other side (default: the topic's own name, outside "
+        "the run: `r1/scan`). With `ros2:` the key is rmw_zenoh's and this is not used.",
+    )
+    ros_topic: str | None = Field(
+        None, description="With `ros2:`, the ROS 2 topic name (default: `/<topic>`)."
+    )
+    type: str | None = Field(
+        None, description="ROS 2 type (default: the sim topic's own), e.g. `geometry_msgs/msg/Twist`."
+    )
+    direction: BridgeDirection = Field(
+        "SIM_TO_ZENOH",
+        description="`SIM_TO_ZENOH` (the sim's messages out), `ZENOH_TO_SIM` (messages from outside into "
+        "the sim, e.g. commands) or `BIDIRECTIONAL`.",
+    )
+    encoding: Literal["cdr", "json"] = Field(
+        "cdr",
+        description="On the other side: `cdr` (the same bytes as in the sim) or `json` (the message's "
+        'fields as a JSON object, e.g. `{"linear": {"x": 0.5}}`).',
+    )
+    rate: PositiveFloat | None = Field(
+        None, description="At most this many messages per sim second to the other side (a throttle)."
+    )
+    lazy: bool = Field(
+        False,
+        description="Forward only while someone subscribes on the other side (SIM_TO_ZENOH), like "
+        "ros_gz_bridge's `lazy`.",
+    )
+    ros2: Ros2 | bool | None = Field(
+        None,
+        description="Use rmw_zenoh's format for this bridge (`true`: the scenario's `ros2:` settings, or "
+        "the defaults). Default: the scenario's `ros2:`, if set.",
+    )
+
+    @model_validator(mode="after")
+    def _one_source(self) -> Bridge:
+        if (self.topic is None) == (self.file is None):
+            raise ValueError("a bridge has either `topic:` (one mapping) or `file:` (a ros_gz_bridge file)")
+        if self.file is not None:
+            extra = [f for f in ("key", "ros_topic", "type") if getattr(self, f) is not None]
+            if extra:
+                raise ValueError(f"{', '.join(extra)}: set per entry inside the file, not beside `file:`")
+        elif self.robot is not None:
+            raise ValueError("`robot:` goes with `file:`; for one topic write it in the topic (`r1/scan`)")
+        return self
+
+
 class Scenario(Strict):
     """A robot-simulation scenario: a world, robots with plugins, a timeline, a recording."""
 
@@ -448,12 +543,27 @@ class Scenario(Strict):
         "it, everything runs on this machine. `scenario run FILE` plays the first host (it records and "
         "judges), `scenario run FILE --host NAME` another one, `--local` all of them here.",
     )
+    bridges: list[Bridge] = Field(
+        default_factory=list,
+        description="Topics re-exposed under other keys, encodings and directions (like ros_gz_bridge); "
+        "`bridges: {file: bridge.yaml}` takes a ros_gz_bridge file as it is. Run by a bridge process.",
+    )
+    ros2: Ros2 | None = Field(
+        None,
+        description="Appear to ROS 2 over rmw_zenoh: every sim topic as `/<ns>/<topic>` (or only the "
+        "bridges), discoverable with `ros2 topic list`.",
+    )
     lockstep: list[str] = Field(
         default_factory=list,
         description="Nodes the world waits for: before acting on commands at each step, the world waits "
         "until each of these nodes has handled the clock it last published (a node made with runner.node "
         "says so when it sleeps). A slow controller cannot be outrun, and a `rate: max` run is repeatable.",
     )
+
+    @field_validator("bridges", mode="before")
+    @classmethod
+    def _bridges(cls, v: Any) -> Any:
+        return [v] if isinstance(v, dict) else v  # `bridges: {file: bridge.yaml}`: one entry
 
     @field_validator("rate", mode="before")
     @classmethod

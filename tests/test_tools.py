@@ -100,6 +100,51 @@ def test_echo_pub_and_topics_work_on_a_live_run(live_run: str) -> None:
     for key in ("toolrun/clock", "toolrun/r1/scan", "toolrun/r1/odom", "toolrun/r1/tf"):
         assert key in proc.stdout, proc.stdout
     assert "sensor_msgs/msg/LaserScan" in proc.stdout
+    scan_row = next(line for line in proc.stdout.splitlines() if "toolrun/r1/scan" in line)
+    assert "world" in scan_row and "recorder" not in scan_row  # (--no-record: no recorder)
+    cmd_row = next(line for line in proc.stdout.splitlines() if "toolrun/r1/cmd_vel" in line)
+    assert "geometry_msgs/msg/Twist" in cmd_row  # subscribed by the world, silent: listed all the same
+
+
+@pytest.mark.timeout(90)
+def test_graph_draws_every_plugins_topics_and_the_tools(
+    live_run: str, write_scenario, tmp_path: Path
+) -> None:
+    from PIL import Image
+
+    from runner.compile import compile_plan
+    from runner.loader import load_file
+    from runner.validate import validate_scenario
+
+    doc = load_file(tmp_path / "scenario.yaml")  # the live run's own file
+    plan = compile_plan(validate_scenario(doc), doc)
+    echo = subprocess.Popen(
+        scenario_cmd("echo", "r1/scan", "--connect", live_run, "--run", "toolrun"),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        time.sleep(2.0)  # its tokens declared
+        proc = run_cli("graph", "-o", str(tmp_path / "g"), timeout=30)
+    finally:
+        echo.terminate()
+        echo.wait(timeout=10)
+    assert proc.returncode == 0, proc.stderr
+    dot = (tmp_path / "g.dot").read_text()
+    assert dot.startswith("digraph")
+    plugin_topics = [t for r in plan.robots for p in r.plugins for t in p.topics]
+    assert len(plugin_topics) >= 4  # cmd_vel in; odom, tf, scan out
+    for t in plugin_topics:  # every plugin's topic, with its direction
+        edge = (
+            f'"process:world" -> "topic:{t.key}"'
+            if t.direction == "pub"
+            else f'"topic:{t.key}" -> "process:world"'
+        )
+        assert edge in dot, (edge, dot)
+        assert t.key.removeprefix("toolrun/") in proc.stdout
+    assert f'"topic:toolrun/r1/scan" -> "process:echo-{echo.pid}"' in dot
+    with Image.open(tmp_path / "g.png") as img:
+        assert img.format == "PNG" and img.width > 300 and img.height > 200
 
 
 @pytest.mark.timeout(60)

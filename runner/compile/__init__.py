@@ -60,7 +60,17 @@ def compile_plan(
     if sc.worlds:
         from runner.compile.worlds import compile_worlds
 
-        return compile_worlds(sc, doc, record_path, notices)
+        plan = compile_worlds(sc, doc, record_path, notices)
+    else:
+        plan = _compile_world(sc, doc, record_path, notices)
+    if sc.bridges or sc.ros2 is not None:
+        from runner.compile.bridges import attach_bridges
+
+        attach_bridges(plan, sc, doc)
+    return plan
+
+
+def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices: Notices) -> RunPlan:
     base = doc.base_dir
     packages = PackageMap.for_scenario(base, {k: (base / v) for k, v in sc.packages.items()})
     for name, folder in packages.explicit.items():

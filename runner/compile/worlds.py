@@ -170,6 +170,8 @@ def compile_worlds(sc: Scenario, doc: Document, record_path: str | None, notices
                 "nodes": [],
                 "lockstep": [],
                 "matrix": {},
+                "bridges": [],  # run-wide: compiled once, against every world's topics
+                "ros2": None,
             }
         )
         view = _WorldView(

@@ -1,0 +1,302 @@
+"""The bridge process: `python -m runner.bridge`, started by `scenario run` as a node of the run when the
+scenario has `bridges:` or `ros2:`.
+
+It reads its mappings (`BridgePlan`s, resolved at compile time) from `SCENARIO_BRIDGE` and joins the run
+at `SCENARIO_ENDPOINT` (and a ROS 2 Zenoh router, if one is named). For each mapping:
+- SIM_TO_ZENOH: a subscriber on the sim key, a publisher on the other key; the message passes on as the
+  same CDR bytes, or as JSON; throttled to `rate` messages per sim second (by the sim stamps); `lazy`
+  subscribes to the sim only while something subscribes on the other side.
+- ZENOH_TO_SIM: a subscriber on the other key (wildcards allowed), a publisher on the sim key; each message
+  is checked against the type (JSON is converted to CDR) and stamped with the sim time, as the timeline
+  and the command-line tools stamp theirs.
+- with `ros2`, the other side speaks rmw_zenoh (`runner.ros2`): its key, liveliness tokens for the node and
+  each publisher/subscription (so `ros2 topic list` sees them), its attachment on every message.
+
+Subscriptions take only messages from other processes, so a BIDIRECTIONAL mapping never feeds itself.
+The process is ready (and the run starts) once everything is declared: nothing the world publishes first
+is missed. It stops on SIGINT/SIGTERM or when its runner goes away.
+"""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import json
+import os
+import signal
+import sys
+import threading
+import time
+from typing import Any
+
+import zenoh
+
+from runner import msgs, ros2
+from runner.graph import GraphTokens
+from runner.plan import BridgePlan, Ros2Plan
+from runner.transport import encoding_for, make_config, meta_key, pack_attachment, unpack_attachment
+
+REMOTE = zenoh.Locality.REMOTE
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, bytes | bytearray | memoryview):
+        return base64.b64encode(bytes(value)).decode()
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not JSON")
+
+
+class _Complaints:
+    """Bad input from outside is said once per mapping (then counted), never fatal."""
+
+    def __init__(self) -> None:
+        self.said: dict[str, int] = {}
+
+    def __call__(self, where: str, message: str) -> None:
+        n = self.said.get(where, 0)
+        self.said[where] = n + 1
+        if n == 0:
+            print(f"bridge: {where}: {message} (dropped; said once)", file=sys.stderr, flush=True)
+
+
+class _RosNode:
+    """One ROS 2 node as rmw_zenoh announces it: its token, and ids for its entities."""
+
+    def __init__(self, session: zenoh.Session, plan: Ros2Plan, node_id: int):
+        self.session = session
+        self.plan = plan
+        self.zid = str(session.zid())
+        self.node_id = node_id
+        self.next_id = node_id + 1
+        self.token = session.liveliness().declare_token(
+            ros2.node_token(plan.domain, self.zid, node_id, "/", plan.node)
+        )
+
+    def entity(self, kind: str, topic: str, type_name: str) -> tuple[Any, bytes]:
+        """A publisher ("MP") or subscription ("MS") token; returns it and the entity's GID."""
+        key = ros2.entity_token(
+            self.plan.domain,
+            self.zid,
+            self.node_id,
+            self.next_id,
+            kind,
+            "/",
+            self.plan.node,
+            topic,
+            type_name,
+        )
+        self.next_id += 1
+        return self.session.liveliness().declare_token(key), ros2.gid(key)
+
+
+class Bridge:
+    def __init__(self, session: zenoh.Session, run: str, clocks: list[str], plans: list[BridgePlan]):
+        self.session = session
+        self.run = run
+        self.sim_ns = 0
+        self.complain = _Complaints()
+        self.graph = GraphTokens(session, run, os.environ.get("SCENARIO_NODE", "bridge"), "bridge")
+        self._keep: list[Any] = []
+        self._ros_nodes: dict[tuple[int, str, str | None], _RosNode] = {}
+        self.forwarded: dict[str, int] = {}
+        for clock in clocks:
+            self._keep.append(session.declare_subscriber(clock, self._on_clock))
+        seen: set[tuple[str, str, str]] = set()
+        for p in plans:
+            other = p.ros_topic if p.ros2 else p.key
+            ident = (p.sim_key, str(other), p.direction)
+            if ident in seen:
+                continue
+            seen.add(ident)
+            if p.direction in ("SIM_TO_ZENOH", "BIDIRECTIONAL"):
+                self._outbound(p)
+            if p.direction in ("ZENOH_TO_SIM", "BIDIRECTIONAL"):
+                self._inbound(p)
+
+    def _on_clock(self, sample: zenoh.Sample) -> None:
+        att = unpack_attachment(sample.attachment.to_bytes()) if sample.attachment is not None else None
+        if att is not None and att[1] > self.sim_ns:
+            self.sim_ns = att[1]
+
+    def _ros_node(self, plan: Ros2Plan) -> _RosNode:
+        ident = (plan.domain, plan.node, plan.router)
+        node = self._ros_nodes.get(ident)
+        if node is None:
+            node = self._ros_nodes[ident] = _RosNode(self.session, plan, len(self._ros_nodes))
+            self._keep.append(node.token)
+        return node
+
+    # ---------------------------------------------------------------------------------- sim -> outside
+    def _outbound(self, p: BridgePlan) -> None:
+        session, type_name = self.session, p.type
+        gid = b""
+        if p.ros2 is not None:
+            assert p.ros_topic is not None
+            node = self._ros_node(p.ros2)
+            token, gid = node.entity("MP", p.ros_topic, type_name)
+            self._keep.append(token)
+            key = ros2.topic_key(p.ros2.domain, p.ros_topic, type_name)
+            pub = session.declare_publisher(key, congestion_control=zenoh.CongestionControl.DROP)
+        else:
+            assert p.key is not None
+            key = p.key
+            encoding = (
+                encoding_for(type_name)
+                if p.encoding == "cdr"
+                else zenoh.Encoding.APPLICATION_JSON.with_schema(type_name)
+            )
+            # an outside subscriber that cannot keep up loses messages; it never slows the simulation
+            pub = session.declare_publisher(
+                key, encoding=encoding, congestion_control=zenoh.CongestionControl.DROP
+            )
+        self._keep.append(pub)
+        self.graph.publisher(key, type_name)
+        period_ns = round(1e9 / p.rate) if p.rate else 0
+        state = {"seq": 0, "last": None, "sub": None}
+        as_json = p.encoding == "json" and p.ros2 is None
+
+        def on_sample(sample: zenoh.Sample) -> None:
+            att = unpack_attachment(sample.attachment.to_bytes()) if sample.attachment is not None else None
+            stamp = att[1] if att is not None else self.sim_ns
+            last = state["last"]
+            if period_ns and last is not None and stamp - last < period_ns:
+                return
+            state["last"] = stamp
+            payload: bytes = sample.payload.to_bytes()
+            if as_json:
+                try:
+                    data = msgs.to_data(msgs.decode(payload, type_name))
+                except Exception as e:
+                    self.complain(p.where, f"a message on {p.sim_key} does not decode as {type_name}: {e}")
+                    return
+                payload = json.dumps(data, default=_json_default, separators=(",", ":")).encode()
+            state["seq"] += 1
+            if p.ros2 is not None:
+                attachment = ros2.pack_attachment(state["seq"], time.time_ns(), gid)
+            else:
+                attachment = pack_attachment(state["seq"] - 1, stamp)
+            pub.put(payload, attachment=attachment)
+            self.forwarded[p.where] = self.forwarded.get(p.where, 0) + 1
+
+        def subscribe() -> None:
+            if state["sub"] is None:
+                state["sub"] = session.declare_subscriber(p.sim_key, on_sample, allowed_origin=REMOTE)
+                self.graph.subscriber(p.sim_key, type_name)  # (a lazy bridge: only while it is)
+
+        def unsubscribe() -> None:
+            sub, state["sub"] = state["sub"], None
+            if sub is not None:
+                self.graph.withdraw_subscriber(p.sim_key, type_name)
+                with contextlib.suppress(Exception):
+                    sub.undeclare()
+
+        if p.lazy:
+            lock = threading.Lock()
+
+            def on_matching(status: Any) -> None:
+                with lock:
+                    (subscribe if status.matching else unsubscribe)()
+
+            self._keep.append(pub.declare_matching_listener(on_matching))
+            with lock:
+                if pub.matching_status.matching:
+                    subscribe()
+        else:
+            subscribe()
+        self._keep.append(_Undeclare(unsubscribe))
+
+    # ---------------------------------------------------------------------------------- outside -> sim
+    def _inbound(self, p: BridgePlan) -> None:
+        session, type_name = self.session, p.type
+        if p.ros2 is not None:
+            assert p.ros_topic is not None
+            node = self._ros_node(p.ros2)
+            token, _gid = node.entity("MS", p.ros_topic, type_name)
+            self._keep.append(token)
+            key = ros2.topic_key(p.ros2.domain, p.ros_topic, type_name)
+        else:
+            assert p.key is not None
+            key = p.key
+        sim_pub = session.declare_publisher(
+            p.sim_key,
+            encoding=encoding_for(type_name),
+            congestion_control=zenoh.CongestionControl.BLOCK,
+            reliability=zenoh.Reliability.RELIABLE,
+        )
+        self._keep.append(sim_pub)
+        self.graph.subscriber(key, type_name)
+        self.graph.publisher(p.sim_key, type_name)
+        period_ns = round(1e9 / p.rate) if p.rate else 0
+        state = {"seq": 0, "last": None}
+        as_json = p.encoding == "json" and p.ros2 is None
+
+        def on_sample(sample: zenoh.Sample) -> None:
+            now = self.sim_ns
+            last = state["last"]
+            if period_ns and last is not None and now - last < period_ns:
+                return
+            raw = sample.payload.to_bytes()
+            try:
+                if as_json:
+                    payload = msgs.encode(msgs.from_data(type_name, json.loads(raw)), type_name)
+                else:
+                    msgs.decode(raw, type_name)  # nothing malformed reaches the world
+                    payload = raw
+            except Exception as e:
+                what = "JSON" if as_json else "CDR"
+                self.complain(p.where, f"a message on {sample.key_expr} is not {what} of {type_name}: {e}")
+                return
+            state["last"] = now
+            sim_pub.put(payload, attachment=pack_attachment(state["seq"], now))
+            state["seq"] += 1
+            self.forwarded[p.where] = self.forwarded.get(p.where, 0) + 1
+
+        self._keep.append(session.declare_subscriber(key, on_sample, allowed_origin=REMOTE))
+
+    def close(self) -> None:
+        for ent in reversed(self._keep):
+            with contextlib.suppress(Exception):
+                ent.undeclare()
+        self._keep.clear()
+        self.graph.close()
+
+
+class _Undeclare:
+    def __init__(self, fn: Any):
+        self.undeclare = fn
+
+
+def main() -> int:
+    try:
+        spec = json.loads(os.environ["SCENARIO_BRIDGE"])
+        endpoint = os.environ["SCENARIO_ENDPOINT"]
+    except (KeyError, ValueError):
+        print("runner.bridge is started by `scenario run` (SCENARIO_BRIDGE is not set)", file=sys.stderr)
+        return 2
+    plans = [BridgePlan.model_validate(b) for b in spec["bridges"]]
+    routers = sorted({p.ros2.router for p in plans if p.ros2 is not None and p.ros2.router})
+    stop = threading.Event()
+    signal.signal(signal.SIGINT, lambda *_: stop.set())
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    parent = os.getppid()
+    # a peer joins several routers (the run's and a ROS 2 one); a client only the first it reaches
+    conf = make_config("peer" if routers else "client", connect=[endpoint, *routers])
+    with zenoh.open(conf) as session:
+        bridge = Bridge(session, spec["run"], list(spec["clocks"]), plans)
+        ready = session.liveliness().declare_token(meta_key(spec["run"], "bridge", "alive"))
+        try:
+            while not stop.wait(0.2):
+                if os.getppid() != parent:
+                    break
+        finally:
+            ready.undeclare()
+            bridge.close()
+    if bridge.complain.said:
+        for where, n in bridge.complain.said.items():
+            print(f"bridge: {where}: {n} message(s) dropped", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
