@@ -736,6 +736,9 @@ def pub(
 @app.command()
 def topics(
     seconds: Annotated[float, typer.Option(help="How long to listen, wall seconds.", min=0.1)] = 1.0,
+    show_all: Annotated[
+        bool, typer.Option("--all", help="Show the run's own helper topics too (`_truth`, `_contacts`).")
+    ] = False,
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
 ) -> None:
@@ -785,6 +788,8 @@ def topics(
         title=f"{name}: live topics",
     )
     for key in sorted(seen):
+        if not show_all and any(c.startswith("_") for c in key[len(name) + 1 :].split("/")):
+            continue  # hidden, as `ros2 topic list` hides `_` topics
         e = seen[key]
         stamps = e["t"]
         sim = (
@@ -809,6 +814,9 @@ def graph(
     output: Annotated[
         Path, typer.Option("--output", "-o", help="Write OUTPUT.dot and OUTPUT.png (default: <run>-graph).")
     ] = Path(""),
+    show_all: Annotated[
+        bool, typer.Option("--all", help="Show the run's own helper topics too (`_truth`, `_contacts`).")
+    ] = False,
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
 ) -> None:
@@ -830,6 +838,8 @@ def graph(
             g = query_graph(session, name)
     except RunError as e:
         raise _fail(e) from None
+    if not show_all:
+        g = g.visible()
     if not g.processes:
         raise _fail(RunError(f"run {name!r} announces no processes (is it still starting?)"))
     stem = output if str(output) not in ("", ".") else Path(f"{name}-graph")

@@ -56,6 +56,17 @@ class Graph:
         if len(parts) == 5 and parts[2] in ("pub", "sub"):
             self.endpoints.add(Endpoint(parts[0], parts[2], parts[3], None if parts[4] == "-" else parts[4]))
 
+    def visible(self) -> Graph:
+        """Without the run's own helper topics (`_truth`, `_contacts`: a chunk starting with `_`), which
+        rqt_graph would hide as well."""
+        prefix = self.run + "/"
+
+        def hidden(key: str) -> bool:
+            rel = key[len(prefix) :] if key.startswith(prefix) else key
+            return any(chunk.startswith("_") for chunk in rel.split("/"))
+
+        return Graph(self.run, dict(self.processes), {e for e in self.endpoints if not hidden(e.key)})
+
     def topics(self) -> dict[str, str | None]:
         """Every concrete key: published, or subscribed without wildcards; with its type when known."""
         out: dict[str, str | None] = {}

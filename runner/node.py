@@ -102,6 +102,8 @@ class Node:
         # lost. In lockstep (the launcher says so), one subscription to the whole run keeps the world's
         # order: every message of sim time t comes before the clock of t, so a node woken by the clock has
         # seen all of it, and the run is repeatable.
+        self.graph = GraphTokens(self.session, self.run, self.name, "node")
+        self.graph.subscriber(self.clock_key, "rosgraph_msgs/msg/Clock")
         self.ordered = ordered if ordered is not None else env.get("SCENARIO_LOCKSTEP") == "1"
         if self.ordered:
             self._keep.append(self.session.declare_subscriber(f"{self.run}/**", self._on_any))
@@ -116,7 +118,6 @@ class Node:
             meta_key(self.run, "lockstep", self.name), congestion_control=zenoh.CongestionControl.BLOCK
         )
         self._token = self.session.liveliness().declare_token(meta_key(self.run, "node", self.name))
-        self.graph = GraphTokens(self.session, self.run, self.name, "node")
         if wait_for_world:
             self._wait_for_world(wait_for_world)
 
