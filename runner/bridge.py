@@ -102,17 +102,50 @@ class Bridge:
         self.forwarded: dict[str, int] = {}
         for clock in clocks:
             self._keep.append(session.declare_subscriber(clock, self._on_clock))
-        seen: set[tuple[str, str, str]] = set()
+        self._seen: set[tuple[str, str, str]] = set()
+        self._lock = threading.Lock()
         for p in plans:
-            other = p.ros_topic if p.ros2 else p.key
-            ident = (p.sim_key, str(other), p.direction)
-            if ident in seen:
+            self._add(p)
+
+    def _add(self, p: BridgePlan) -> None:
+        other = p.ros_topic if p.ros2 else p.key
+        directions = ("SIM_TO_ZENOH", "ZENOH_TO_SIM") if p.direction == "BIDIRECTIONAL" else (p.direction,)
+        for direction in directions:
+            ident = (p.sim_key, str(other), direction)
+            if ident in self._seen:
                 continue
-            seen.add(ident)
-            if p.direction in ("SIM_TO_ZENOH", "BIDIRECTIONAL"):
-                self._outbound(p)
-            if p.direction in ("ZENOH_TO_SIM", "BIDIRECTIONAL"):
-                self._inbound(p)
+            self._seen.add(ident)
+            (self._outbound if direction == "SIM_TO_ZENOH" else self._inbound)(p)
+
+    def mirror_nodes(self, ros: Ros2Plan) -> None:
+        """`ros2: {topics: all}`: the topics nodes publish and subscribe to (announced in the run's graph as
+        the nodes start) appear to ROS 2 too, as `/<ns>/<topic>`."""
+        from runner.graph import Graph
+
+        def on_token(sample: zenoh.Sample) -> None:
+            if sample.kind != zenoh.SampleKind.PUT:
+                return
+            graph = Graph(self.run)
+            graph.add_token(str(sample.key_expr))
+            for e in graph.endpoints:
+                rel = e.key[len(self.run) + 1 :] if e.key.startswith(self.run + "/") else ""
+                hidden = any(c.startswith("_") for c in rel.split("/"))
+                if graph.processes.get(e.process) != "node" or not rel or hidden or "*" in rel or not e.type:
+                    continue
+                direction = "SIM_TO_ZENOH" if e.kind == "pub" else "ZENOH_TO_SIM"
+                plan = BridgePlan(
+                    where=f"ros2 (/{rel}, node {e.process})",
+                    sim_key=e.key,
+                    type=e.type,
+                    direction=direction,  # type: ignore[arg-type]
+                    ros_topic="/" + rel,
+                    ros2=ros,
+                )
+                with self._lock, contextlib.suppress(Exception):
+                    self._add(plan)
+
+        key = meta_key(self.run, "graph", "**")
+        self._keep.append(self.session.liveliness().declare_subscriber(key, on_token, history=True))
 
     def _on_clock(self, sample: zenoh.Sample) -> None:
         att = unpack_attachment(sample.attachment.to_bytes()) if sample.attachment is not None else None
@@ -284,6 +317,8 @@ def main() -> int:
     conf = make_config("peer" if routers else "client", connect=[endpoint, *routers])
     with zenoh.open(conf) as session:
         bridge = Bridge(session, spec["run"], list(spec["clocks"]), plans)
+        if spec.get("mirror_nodes"):
+            bridge.mirror_nodes(Ros2Plan.model_validate(spec["mirror_nodes"]))
         ready = session.liveliness().declare_token(meta_key(spec["run"], "bridge", "alive"))
         try:
             while not stop.wait(0.2):

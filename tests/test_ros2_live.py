@@ -124,3 +124,83 @@ def test_a_ros2_system_discovers_reads_and_drives_the_run(write_scenario, tmp_pa
     assert len(commands) == 20 and commands[0].linear.x == pytest.approx(0.5)
     xs = [m.pose.pose.position.x for topic, _t, _s, m in records if topic == "rosrun/r1/odom"]
     assert xs[-1] - xs[0] > 0.3, "the robot did not move"
+
+
+@pytest.mark.timeout(90)
+def test_the_run_joins_a_ros2_router_of_its_own(write_scenario, tmp_path: Path) -> None:
+    """`ros2: {router: ...}`: the bridge also joins the ROS 2 side's Zenoh router (rmw_zenohd's role here is
+    played by a plain Zenoh router), and a ROS 2 session that knows only that router sees the run."""
+    from runner.transport import free_port, make_config
+
+    ros_router = f"tcp/127.0.0.1:{free_port()}"
+    path = write_scenario(SCENE.replace("ros2: {domain: 7}", f'ros2: {{domain: 3, router: "{ros_router}"}}'))
+    with (
+        zenoh.open(make_config("router", listen=[ros_router])),
+        zenoh.open(make_config("client", connect=[ros_router])) as ros_side,
+    ):
+        got: list[bytes] = []
+        key = ros2.topic_key(3, "/r1/scan", "sensor_msgs/msg/LaserScan")
+        sub = ros_side.declare_subscriber(key, lambda s: got.append(s.payload.to_bytes()))
+        run = subprocess.Popen(
+            scenario_cmd("run", str(path), "-q", "--no-record"),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        try:
+            deadline = time.monotonic() + 30
+            while len(got) < 3 and time.monotonic() < deadline:
+                time.sleep(0.05)
+            tokens = [str(r.ok.key_expr) for r in ros_side.liveliness().get("@ros2_lv/3/**") if r.ok]
+        finally:
+            run.send_signal(2)
+            run.communicate(timeout=30)
+            sub.undeclare()
+    assert len(got) >= 3
+    assert len(msgs.decode(got[0], "sensor_msgs/msg/LaserScan").ranges) == 16
+    assert any(t.endswith("/NN/%/%/rosrun") for t in tokens), tokens
+
+
+NODE_SCRIPT = """
+from runner.node import Node
+
+with Node() as node:
+    status = node.publisher("status", "std_msgs/msg/String")
+    while node.sleep(0.1):
+        status.publish({"data": f"at {node.now:.1f}"})
+"""
+
+
+@pytest.mark.timeout(90)
+def test_a_nodes_topics_appear_to_ros2_as_the_node_starts(write_scenario, tmp_path: Path) -> None:
+    (tmp_path / "status_node.py").write_text(NODE_SCRIPT)
+    path = write_scenario(SCENE + "nodes:\n  - {name: reporter, cmd: python status_node.py, namespace: r1}\n")
+    listener = Listener([])
+    got: list[tuple[bytes, bytes | None]] = []
+    key = ros2.topic_key(7, "/r1/status", "std_msgs/msg/String")
+    sub = listener.session.declare_subscriber(
+        key,
+        lambda s: got.append(
+            (s.payload.to_bytes(), s.attachment.to_bytes() if s.attachment is not None else None)
+        ),
+    )
+    run = subprocess.Popen(
+        scenario_cmd("run", str(path), "-q", "--no-record", "--connect", listener.endpoint),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        deadline = time.monotonic() + 30
+        while len(got) < 3 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        tokens = [str(r.ok.key_expr) for r in listener.session.liveliness().get("@ros2_lv/7/**") if r.ok]
+    finally:
+        run.send_signal(2)
+        run.communicate(timeout=30)
+        sub.undeclare()
+        listener.close()
+    assert len(got) >= 3
+    assert msgs.decode(got[-1][0], "std_msgs/msg/String").data.startswith("at ")
+    mp = next(t for t in tokens if "/MP/" in t and "%r1%status" in t)
+    assert ros2.unpack_attachment(got[0][1])[2] == ros2.gid(mp)  # type: ignore[index]

@@ -158,6 +158,10 @@ def attach_bridges(plan: RunPlan, sc: Scenario, doc: Document) -> None:
             "run": plan.name,
             "clocks": [p.clock_key for p in plan.parts()],
             "bridges": [b.model_dump(mode="json") for b in out],
+            # nodes' topics are known once they run: the bridge mirrors them as they appear
+            "mirror_nodes": run_ros2.model_dump(mode="json")
+            if run_ros2 is not None and run_ros2.topics == "all"
+            else None,
         }
         plan.nodes.append(
             NodePlan(
