@@ -44,6 +44,13 @@ class Listener:
         self.session.close()
 
 
+def start_run(path: Path, *args: str) -> subprocess.Popen[str]:
+    """`scenario run PATH ARGS` in the background (stop it with SIGINT, then `communicate()`)."""
+    return subprocess.Popen(
+        scenario_cmd("run", str(path), "-q", *args), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+
+
 def _run(*args: str, timeout: float = 90) -> subprocess.CompletedProcess[str]:
     return subprocess.run(scenario_cmd(*args), capture_output=True, text=True, timeout=timeout)
 
@@ -127,12 +134,7 @@ def test_json_twist_from_a_plain_zenoh_program_moves_the_robot(write_scenario, t
     program.write_text(PLAIN_PROGRAM)
     listener = Listener(["outside/**"])
     mcap = tmp_path / "run.mcap"
-    run = subprocess.Popen(
-        scenario_cmd("run", str(path), "-q", "--record", str(mcap), "--connect", listener.endpoint),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    run = start_run(path, "--record", str(mcap), "--connect", listener.endpoint)
     try:
         # the program knows nothing of the run but the endpoint and the key
         subprocess.run([sys.executable, str(program), listener.endpoint, "2.5"], check=True, timeout=30)
@@ -180,12 +182,7 @@ def test_bidirectional_does_not_echo_and_lazy_subscribes_only_when_needed(write_
     path = write_scenario(BIDI_SCENE)
     listener = Listener(["ext/cmd_vel"])
     mcap = tmp_path / "bidi.mcap"
-    run = subprocess.Popen(
-        scenario_cmd("run", str(path), "-q", "--record", str(mcap), "--connect", listener.endpoint),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    run = start_run(path, "--record", str(mcap), "--connect", listener.endpoint)
     session = listener.session
     try:
         deadline = time.monotonic() + 30

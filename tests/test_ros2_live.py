@@ -5,7 +5,6 @@ by the golden tests of test_ros2_format.py."""
 
 from __future__ import annotations
 
-import subprocess
 import threading
 import time
 from pathlib import Path
@@ -14,8 +13,8 @@ import pytest
 import zenoh
 
 from runner import msgs, ros2
-from tests.conftest import read_mcap, scenario_cmd
-from tests.test_bridges import Listener
+from tests.conftest import read_mcap
+from tests.test_bridges import Listener, start_run
 
 SCENE = """
 name: rosrun
@@ -38,12 +37,7 @@ def test_a_ros2_system_discovers_reads_and_drives_the_run(write_scenario, tmp_pa
     listener = Listener([])
     session = listener.session
     mcap = tmp_path / "ros.mcap"
-    run = subprocess.Popen(
-        scenario_cmd("run", str(path), "-q", "--record", str(mcap), "--connect", listener.endpoint),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    run = start_run(path, "--record", str(mcap), "--connect", listener.endpoint)
     try:
         # discovery, as rmw_zenoh's graph cache does it
         tokens: list[str] = []
@@ -141,12 +135,7 @@ def test_the_run_joins_a_ros2_router_of_its_own(write_scenario, tmp_path: Path) 
         got: list[bytes] = []
         key = ros2.topic_key(3, "/r1/scan", "sensor_msgs/msg/LaserScan")
         sub = ros_side.declare_subscriber(key, lambda s: got.append(s.payload.to_bytes()))
-        run = subprocess.Popen(
-            scenario_cmd("run", str(path), "-q", "--no-record"),
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
+        run = start_run(path, "--no-record")
         try:
             deadline = time.monotonic() + 30
             while len(got) < 3 and time.monotonic() < deadline:
@@ -184,12 +173,7 @@ def test_a_nodes_topics_appear_to_ros2_as_the_node_starts(write_scenario, tmp_pa
             (s.payload.to_bytes(), s.attachment.to_bytes() if s.attachment is not None else None)
         ),
     )
-    run = subprocess.Popen(
-        scenario_cmd("run", str(path), "-q", "--no-record", "--connect", listener.endpoint),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    run = start_run(path, "--no-record", "--connect", listener.endpoint)
     try:
         deadline = time.monotonic() + 30
         while len(got) < 3 and time.monotonic() < deadline:

@@ -267,42 +267,22 @@ def _one(
         problems.append(Problem("the topic's type is not known here; give it", doc.locate(at), at))
         return []
     rel = key[len(topics.run) + 1 :]
+    common = {"where": _where(doc, where), "sim_key": key, "type": type_name, "direction": b.direction}
+    common |= {"rate": b.rate, "lazy": b.lazy}
     if ros2 is not None:
         if b.encoding != "cdr":
             at = (*where, "encoding")
             problems.append(Problem("ROS 2 speaks CDR", doc.locate(at), at, expected="cdr", found=b.encoding))
             return []
-        return [
-            BridgePlan(
-                where=_where(doc, where),
-                sim_key=key,
-                type=type_name,
-                direction=b.direction,
-                ros_topic=_qualify(b.ros_topic or rel, None),
-                ros2=ros2,
-                rate=b.rate,
-                lazy=b.lazy,
-            )
-        ]
+        return [BridgePlan(**common, ros_topic=_qualify(b.ros_topic or rel, None), ros2=ros2)]
     other = (b.key or rel).strip("/")
-    if not _key_ok(other, key, b.direction, topics.run, doc, (*where, "key"), problems):
+    if not _key_ok(other, b.direction, topics.run, doc, (*where, "key"), problems):
         return []
-    return [
-        BridgePlan(
-            where=_where(doc, where),
-            sim_key=key,
-            type=type_name,
-            direction=b.direction,
-            key=other,
-            encoding=b.encoding,
-            rate=b.rate,
-            lazy=b.lazy,
-        )
-    ]
+    return [BridgePlan(**common, key=other, encoding=b.encoding)]
 
 
 def _key_ok(
-    other: str, sim_key: str, direction: str, run: str, doc: Document, at: PathKey, problems: list[Problem]
+    other: str, direction: str, run: str, doc: Document, at: PathKey, problems: list[Problem]
 ) -> bool:
     import zenoh
 
@@ -331,7 +311,6 @@ def _key_ok(
             )
         )
         return False
-    del sim_key
     return True
 
 
@@ -478,31 +457,14 @@ def _file_entry(
         )
         return None
     fq = _qualify(str(ros_name), namespace)
-    where = f"{fdoc.locate((j,))} ({b.file} entry {j})"
+    common = {"where": f"{fdoc.locate((j,))} ({b.file} entry {j})", "sim_key": key, "type": full}
+    common |= {"direction": ours, "lazy": lazy, "rate": b.rate}
     if ros2 is not None:
-        return BridgePlan(
-            where=where,
-            sim_key=key,
-            type=full,
-            direction=ours,
-            ros_topic=fq,
-            ros2=ros2,
-            lazy=lazy,
-            rate=b.rate,
-        )
+        return BridgePlan(**common, ros_topic=fq, ros2=ros2)
     other = fq.strip("/")
-    if not _key_ok(other, key, ours, topics.run, fdoc, (j,), problems):
+    if not _key_ok(other, ours, topics.run, fdoc, (j,), problems):
         return None
-    return BridgePlan(
-        where=where,
-        sim_key=key,
-        type=full,
-        direction=ours,
-        key=other,
-        encoding=b.encoding,
-        lazy=lazy,
-        rate=b.rate,
-    )
+    return BridgePlan(**common, key=other, encoding=b.encoding)
 
 
 def _mirror_all(topics: _Topics, ros2: Ros2Plan) -> list[BridgePlan]:
