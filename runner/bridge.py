@@ -160,16 +160,19 @@ class Bridge:
             self._keep.append(node.token)
         return node
 
+    def _ros_entity(self, p: BridgePlan, kind: str) -> tuple[str, bytes]:
+        """The rmw_zenoh key of a mapping's ROS 2 side, with its entity announced ("MP"/"MS"); its GID."""
+        assert p.ros2 is not None and p.ros_topic is not None
+        token, gid = self._ros_node(p.ros2).entity(kind, p.ros_topic, p.type)
+        self._keep.append(token)
+        return ros2.topic_key(p.ros2.domain, p.ros_topic, p.type), gid
+
     # ---------------------------------------------------------------------------------- sim -> outside
     def _outbound(self, p: BridgePlan) -> None:
         session, type_name = self.session, p.type
         gid = b""
         if p.ros2 is not None:
-            assert p.ros_topic is not None
-            node = self._ros_node(p.ros2)
-            token, gid = node.entity("MP", p.ros_topic, type_name)
-            self._keep.append(token)
-            key = ros2.topic_key(p.ros2.domain, p.ros_topic, type_name)
+            key, gid = self._ros_entity(p, "MP")
             pub = session.declare_publisher(key, congestion_control=zenoh.CongestionControl.DROP)
         else:
             assert p.key is not None
@@ -243,11 +246,7 @@ class Bridge:
     def _inbound(self, p: BridgePlan) -> None:
         session, type_name = self.session, p.type
         if p.ros2 is not None:
-            assert p.ros_topic is not None
-            node = self._ros_node(p.ros2)
-            token, _gid = node.entity("MS", p.ros_topic, type_name)
-            self._keep.append(token)
-            key = ros2.topic_key(p.ros2.domain, p.ros_topic, type_name)
+            key, _gid = self._ros_entity(p, "MS")
         else:
             assert p.key is not None
             key = p.key

@@ -564,6 +564,9 @@ def schema(
 
 
 RunOpt = Annotated[str | None, typer.Option("--run", help="The run to join (default: the one running here).")]
+AllOpt = Annotated[
+    bool, typer.Option("--all", help="Show the run's own helper topics too (`_truth`, `_contacts`).")
+]
 ConnectOpt = Annotated[
     list[str] | None, typer.Option("--connect", help="Zenoh endpoint of the run (default: the local run's).")
 ]
@@ -736,9 +739,7 @@ def pub(
 @app.command()
 def topics(
     seconds: Annotated[float, typer.Option(help="How long to listen, wall seconds.", min=0.1)] = 1.0,
-    show_all: Annotated[
-        bool, typer.Option("--all", help="Show the run's own helper topics too (`_truth`, `_contacts`).")
-    ] = False,
+    show_all: AllOpt = False,
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
 ) -> None:
@@ -812,11 +813,10 @@ def topics(
 @app.command()
 def graph(
     output: Annotated[
-        Path, typer.Option("--output", "-o", help="Write OUTPUT.dot and OUTPUT.png (default: <run>-graph).")
-    ] = Path(""),
-    show_all: Annotated[
-        bool, typer.Option("--all", help="Show the run's own helper topics too (`_truth`, `_contacts`).")
-    ] = False,
+        Path | None,
+        typer.Option("--output", "-o", help="Write OUTPUT.dot and OUTPUT.png (default: <run>-graph)."),
+    ] = None,
+    show_all: AllOpt = False,
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
 ) -> None:
@@ -842,7 +842,7 @@ def graph(
         g = g.visible()
     if not g.processes:
         raise _fail(RunError(f"run {name!r} announces no processes (is it still starting?)"))
-    stem = output if str(output) not in ("", ".") else Path(f"{name}-graph")
+    stem = output or Path(f"{name}-graph")
     stem.parent.mkdir(parents=True, exist_ok=True)
     dot, png = stem.with_name(stem.name + ".dot"), stem.with_name(stem.name + ".png")
     dot.write_text(to_dot(g))
