@@ -161,6 +161,8 @@ class _WorldPart:
                 _stop(self.renderer)
             if self.rtail:
                 self.rtail.join(timeout=1.0)
+        if error is None and self.end_info.get("reason") == "failed":
+            error = f"{self.label}: {self.end_info.get('error')}"  # stopped on its own, in order
         return error
 
     def cleanup(self) -> None:

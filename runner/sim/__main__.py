@@ -71,6 +71,8 @@ def main(argv: list[str] | None = None) -> int:
             stats = world.run(should_stop=lambda: should_stop() or gone.is_set())
             go_sub.undeclare()
             reason = "completed" if stats.sim_ns >= plan.duration_ns else "stopped"
+            if stats.error is not None:
+                reason = "failed"  # the runner reports it (the end message carries it)
             if reason == "stopped" and gone.is_set() and not should_stop():
                 print(
                     f"world: the runner went away at {stats.sim_ns / 1e9:.2f} s sim; stopping",
@@ -90,6 +92,7 @@ def main(argv: list[str] | None = None) -> int:
                         "steps": stats.steps,
                         "wall_s": stats.wall_s,
                         "published": stats.published,
+                        "error": stats.error,
                     }
                 ).encode()
             )

@@ -136,6 +136,16 @@ class WorldStats:
     sim_ns: int = 0
     wall_s: float = 0.0
     published: dict[str, int] = field(default_factory=dict)
+    error: str | None = None  # why the world stopped early on its own (physics went unstable)
+
+
+# MuJoCo's warnings for NaN/Inf/huge positions, velocities, accelerations: it then resets the data and goes
+# on as if nothing happened, so the world checks them after every batch of steps and stops instead
+_UNSTABLE = (
+    int(mujoco.mjtWarning.mjWARN_BADQPOS),
+    int(mujoco.mjtWarning.mjWARN_BADQVEL),
+    int(mujoco.mjtWarning.mjWARN_BADQACC),
+)
 
 
 class World:
@@ -445,6 +455,8 @@ class World:
         wall0 = time.perf_counter()
         next_check = wall0
         steps = 0
+        warnings = [d.warning[i] for i in _UNSTABLE]
+        error = None
         while True:
             self._boundary()
             if self.now_ns >= end_ns:
@@ -459,6 +471,9 @@ class World:
             else:
                 mujoco.mj_step(m, d, nstep=n)
             steps += n
+            if warnings[0].number or warnings[1].number or warnings[2].number:
+                error = self._instability(self.now_ns, self.now_ns + n * self.step_ns)
+                break
             self.now_ns += n * self.step_ns
             wall = time.perf_counter()
             if factor is not None:
@@ -486,7 +501,28 @@ class World:
         for link in self.remote_renders.values():
             link.close()
         gc.unfreeze()  # collectable again (a process that builds several worlds must not keep them all)
-        return WorldStats(steps=steps, sim_ns=self.now_ns, wall_s=wall_s, published=published)
+        return WorldStats(steps=steps, sim_ns=self.now_ns, wall_s=wall_s, published=published, error=error)
+
+    def _instability(self, t0_ns: int, t1_ns: int) -> str:
+        """What went unstable, where (the joint of the degree of freedom MuJoCo names, and its robot)."""
+        m, d = self.model, self.data
+        kinds = zip(("positions", "velocities", "accelerations"), _UNSTABLE, strict=True)
+        kind, i = next((k, i) for k, i in kinds if d.warning[i].number)
+        dof = int(d.warning[i].lastinfo)
+        what = f"degree of freedom {dof}"
+        if 0 <= dof < m.nv:
+            jnt = int(m.dof_jntid[dof])
+            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, jnt)
+            body = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.jnt_bodyid[jnt])) or ""
+            what = f"joint {name}" if name else f"the free joint of body {body}"
+            robot = next((r.name for r in self.plan.robots if (name or body).startswith(r.prefix)), None)
+            if robot:
+                what += f" (robot {robot})"
+        return (
+            f"the physics went unstable between t = {t0_ns / 1e9:.3f} s and {t1_ns / 1e9:.3f} s: NaN, Inf "
+            f"or huge values in the {kind} of {what}; the run stops here (the recording keeps everything "
+            "before). Hint: a smaller world.physics.timestep, or check the joint's limits, damping, masses"
+        )
 
 
 class RemoteRender:
