@@ -539,6 +539,39 @@ def info(mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")]) -> 
         )
     out.print(table)
     out.print(f"{s['messages']} messages, sim time {start / 1e9:.3f} s .. {end / 1e9:.3f} s ({span:.3f} s)")
+    if s["cut"]:
+        out.print(
+            f"cut: the recording has no summary (its runner was killed); it reaches {end / 1e9:.3f} s sim, "
+            f"every complete chunk read. `scenario recover {mcap}` writes a complete copy.",
+            markup=False,
+        )
+
+
+@app.command()
+def recover(
+    mcap: Annotated[Path, typer.Argument(help="A recording cut short (its runner was killed).")],
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="Where to write (default: NAME.recovered.mcap).")
+    ] = None,
+) -> None:
+    """Rewrite a cut recording as a complete MCAP (summary, indexes): every message of its complete chunks.
+    The cut file is left as it is.
+
+    Example: scenario recover runs/two_robots.mcap
+    """
+    from runner.record import recover as do_recover
+
+    if not mcap.is_file():
+        raise _fail(RunError(f"{mcap}: file not found"))
+    target = output or mcap.with_name(mcap.stem + ".recovered.mcap")
+    if target.resolve() == mcap.resolve():
+        raise _fail(RunError("the output would overwrite the cut file; give another --output"))
+    s = do_recover(mcap, target)
+    out.print(
+        f"{target}: {s['messages']} messages on {len(s['topics'])} topics, "
+        f"sim time {s['start_ns'] / 1e9:.3f} s .. {s['end_ns'] / 1e9:.3f} s",
+        markup=False,
+    )
 
 
 @app.command()

@@ -307,6 +307,8 @@ def run_plan(
         try:
             while any(p.running() for p in parts):
                 time.sleep(0.05)
+                if recorder is not None:
+                    recorder.flush_stale(1.0)  # killed outright, the file loses at most a second
                 all_ready = all(p.ready.is_set() for p in parts) and bridge_ready.is_set()
                 if all_ready and not started["at"]:
                     started["at"] = time.perf_counter()

@@ -22,6 +22,7 @@ import contextlib
 import struct
 import sys
 import threading
+import time
 import zlib
 from array import array
 from collections.abc import Callable, Iterable
@@ -127,6 +128,7 @@ class _McapFile:
         self._channels: list[Channel] = []
         self._by_id: dict[int, _Channel] = {}
         self._chunk_indexes: list[ChunkIndex] = []
+        self.flushed_at = time.monotonic()
         self._start_ns: int | None = None
         self._end_ns = 0
         self._pos = 0
@@ -228,6 +230,10 @@ class _McapFile:
                 uncompressed_size=len(chunk),
             )
         )
+        # Handed to the OS with every chunk: a runner killed outright (kill -9) leaves a file readable up
+        # to its last chunk (`scenario info` says so, `scenario recover` completes it)
+        self._stream.flush()
+        self.flushed_at = time.monotonic()
 
     def finish(self) -> None:
         """Write the last chunk, the summary and the footer. Does not close the stream."""
@@ -465,6 +471,13 @@ class Recorder:
         with self._lock:
             return {k: c.stats.count for k, c in self._channels.items()}
 
+    def flush_stale(self, max_age_s: float = 1.0) -> None:
+        """Write the chunk being built if the last one went out more than `max_age_s` ago: a slow run
+        killed outright loses at most that much (the runner calls this as it watches the run)."""
+        with self._lock:
+            if not self.closed and self._mcap.chunk and time.monotonic() - self._mcap.flushed_at > max_age_s:
+                self._mcap.flush_chunk()
+
     def close(self) -> None:
         """Stop recording (what `subscribe` queued first) and finish the file. Idempotent."""
         sub, self._subscriber = self._subscriber, None
@@ -484,14 +497,19 @@ class Recorder:
 
 
 def read_summary(path: Path) -> dict[str, Any]:
-    """Topics, types, counts and sim-time span of an MCAP file (for `scenario info`)."""
+    """Topics, types, counts and sim-time span of an MCAP file (for `scenario info`). A file without its
+    summary (the recording was cut: its runner was killed) is read record by record up to its last
+    complete chunk; then `cut` is True and `readable_bytes` says how far it reaches."""
+    from mcap.exceptions import McapError
     from mcap.reader import make_reader
 
     with open(path, "rb") as f:
-        reader = make_reader(f)
-        summary = reader.get_summary()
+        try:
+            summary = make_reader(f).get_summary()
+        except (McapError, struct.error, ValueError, EOFError):
+            summary = None
         if summary is None or summary.statistics is None:
-            raise ValueError("the file has no summary (was the recording cut?)")
+            return _scan(path)
         stats = summary.statistics
         topics = []
         for cid, ch in sorted(summary.channels.items(), key=lambda kv: kv[1].topic):
@@ -508,4 +526,78 @@ def read_summary(path: Path) -> dict[str, Any]:
             "end_ns": stats.message_end_time,
             "messages": stats.message_count,
             "topics": topics,
+            "cut": False,
         }
+
+
+def _records(path: Path) -> Iterable[Any]:
+    """The records of an MCAP file in order (chunks opened), up to the first incomplete one."""
+    from mcap.exceptions import McapError
+    from mcap.stream_reader import StreamReader
+
+    with open(path, "rb") as f:
+        try:
+            yield from StreamReader(f, validate_crcs=True).records
+        except (McapError, struct.error, ValueError, EOFError, zstandard.ZstdError):
+            return  # cut there
+
+
+def _scan(path: Path) -> dict[str, Any]:
+    from mcap.records import Message
+
+    schemas: dict[int, str] = {}
+    channels: dict[int, tuple[str, str]] = {}
+    counts: dict[int, int] = {}
+    start, end = None, 0
+    for record in _records(path):
+        if isinstance(record, Schema):
+            schemas[record.id] = record.name
+        elif isinstance(record, Channel):
+            channels[record.id] = (record.topic, schemas.get(record.schema_id, ""))
+        elif isinstance(record, Message):
+            counts[record.channel_id] = counts.get(record.channel_id, 0) + 1
+            start = record.log_time if start is None else min(start, record.log_time)
+            end = max(end, record.log_time)
+    topics = [
+        {"topic": topic, "type": type_name, "count": counts.get(cid, 0)}
+        for cid, (topic, type_name) in sorted(channels.items(), key=lambda kv: kv[1][0])
+    ]
+    return {
+        "start_ns": start or 0,
+        "end_ns": end,
+        "messages": sum(counts.values()),
+        "topics": topics,
+        "cut": True,
+    }
+
+
+def recover(path: Path, out: Path) -> dict[str, Any]:
+    """Write `out`: a complete MCAP (summary, indexes) with every message the cut file `path` holds."""
+    from mcap.records import Message
+    from mcap.writer import CompressionType, Writer
+
+    schema_ids: dict[int, int] = {}
+    channel_ids: dict[int, int] = {}
+    with open(out, "wb") as f:
+        writer = Writer(f, compression=CompressionType.ZSTD)
+        writer.start(profile="ros2", library="scenario-runner (recovered)")
+        for record in _records(path):
+            if isinstance(record, Schema) and record.id not in schema_ids:
+                schema_ids[record.id] = writer.register_schema(record.name, record.encoding, record.data)
+            elif isinstance(record, Channel) and record.id not in channel_ids:
+                channel_ids[record.id] = writer.register_channel(
+                    record.topic,
+                    record.message_encoding,
+                    schema_ids.get(record.schema_id, 0),
+                    dict(record.metadata),
+                )
+            elif isinstance(record, Message) and record.channel_id in channel_ids:
+                writer.add_message(
+                    channel_ids[record.channel_id],
+                    record.log_time,
+                    record.data,
+                    record.publish_time,
+                    record.sequence,
+                )
+        writer.finish()
+    return read_summary(out)

@@ -262,3 +262,41 @@ def test_unwritable_recording_is_a_clear_error(tmp_path: Path):
     proc = run_cli("run", str(SCENARIOS / "two_robots.yaml"), "--record", str(blocker / "x.mcap"))
     assert proc.returncode == 1
     assert "cannot write the recording" in proc.stderr and "Traceback" not in proc.stderr
+
+
+@pytest.mark.timeout(90)
+def test_a_runner_killed_outright_leaves_a_recording_readable_to_its_last_chunk(tmp_path: Path):
+    """kill -9 of the runner: no summary is written, yet every chunk it wrote (at most a second behind)
+    reads back; `scenario info` says the file was cut and how far it reaches, `scenario recover` writes a
+    complete copy; the world, orphaned, stops by itself."""
+    mcap = tmp_path / "killed.mcap"
+    proc = _start_long_run(mcap)
+    try:
+        time.sleep(2.5)
+        children = _children(proc.pid)
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.communicate(timeout=10)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    deadline = time.monotonic() + 5
+    while any(Path(f"/proc/{c}").exists() for c in children) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(Path(f"/proc/{c}").exists() for c in children), "the world outlived its runner"
+
+    info = run_cli("info", str(mcap))
+    assert info.returncode == 0, info.stderr
+    assert "cut: the recording has no summary" in info.stdout
+    reach = float(info.stdout.split("it reaches ")[1].split(" s sim")[0])
+    assert reach >= 2.0  # ~3.5 s of sim were run at real time; a second at most is lost
+
+    fixed = tmp_path / "fixed.mcap"
+    rec = run_cli("recover", str(mcap), "-o", str(fixed))
+    assert rec.returncode == 0, rec.stderr
+    messages = read_mcap(fixed)  # complete: summary and indexes, read by the standard reader
+    clock = [t for topic, _, t, _ in messages if topic == "two_robots/clock"]
+    scans = [t for topic, _, t, _ in messages if topic == "two_robots/r1/scan"]
+    assert clock[-1] / 1e9 == pytest.approx(reach, abs=0.05)
+    assert abs(len(scans) - (clock[-1] / 1e8 + 1)) <= 2  # nothing missing up to the cut
+    info2 = run_cli("info", str(fixed))
+    assert "cut:" not in info2.stdout and f"{len(messages)} messages" in info2.stdout
