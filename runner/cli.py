@@ -186,6 +186,10 @@ def run(
     local: Annotated[
         bool, typer.Option("--local", help="Run every part on this machine, whatever `hosts:` says.")
     ] = False,
+    strict: Annotated[
+        bool,
+        typer.Option("--strict", help="Fail (exit 1) if any message published in the run was not recorded."),
+    ] = False,
 ) -> None:
     """Validate, compile and run a scenario; record every message to MCAP; judge its assertions. With a
     `matrix:`, every variant runs and is judged on its own. With `hosts:`, this plays the first (main)
@@ -224,7 +228,7 @@ def run(
             plan.record.path = str(path.with_name(f"{path.stem}-{i}{path.suffix}"))
         if label and not quiet:
             err.print(f"variant {i}: {label}", markup=False)
-        suite, rc = _run_one(plan, label, quiet, listen, connect, no_judge, None if local else host)
+        suite, rc = _run_one(plan, label, quiet, listen, connect, no_judge, None if local else host, strict)
         suites.append(suite)
         code = max(code, rc)
         if rc == 130:
@@ -266,6 +270,7 @@ def _run_one(
     connect: list[str] | None,
     no_judge: bool,
     host: str | None = None,
+    strict: bool = False,
 ) -> tuple[Any, int]:
     from runner.checks.report import Suite, judge_for
     from runner.launch import run_plan
@@ -321,14 +326,19 @@ def _run_one(
         _print_summary(result)
     if results:
         _print_results(results)
-    if result.error:
-        err.print("error: " + result.error, markup=False, style="red")
+    error = result.error
+    lost = sum(result.lost.values()) + sum(t.lost for t in result.topics)
+    if strict and lost and error is None:
+        where = sorted({k for k, n in result.lost.items() if n} | {t.key for t in result.topics if t.lost})
+        error = f"--strict: {lost} message(s) published but not recorded, on {', '.join(where)}"
+    if error:
+        err.print("error: " + error, markup=False, style="red")
     name = f"{plan.name}[{label}]" if label else plan.name
-    suite = Suite(name, results, result.error, result.wall_s, str(result.mcap) if result.mcap else None)
+    suite = Suite(name, results, error, result.wall_s, str(result.mcap) if result.mcap else None)
     if results and not suite.passed and result.mcap is not None:
         _plot(plan, result.mcap, results)
     code = result.exit_code
-    if code == 0 and not suite.passed:
+    if code == 0 and (not suite.passed or error):
         code = 1
     return suite, code
 
@@ -500,11 +510,28 @@ def test_cmd(
 
 
 def _print_summary(result: Any) -> None:
-    table = Table("topic", "type", "count", "rate (sim Hz)", "lost", title="Recorded", title_justify="left")
+    table = Table(
+        "topic",
+        "type",
+        "published",
+        "recorded",
+        "rate (sim Hz)",
+        "lost",
+        title="Recorded",
+        title_justify="left",
+    )
     lost = result.lost
     for t in result.topics:
         n_lost = lost.get(t.key, 0) + t.lost
-        table.add_row(t.key, t.type, str(t.count), f"{t.rate():.1f}", str(n_lost) if n_lost else "")
+        published = result.published.get(t.key)  # (the worlds' count; other publishers say theirs by seq)
+        table.add_row(
+            t.key,
+            t.type,
+            str(published) if published is not None else "-",
+            str(t.count),
+            f"{t.rate():.1f}",
+            f"[red]{n_lost}[/red]" if n_lost else "0",
+        )
     if result.topics:
         out.print(table)
     sim = result.sim_ns / 1e9

@@ -15,7 +15,7 @@ import time
 import zenoh
 
 from runner.graph import GraphTokens
-from runner.sim.child import StopFlag, parse, process_name
+from runner.sim.child import StopFlag, mujoco_warnings_to_stderr, parse, process_name
 from runner.sim.world import World
 from runner.transport import ZenohBus, make_config, meta_key
 
@@ -27,10 +27,13 @@ END_ACK_TIMEOUT_S = 10.0
 def main(argv: list[str] | None = None) -> int:
     plan, connect = parse("python -m runner.sim", argv)
     should_stop = StopFlag()
+    mujoco_warnings_to_stderr()
 
     with zenoh.open(make_config("client", connect=connect)) as session:
         run = plan.name.split("/", 1)[0]  # a world of several is named <run>/<world>
-        bus = ZenohBus(session, GraphTokens(session, run, process_name(plan.name, "world"), "world"))
+        bus = ZenohBus(
+            session, GraphTokens(session, run, process_name(plan.name, "world"), "world"), plan.best_effort
+        )
         try:
             end_pub = session.declare_publisher(
                 meta_key(plan.name, "world", "end"), congestion_control=zenoh.CongestionControl.BLOCK

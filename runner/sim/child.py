@@ -45,3 +45,13 @@ def process_name(plan_name: str, role: str) -> str:
     if not world:
         return role
     return world if role == "world" else f"{world}-{role}"
+
+
+def mujoco_warnings_to_stderr() -> None:
+    """MuJoCo's warnings on stderr (the runner shows them, prefixed), not in a MUJOCO_LOG.TXT left in
+    whatever folder the run was started from."""
+    import sys
+
+    import mujoco
+
+    mujoco.set_mju_user_warning(lambda text: print(f"MuJoCo warning: {text}", file=sys.stderr, flush=True))

@@ -22,7 +22,7 @@ from typing import Any
 import zenoh
 
 from runner.graph import GraphTokens
-from runner.sim.child import StopFlag, parse, process_name
+from runner.sim.child import StopFlag, mujoco_warnings_to_stderr, parse, process_name
 from runner.sim.world import _STATE_HEAD, World
 from runner.transport import ZenohBus, make_config, meta_key
 
@@ -32,10 +32,15 @@ MATCH_TIMEOUT_S = 5.0
 def main(argv: list[str] | None = None) -> int:
     plan, connect = parse("python -m runner.sim.render", argv)
     should_stop = StopFlag()
+    mujoco_warnings_to_stderr()
 
     with zenoh.open(make_config("client", connect=connect)) as session:
         run = plan.name.split("/", 1)[0]
-        bus = ZenohBus(session, GraphTokens(session, run, process_name(plan.name, "renderer"), "renderer"))
+        bus = ZenohBus(
+            session,
+            GraphTokens(session, run, process_name(plan.name, "renderer"), "renderer"),
+            plan.best_effort,
+        )
         subs: list[Any] = []
         world: World | None = None
         try:

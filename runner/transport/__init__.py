@@ -97,20 +97,24 @@ class ZenohBus:
     """Publishers and subscribers on a session; with `graph` (a `runner.graph.GraphTokens`), each is also
     announced in the run's graph."""
 
-    def __init__(self, session: zenoh.Session, graph: Any = None):
+    def __init__(self, session: zenoh.Session, graph: Any = None, best_effort: Sequence[str] = ()):
         self.session = session
         self.graph = graph
+        self.best_effort = [zenoh.KeyExpr(e) for e in best_effort]
         self._keep: list[Any] = []
         self._pubs: list[Any] = []
 
     def publisher(self, key: str, type_name: str) -> Callable[[bytes, bytes], None]:
         if self.graph is not None:
             self.graph.publisher(key, type_name)
+        # Reliable by default: a publisher waits rather than drop (nothing recorded is lost; a slow subscriber
+        # slows the simulation down); `qos:` makes some topics best effort (they drop instead).
+        drop = any(e.intersects(zenoh.KeyExpr(key)) for e in self.best_effort)
         pub = self.session.declare_publisher(
             key,
             encoding=encoding_for(type_name),
-            congestion_control=zenoh.CongestionControl.BLOCK,
-            reliability=zenoh.Reliability.RELIABLE,
+            congestion_control=zenoh.CongestionControl.DROP if drop else zenoh.CongestionControl.BLOCK,
+            reliability=zenoh.Reliability.BEST_EFFORT if drop else zenoh.Reliability.RELIABLE,
         )
         self._keep.append(pub)
         self._pubs.append(pub)
