@@ -16,6 +16,8 @@ Sections (in order):
   and the delay from a `cmd_vel` put by another process to the controller acting on it.
 - lockstep: the go-to-goal example with its controller node in lockstep with the world, and free-running.
 - recorder: messages/s the recorder sustains from another process, with sequence numbers checked.
+- soak: the demo for 10 sim minutes at `rate: max`, recorded with --strict: resident memory of the runner
+  and of the world from warm-up to the end (bench/soak.py), messages lost.
 - plugins: per-plugin cost per call, camera frames/s, lidar rays/s (bench/plugins.py).
 
 Results go to bench/results/<section>.json (with machine info); `--readme` also writes the tables into
@@ -59,7 +61,17 @@ from runner.launch import run_plan  # noqa: E402
 from runner.plan import RunPlan  # noqa: E402
 from runner.transport import free_port  # noqa: E402
 
-SECTIONS = ("two_robots", "scaling", "messages", "cameras", "realtime", "lockstep", "recorder", "plugins")
+SECTIONS = (
+    "two_robots",
+    "scaling",
+    "messages",
+    "cameras",
+    "realtime",
+    "lockstep",
+    "recorder",
+    "soak",
+    "plugins",
+)
 
 
 # ------------------------------------------------------------------------------------------- helpers
@@ -531,6 +543,19 @@ def recorder(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     return doc, table("recorder: another process publishing as fast as it can", ("", "value"), rows)
 
 
+def soak(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
+    from bench.soak import soak as run_soak
+
+    seconds = 120.0 if args.quick else 600.0
+    doc = run_soak(seconds)
+    rows = [(k, v) for k, v in doc.items() if not isinstance(v, list)]
+    grow = max(doc.get("runner_rss_growth_pct", 0.0), doc.get("world_rss_growth_pct", 0.0))
+    doc["targets"] = {"RSS growth < 10 % and nothing lost": grow < 10.0 and doc["lost"] == 0}
+    return doc, table(
+        f"soak: two_robots, {seconds:g} s sim at rate: max, recorded, --strict", ("", "value"), rows
+    )
+
+
 def plugins(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     from bench import plugins as pl
 
@@ -549,6 +574,7 @@ RUNNERS = {
     "realtime": realtime,
     "lockstep": lockstep,
     "recorder": recorder,
+    "soak": soak,
     "plugins": plugins,
 }
 
