@@ -60,7 +60,15 @@ class Problem:
             lines.append(f"  found:    {self.found}")
         if self.hint:
             lines.append(f"  hint:     {self.hint}")
-        return "\n".join(lines)
+        return "\n".join(_printable(line) for line in lines)
+
+
+def _printable(text: str) -> str:
+    """Control characters (a NUL in a path, an escape sequence) shown as escapes, never sent to the
+    terminal; line breaks and tabs kept (MuJoCo's messages span lines)."""
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() or c in "\n\t" else repr(c)[1:-1] for c in text)
 
 
 class ScenarioError(Exception):

@@ -7,6 +7,7 @@ later pass can point at the line. Duplicate keys are an error (plain PyYAML keep
 
 from __future__ import annotations
 
+import datetime
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -54,7 +55,7 @@ class _Builder:
             self._scalars.flatten_mapping(node)  # handles `<<: *anchor` merges
             out: dict[Any, Any] = {}
             for key_node, value_node in node.value:
-                key = self._scalars.construct_object(key_node, deep=True)
+                key = self._scalar(key_node, path)
                 if not isinstance(key, str | int | float | bool) and key is not None:
                     raise ScenarioError(
                         Problem(
@@ -81,28 +82,123 @@ class _Builder:
             return out
         if isinstance(node, yaml.SequenceNode):
             return [self.build(item, (*path, i)) for i, item in enumerate(node.value)]
-        return self._scalars.construct_object(node, deep=True)
+        return self._scalar(node, path)
+
+    def _scalar(self, node: yaml.Node, path: PathKey) -> Any:
+        try:
+            value = self._scalars.construct_object(node, deep=True)
+        except yaml.constructor.ConstructorError as e:
+            raise ScenarioError(
+                Problem(
+                    f"this YAML value cannot be read: {e.problem}",
+                    self.mark(node),
+                    path,
+                    hint="scenarios use plain YAML: remove the `!tag` (quote the value if it is text)",
+                )
+            ) from None
+        except Exception as e:  # a tagged value that does not parse, e.g. `!!int abc`, `!!timestamp x`
+            raise ScenarioError(
+                Problem(
+                    f"{_short(node.value)} cannot be read as {node.tag.replace('tag:yaml.org,2002:', '!!')}"
+                    + (f" ({e})" if isinstance(e, ValueError) else ""),
+                    self.mark(node),
+                    path,
+                    hint="remove the `!!tag`, or quote the value",
+                )
+            ) from None
+        if isinstance(value, datetime.date | bytes | set):
+            # YAML reads `2024-01-01` as a date: nothing in a scenario is one, so keep the text
+            return str(node.value) if isinstance(node, yaml.ScalarNode) else value
+        return value
+
+
+_DEFAULT_HINT = "check the indentation and that every `key: value` has a space after the colon"
+
+
+def _unclosed(text: str) -> tuple[int, int, str] | None:
+    """(line, column, bracket) of the first '[' or '{' that is never closed (outside quotes and comments)."""
+    stack: list[tuple[int, int, str]] = []
+    for ln, line in enumerate(text.splitlines(), 1):
+        quote = ""
+        for col, ch in enumerate(line, 1):
+            if quote:
+                if ch == quote:
+                    quote = ""
+            elif ch in "'\"" and (col == 1 or line[col - 2] in " [{,:"):
+                quote = ch
+            elif ch == "#" and (col == 1 or line[col - 2] in " \t"):
+                break
+            elif ch in "[{":
+                stack.append((ln, col, ch))
+            elif ch in "]}" and stack and stack[-1][2] == {"]": "[", "}": "{"}[ch]:
+                stack.pop()
+    return stack[0] if stack else None
+
+
+def _yaml_problem(e: yaml.MarkedYAMLError, text: str, file: Path | None) -> Problem:
+    """A YAML syntax error in words, pointing where the mistake most likely is."""
+    problem = e.problem or e.context or "unknown error"
+    context = e.context or ""
+    mark = e.problem_mark or e.context_mark
+    message = f"this is not valid YAML: {problem}"
+    hint = _DEFAULT_HINT
+    at_end = "end of stream" in problem or "<stream end>" in problem
+    opener = _unclosed(text) if ("flow" in context or at_end) else None
+    if "'\\t'" in problem or "\t" in problem:
+        message = "this is not valid YAML: a tab character; YAML indents with spaces only"
+        hint = "replace the tab with spaces"
+    elif "quoted scalar" in context and e.context_mark is not None:
+        mark = e.context_mark
+        message = "this is not valid YAML: a quoted string is never closed"
+        hint = "add the closing quote, or escape the quote inside the string"
+    elif opener is not None:
+        line, column, bracket = opener
+        closer = {"[": "]", "{": "}"}[bracket]
+        message = f"this is not valid YAML: {bracket!r} is never closed with {closer!r}"
+        hint = f"close it with {closer!r}, and separate its items with ', '"
+        return Problem(message, Location(file, line, column), hint=hint)
+    elif "mapping values are not allowed" in problem:
+        message = "this is not valid YAML: a ':' where no key can start"
+        hint = (
+            "check the indentation (a key indented deeper than the one before it), or quote a value "
+            "that holds ': '"
+        )
+    elif "expected ',' or" in problem:
+        hint = (
+            "inside [...] and {...}, quote text that holds '[', ']', '{', '}', ',' or ': ' "
+            "(e.g. 'robots[0].pose.xyz': [...])"
+        )
+    elif "expected <block end>" in problem:
+        hint = "check the indentation: the items of one list or mapping start in the same column"
+    elif "undefined alias" in problem:
+        hint = "define the anchor (`&name`) before using it (`*name`)"
+    elif "cannot start any token" in problem:
+        hint = "quote the value: '@', '`' and '%' cannot start a plain value"
+    loc = Location(file, mark.line + 1, mark.column + 1) if mark else Location(file, 1, 1)
+    return Problem(message, loc, hint=hint)
+
+
+def _short(value: Any, limit: int = 60) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def load_text(text: str, file: Path | None = None) -> Document:
     try:
         node = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.MarkedYAMLError as e:
-        mark = e.problem_mark or e.context_mark
-        loc = Location(file, mark.line + 1, mark.column + 1) if mark else Location(file)
-        raise ScenarioError(
-            Problem(
-                f"this is not valid YAML: {e.problem or e.context}",
-                loc,
-                hint="check the indentation and that every `key: value` has a space after the colon",
-            )
-        ) from None
+        raise ScenarioError(_yaml_problem(e, text, file)) from None
     except yaml.YAMLError as e:
-        raise ScenarioError(Problem(f"this is not valid YAML: {e}", Location(file))) from None
+        raise ScenarioError(Problem(f"this is not valid YAML: {e}", Location(file, 1, 1))) from None
+    except RecursionError:
+        raise ScenarioError(Problem("this YAML is nested too deeply to read", Location(file, 1, 1))) from None
     if node is None:
         return Document({}, file, {(): Location(file, 1, 1)})
     builder = _Builder(file)
-    data = builder.build(node, ())
+    try:
+        data = builder.build(node, ())
+    except RecursionError:
+        raise ScenarioError(Problem("this YAML is nested too deeply to read", Location(file, 1, 1))) from None
     return Document(data, file, builder.positions)
 
 

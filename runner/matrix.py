@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import copy
 import itertools
+import math
 import re
 from typing import Any
 
@@ -22,6 +23,9 @@ from runner.errors import Problem, ScenarioError
 from runner.loader import Document
 
 _PART = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(-?\d+)\]")
+
+
+MAX_VARIANTS = 1000  # each one is a run: beyond this, a matrix is a mistake, not a test plan
 
 
 def parse_path(text: str) -> tuple[str | int, ...] | None:
@@ -100,6 +104,18 @@ def variants(doc: Document) -> list[tuple[str, Document]]:
             paths.append((str(key), path))
     if problems:
         raise ScenarioError(problems)
+    total = math.prod(len(matrix[k]) for k, _ in paths)
+    if total > MAX_VARIANTS:
+        raise ScenarioError(
+            Problem(
+                f"the matrix makes {total} variants, more than {MAX_VARIANTS}",
+                doc.locate(("matrix",)),
+                ("matrix",),
+                expected=f"at most {MAX_VARIANTS} combinations",
+                found=" x ".join(str(len(matrix[k])) for k, _ in paths),
+                hint="split it into several scenario files, or run chosen variants with --variant",
+            )
+        )
     out: list[tuple[str, Document]] = []
     for combo in itertools.product(*[matrix[k] for k, _ in paths]):
         variant = copy.deepcopy(data)

@@ -109,6 +109,8 @@ class RunPlan(BaseModel):
     renderers: Literal["auto", "world", "process"] = "auto"  # the launcher resolves auto
     nodes: list[NodePlan] = []
     lockstep: list[str] = []  # node names the world waits for at each step
+    zenoh: dict[str, Any] | None = None  # {"file": absolute path | None, "settings": {path: value}}
+    listen: list[str] = []  # the run's router endpoints (zenoh.listen), unless --listen says otherwise
     best_effort: list[str] = []  # key expressions whose publishers drop rather than block (qos:)
     bridges: list[BridgePlan] = []  # run by the bridge process (a node of the run)
     ros2: Ros2Plan | None = None  # the run's rmw_zenoh settings, when it appears to ROS 2 as a whole

@@ -22,15 +22,42 @@ from pydantic import (
 )
 
 SCHEMA_VERSION = 1
+MAX_DURATION = 2**31 - 1  # sim seconds: builtin_interfaces/Time counts seconds in an int32
 
 RUN_NAME_RE = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.\-]*$")
 # ROS 2 style names (so that the same names work over rmw_zenoh later); nested namespaces allowed.
 NAMESPACE_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*(/[A-Za-z][A-Za-z0-9_]*)*$")
 TOPIC_RE = re.compile(r"^/?[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*$")
+IDENT_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")  # world names, ROS 2 node names
+NODE_NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_-]*$")  # nodes and hosts
+
+# What each pattern means, in words, and the characters it allows besides letters, digits and '_'
+# (for error messages: runner.validate).
+PATTERN_WORDS: dict[str, tuple[str, str]] = {
+    RUN_NAME_RE.pattern: (
+        "letters, digits, '_', '-' and '.', not starting with '-' or '.' (e.g. my_run)",
+        "-.",
+    ),
+    NAMESPACE_RE.pattern: (
+        "a ROS-style name: letters, digits and '_', starting with a letter; nested with '/' (e.g. fleet/r1)",
+        "/",
+    ),
+    TOPIC_RE.pattern: (
+        "a topic name: chunks of letters, digits and '_' separated by '/', none starting with a digit "
+        "(e.g. r1/cmd_vel)",
+        "/",
+    ),
+    IDENT_RE.pattern: ("letters, digits and '_', not starting with a digit (e.g. arena_2)", ""),
+    NODE_NAME_RE.pattern: (
+        "letters, digits, '_' and '-', starting with a letter or '_' (e.g. controller)",
+        "-",
+    ),
+}
 
 
 class Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", populate_by_name=False)
+    # NaN and infinity are never a meaningful duration, rate or size: refused like any wrong value.
+    model_config = ConfigDict(extra="forbid", populate_by_name=False, allow_inf_nan=False)
 
 
 Vec3 = Annotated[tuple[float, float, float], Field(description="[x, y, z]")]
@@ -130,7 +157,7 @@ class World(Strict):
 class NamedWorld(World):
     """One of several worlds: simulated by a process of its own, in a key space of its own."""
 
-    name: Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")] = Field(
+    name: Annotated[str, Field(pattern=IDENT_RE.pattern)] = Field(
         description="World name (letters, digits, '_'): the second chunk of its keys (`run/arena/r1/scan`)."
     )
 
@@ -244,6 +271,20 @@ class Region(Strict):
             raise ValueError(f"max {list(v)} must exceed min {list(lo)} on both axes")
         return v
 
+    @model_validator(mode="after")
+    def _one_shape(self) -> Region:
+        circle = self.center is not None or self.radius is not None
+        box = self.min is not None or self.max is not None
+        if circle and box:
+            raise ValueError("a region is a circle (`center` + `radius`) or a box (`min` + `max`), not both")
+        if circle and (self.center is None or self.radius is None):
+            raise ValueError("a circular region needs both `center: [x, y]` and `radius:`")
+        if box and (self.min is None or self.max is None):
+            raise ValueError("a box region needs both `min: [x, y]` and `max: [x, y]`")
+        if not (circle or box):
+            raise ValueError("an empty region: give `center` + `radius`, or `min` + `max`")
+        return self
+
     def contains(self, x: float, y: float) -> bool:
         if self.center is not None and self.radius is not None:
             return (x - self.center[0]) ** 2 + (y - self.center[1]) ** 2 <= self.radius**2
@@ -262,6 +303,21 @@ class _Window(Strict):
         None, description="End of the window, sim seconds (default: the end)."
     )
 
+    @field_validator("until")
+    @classmethod
+    def _after_until(cls, v: float | None, info: Any) -> float | None:
+        start = info.data.get("after")
+        if v is not None and start is not None and v < start:
+            raise ValueError(f"the window ends (until: {v}) before it starts (after: {start})")
+        return v
+
+
+def _min_below_max(v: float | None, info: Any, unit: str) -> float | None:
+    lo = info.data.get("min")
+    if v is not None and lo is not None and v < lo:
+        raise ValueError(f"max ({v} {unit}) is below min ({lo} {unit})")
+    return v
+
 
 class Reach(_AssertionBase):
     """A robot's base comes within `tolerance` of `point` (or inside `region`) by sim time `by`."""
@@ -274,6 +330,12 @@ class Reach(_AssertionBase):
     by: PositiveFloat | None = Field(
         None, description="Deadline in sim seconds (default: the end of the run)."
     )
+
+    @model_validator(mode="after")
+    def _goal(self) -> Reach:
+        if (self.point is None) == (self.region is None):
+            raise ValueError("a reach assertion has either `point: [x, y]` or `region:`")
+        return self
 
 
 class StayWithin(_AssertionBase, _Window):
@@ -303,6 +365,11 @@ class TopicRate(_AssertionBase):
     min: NonNegativeFloat | None = Field(None, description="Lowest acceptable rate, Hz.")
     max: PositiveFloat | None = Field(None, description="Highest acceptable rate, Hz.")
     after: NonNegativeFloat = Field(1.0, description="Warm-up in sim seconds before counting.")
+
+    @field_validator("max")
+    @classmethod
+    def _range(cls, v: float | None, info: Any) -> float | None:
+        return _min_below_max(v, info, "Hz")
 
 
 class MessageCheck(_AssertionBase, _Window):
@@ -341,6 +408,11 @@ class DistanceTraveled(_AssertionBase):
     min: NonNegativeFloat | None = Field(None, description="Shortest acceptable path, metres.")
     max: PositiveFloat | None = Field(None, description="Longest acceptable path, metres.")
 
+    @field_validator("max")
+    @classmethod
+    def _range(cls, v: float | None, info: Any) -> float | None:
+        return _min_below_max(v, info, "m")
+
 
 Assertion = Annotated[
     Reach | StayWithin | NoCollision | TopicRate | MessageCheck | MaxSpeed | MaxTilt | DistanceTraveled,
@@ -363,7 +435,7 @@ class Node(Strict):
     its namespace and the clock key in its environment (`SCENARIO_ENDPOINT`, `SCENARIO_RUN`,
     `SCENARIO_NAMESPACE`, `SCENARIO_CLOCK`, `SCENARIO_NODE`); `runner.node.Node()` reads them."""
 
-    name: Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_-]*$")] = Field(
+    name: Annotated[str, Field(pattern=NODE_NAME_RE.pattern)] = Field(
         description="Node name (letters, digits, '_', '-'): in logs, `lockstep:` and the run's report."
     )
     cmd: str | list[str] = Field(
@@ -397,7 +469,7 @@ class Ros2(Strict):
     `ros2 topic echo` and rclcpp/rclpy nodes running `RMW_IMPLEMENTATION=rmw_zenoh_cpp` see the run."""
 
     domain: Annotated[int, Field(ge=0, le=232)] = Field(0, description="ROS_DOMAIN_ID.")
-    node: Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")] | None = Field(
+    node: Annotated[str, Field(pattern=IDENT_RE.pattern)] | None = Field(
         None, description="The ROS 2 node name the simulation appears as (default: the run's name)."
     )
     router: str | None = Field(
@@ -410,6 +482,39 @@ class Ros2(Strict):
         "all",
         description="`all`: every topic of the simulation appears as `/<namespace>/<topic>` (and "
         "`/clock`), in the directions the simulation uses it; `bridged`: only the `bridges:`.",
+    )
+
+
+class ZenohSettings(Strict):
+    """The run's Zenoh configuration, passed to every session of the run (router, worlds, renderers,
+    nodes, bridge, and the command-line tools that join it): TLS, access control, anything Zenoh has."""
+
+    config: str | None = Field(
+        None, description="A Zenoh configuration file (JSON5), relative to the scenario, taken first."
+    )
+    settings: dict[str, Any] = Field(
+        default_factory=dict,
+        description="Settings by their path in Zenoh's configuration, on top of the file, e.g. "
+        "`transport/link/tls/root_ca_certificate: certs/ca.pem` (file paths relative to the scenario).",
+    )
+    listen: list[str] = Field(
+        default_factory=list,
+        description="The run's router endpoints, e.g. `tls/127.0.0.1:7447` (default: a free TCP port on "
+        "127.0.0.1: loopback only unless told otherwise; `--listen` overrides).",
+    )
+
+
+class QosRule(Strict):
+    """How the publishers of some topics behave when a subscriber falls behind."""
+
+    topics: str = Field(
+        description="Key expression inside the run (`*/camera/**`, `r1/scan`): the topics this rule is for."
+    )
+    reliability: Literal["reliable", "best_effort"] = Field(
+        description="`reliable` (the default for every topic): a publisher waits rather than drop a message, "
+        "so nothing recorded is ever lost and a slow subscriber slows the simulation down; `best_effort`: "
+        "it drops instead (cameras for a live viewer: the simulation never waits; the recorder counts "
+        "what was lost)."
     )
 
 
@@ -490,6 +595,7 @@ class Scenario(Strict):
 
     model_config = ConfigDict(
         extra="forbid",
+        allow_inf_nan=False,
         json_schema_extra={"$schema": "https://json-schema.org/draft/2020-12/schema"},
         title="Scenario",
     )
@@ -510,6 +616,12 @@ class Scenario(Strict):
         default_factory=dict,
         description="ROS packages by name -> folder (relative to the scenario), for `$(find pkg)` and "
         "`package://pkg/...`. Folders with a package.xml beside the scenario are found without this.",
+    )
+    allow_paths: list[str] = Field(
+        default_factory=list,
+        description="Folders (relative to the scenario) that robot descriptions may also read from. By "
+        "default a xacro file may include or load only files of the scenario's folder, of its own folder and "
+        "of the packages (`packages:`, SCENARIO_PACKAGE_PATH).",
     )
     world: World = Field(default_factory=World, description="Physics, ground and primitive models.")
     worlds: list[NamedWorld] = Field(
@@ -537,11 +649,19 @@ class Scenario(Strict):
     nodes: list[Node] = Field(
         default_factory=list, description="Processes started with the run (controllers, planners...)."
     )
-    hosts: dict[Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_-]*$")], Host] = Field(
+    hosts: dict[Annotated[str, Field(pattern=NODE_NAME_RE.pattern)], Host] = Field(
         default_factory=dict,
         description="Machines of the run by name; worlds and nodes say where they run (`host:`). Without "
         "it, everything runs on this machine. `scenario run FILE` plays the first host (it records and "
         "judges), `scenario run FILE --host NAME` another one, `--local` all of them here.",
+    )
+    zenoh: ZenohSettings | None = Field(
+        None, description="Zenoh configuration for every session of the run (TLS, access control...)."
+    )
+    qos: list[QosRule] = Field(
+        default_factory=list,
+        description="Per-topic delivery: every topic is reliable (nothing lost: a publisher blocks rather "
+        "than drop) unless a rule makes it `best_effort`.",
     )
     bridges: list[Bridge] = Field(
         default_factory=list,
@@ -573,3 +693,19 @@ class Scenario(Strict):
         if isinstance(v, bool) or not isinstance(v, int | float) or v <= 0:
             raise ValueError("rate must be 'realtime', 'max' or a positive real-time factor (e.g. 2.0)")
         return float(v)
+
+    @field_validator("seed")
+    @classmethod
+    def _seed(cls, v: int) -> int:
+        if v < 0:
+            raise ValueError("a seed is 0 or more (random generators take non-negative seeds)")
+        return v
+
+    @field_validator("duration")
+    @classmethod
+    def _duration(cls, v: float) -> float:
+        if v > MAX_DURATION:
+            raise ValueError(
+                f"a run lasts at most {MAX_DURATION} s of sim time (the ROS clock counts seconds in an int32)"
+            )
+        return v

@@ -7,13 +7,14 @@ Used for the scenario itself and for every plugin's `Params` (with a path prefix
 from __future__ import annotations
 
 import difflib
+import re
 from typing import Any, TypeVar, get_args, get_origin
 
 from pydantic import BaseModel, ValidationError
 
 from runner.errors import Problem, ScenarioError
 from runner.loader import Document, PathKey
-from runner.schema import Scenario
+from runner.schema import PATTERN_WORDS, Scenario
 
 M = TypeVar("M", bound=BaseModel)
 
@@ -27,7 +28,7 @@ def _resolve(data: Any, loc: tuple[Any, ...], about_keys: bool) -> tuple[PathKey
     missing = False
     for i, el in enumerate(loc):
         last = i == len(loc) - 1
-        in_dict = isinstance(cur, dict) and el in cur
+        in_dict = isinstance(cur, dict) and _has_key(cur, el)
         in_list = isinstance(cur, list) and isinstance(el, int) and 0 <= el < len(cur)
         if in_dict or in_list:
             path.append(el)
@@ -35,8 +36,15 @@ def _resolve(data: Any, loc: tuple[Any, ...], about_keys: bool) -> tuple[PathKey
         elif last and about_keys and isinstance(cur, dict) and isinstance(el, str):
             path.append(el)
             missing = True
-        # else: a union branch tag; skip it
+        # else: a union branch tag, '[key]', or an item missing from a too short list; skip it
     return tuple(path), cur, missing
+
+
+def _has_key(d: dict[Any, Any], el: Any) -> bool:
+    try:
+        return el in d
+    except TypeError:  # an unhashable element of `loc`
+        return False
 
 
 def _model_at(root: type[BaseModel], path: PathKey, data: Any = None) -> type[BaseModel] | None:
@@ -109,16 +117,92 @@ def _unwrap_model(tp: Any, el: Any) -> Any:
     return None
 
 
+def _type_at(root: type[BaseModel], path: PathKey, data: Any = None) -> Any:
+    """The annotation of the value at `path` (None when it cannot be followed)."""
+    tp: Any = root
+    cur = data
+    for el in path:
+        tp = _unwrap_model(_pick_member(tp, cur), el)
+        cur = _step(cur, el)
+        if tp is None:
+            return None
+    return tp
+
+
+def _tuple_len(tp: Any) -> int | None:
+    """The number of items of a fixed-length tuple type (also inside `| None`)."""
+    for arg in [tp, *get_args(tp)]:
+        if get_origin(arg) is tuple:
+            args = get_args(arg)
+            if args and Ellipsis not in args:
+                return len(args)
+    return None
+
+
+def _tags(tp: Any) -> list[str]:
+    """The `type` literals of a union of models tagged by `type`."""
+    out: list[str] = []
+    for arg in _flatten(tp):
+        if isinstance(arg, type) and issubclass(arg, BaseModel) and "type" in arg.model_fields:
+            out += [str(t) for t in get_args(arg.model_fields["type"].annotation)]
+    return out
+
+
+def _pattern_problem(value: Any, pattern: str) -> tuple[str, str | None]:
+    """(what the pattern allows, in words; why the value does not fit) for a string_pattern_mismatch."""
+    words, extra = PATTERN_WORDS.get(pattern, (f"text matching the pattern {pattern}", ""))
+    if not isinstance(value, str):
+        return words, None
+    if value == "":
+        return words, "it is empty"
+    reserved = sorted({c for c in value if c in "*$?#"})
+    if reserved:
+        return words, (
+            "not allowed: "
+            + ", ".join(repr(c) for c in reserved)
+            + " (wildcards and reserved characters of Zenoh key expressions: names become key chunks)"
+        )
+    bad = sorted({c for c in value if not (c.isascii() and (c.isalnum() or c == "_")) and c not in extra})
+    if bad:
+        return words, "not allowed: " + ", ".join(repr(c) for c in bad)
+    if "/" in extra and ("//" in value or value.endswith("/") or value.startswith("//")):
+        return words, "an empty chunk: no doubled or trailing '/'"
+    if value.startswith("/") and re.fullmatch(pattern, "/a") is None:
+        return words, "no leading '/' here"
+    chunks = value.split("/") if "/" in extra else [value]
+    if any(c[:1].isdigit() for c in chunks if c):
+        return words, "a name (or a chunk of it) starts with a digit"
+    if value[:1] in "-.":
+        return words, f"it starts with {value[0]!r}"
+    return words, None
+
+
 def _short(value: Any, limit: int = 60) -> str:
     text = repr(value)
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
+def _kind(value: Any) -> str:
+    """What a YAML reader calls the value's type."""
+    if value is None:
+        return "null"
+    return {
+        dict: "mapping",
+        list: "list",
+        str: "string",
+        bool: "boolean",
+        int: "integer",
+        float: "number",
+    }.get(type(value), type(value).__name__)
+
+
 _TYPE_WORDS = {
     "string_type": "a string",
     "model_type": "a mapping",
+    "model_attributes_type": "a mapping",
     "dict_type": "a mapping",
     "list_type": "a list",
+    "tuple_type": "a list",
     "float_type": "a number",
     "int_type": "an integer",
     "bool_type": "true or false",
@@ -138,8 +222,24 @@ def problems_from_validation(
         path, value, missing = _resolve(data, tuple(e["loc"]), about_keys)
         grouped.setdefault(path, []).append((e, value, missing))
 
+    # A misspelt required key is both "unknown key 'descripton'" and "missing key 'description'": say it once.
+    unknown = {
+        (p[:-1], str(p[-1]))
+        for p, errs in grouped.items()
+        for e, _, _ in errs
+        if e["type"] == "extra_forbidden"
+    }
+    for path in list(grouped):
+        if path and all(e["type"] == "missing" for e, _, _ in grouped[path]):
+            typos = [k for parent, k in unknown if parent == path[:-1]]
+            if difflib.get_close_matches(str(path[-1]), typos, n=1):
+                del grouped[path]
+
     problems: list[Problem] = []
     for path, errs in grouped.items():
+        deeper = any(len(other) > len(path) and other[: len(path)] == path for other in grouped)
+        if deeper and all(x[0]["type"].endswith("_type") for x in errs):
+            continue  # `description: str | {file, args}`: the mapping's own errors say more
         # Several errors on one path come from the branches of a union. Errors inside the branch the
         # user meant (e.g. an unknown key inside a mapping) are worth more than "not a string".
         specific = [x for x in errs if not x[0]["type"].endswith("_type")]
@@ -154,7 +254,7 @@ def problems_from_validation(
                     doc.locate(prefix + path),
                     prefix + path,
                     expected=" or ".join(words),
-                    found=f"{type(value).__name__} {_short(value)}",
+                    found=f"{_kind(value)} {_short(value)}",
                 )
             )
             continue
@@ -201,6 +301,58 @@ def _problem(
             expected="one of: " + ", ".join(tags),
             hint=f"did you mean {close[0]!r}?" if close else None,
         )
+    loc = tuple(e["loc"])
+    if kind == "invalid_key" or (kind.endswith("_type") and loc and loc[-1] == "[key]"):
+        key = e.get("input")
+        parent = path[:-1] if path and (path[-1] is key or path[-1] == key) else path
+        return Problem(
+            f"the key {key!r} is not text",
+            doc.locate((*prefix, *parent, key)),
+            prefix + parent,
+            expected="a name",
+            found=f"{_kind(key)} {_short(key)}",
+            hint="quote it if it is meant as text (`'1': ...`)",
+        )
+    if kind == "union_tag_not_found":
+        where = (*full, "type")
+        tags = _tags(_type_at(model, path, data))
+        return Problem(
+            "missing required key 'type'",
+            doc.locate(full),
+            where,
+            expected="one of: " + ", ".join(tags) if tags else None,
+            hint="add `type:` to say which kind this is",
+        )
+    if kind == "string_pattern_mismatch":
+        words, why = _pattern_problem(value, str((e.get("ctx") or {}).get("pattern", "")))
+        return Problem(
+            "not a valid name", doc.locate(full), full, expected=words, found=_short(value), hint=why
+        )
+    if kind in ("too_short", "too_long") or (kind == "missing" and isinstance(e["loc"][-1], int)):
+        n = _tuple_len(_type_at(model, path, data))
+        ctx = e.get("ctx") or {}
+        if n is not None:
+            expected = f"a list of {n} numbers"
+        elif kind == "too_short":
+            expected = f"at least {ctx.get('min_length')} item(s)"
+        else:
+            expected = f"at most {ctx.get('max_length')} item(s)"
+        count = len(value) if isinstance(value, list | tuple | str | dict) else None
+        return Problem(
+            f"expected {n} items, found {count}" if n is not None else "wrong number of items",
+            doc.locate(full),
+            full,
+            expected=expected,
+            found=_short(value),
+        )
+    if kind.endswith("_type") and kind in _TYPE_WORDS:
+        expected = _TYPE_WORDS[kind]
+        if kind == "tuple_type":
+            n = _tuple_len(_type_at(model, path, data))
+            expected = f"a list of {n} numbers" if n else expected
+        return Problem(
+            "wrong type", doc.locate(full), full, expected=expected, found=f"{_kind(value)} {_short(value)}"
+        )
     if kind == "missing":
         key = path[-1]
         holder = _model_at(model, path[:-1], data)
@@ -237,9 +389,32 @@ def validate_scenario(doc: Document) -> Scenario:
                 hint="start the file with `name: my_scenario`",
             )
         )
+    _check_text(doc.data, doc, ())
     sc = validate_model(Scenario, doc.data, doc)
     check_consistency(sc, doc)
     return sc
+
+
+def _check_text(value: Any, doc: Document, path: PathKey) -> None:
+    """No text in a scenario holds a NUL character: no name, path or command can (the OS refuses it)."""
+    bad = isinstance(value, str) and "\x00" in value
+    if bad:
+        raise ScenarioError(
+            Problem(
+                "this text holds a NUL character",
+                doc.locate(path),
+                path,
+                found=_short(value),
+                hint="remove the \\0 (or \\x00) escape",
+            )
+        )
+    if isinstance(value, dict):
+        for k, v in value.items():
+            _check_text(k, doc, (*path, k))
+            _check_text(v, doc, (*path, k))
+    elif isinstance(value, list):
+        for i, v in enumerate(value):
+            _check_text(v, doc, (*path, i))
 
 
 def check_consistency(sc: Scenario, doc: Document) -> None:
@@ -287,20 +462,22 @@ def check_consistency(sc: Scenario, doc: Document) -> None:
                     )
                 )
             plugin_names.setdefault(pname, k)
-    model_names: dict[str, int] = {}
-    for i, m in enumerate(sc.world.models):
-        if m.name in model_names or m.name in seen_names:
-            problems.append(
-                Problem(
-                    f"model name {m.name!r} is already used",
-                    doc.locate(("world", "models", i, "name")),
-                    ("world", "models", i, "name"),
-                    hint="names of models and robots must be unique",
+    worlds: list[tuple[PathKey, Any]] = [(("world",), sc.world)]
+    worlds += [(("worlds", k), w) for k, w in enumerate(sc.worlds)]
+    for at, world in worlds:
+        model_names: dict[str, int] = {}
+        for i, m in enumerate(world.models):
+            where: PathKey = (*at, "models", i, "name")
+            if m.name in model_names or m.name in seen_names:
+                problems.append(
+                    Problem(
+                        f"model name {m.name!r} is already used",
+                        doc.locate(where),
+                        where,
+                        hint="names of models and robots must be unique",
+                    )
                 )
-            )
-        model_names.setdefault(m.name, i)
-        if not m.static and m.mass is None:
-            pass  # default mass of 1 kg, documented
+            model_names.setdefault(m.name, i)
     for i, ev in enumerate(sc.timeline):
         if ev.t > sc.duration:
             problems.append(

@@ -213,7 +213,9 @@ def test_stop_on_first_failure_ends_the_run_early(write_scenario, tmp_path: Path
     assert proc.returncode == 1, proc.stderr
     assert "stopped:" in proc.stdout  # ended by the judge, not by the duration
     sim = float(proc.stdout.split("stopped: ")[1].split(" s sim")[0])
-    assert sim < 10.0  # r1 exceeds 0.3 m/s within a second; the run ends soon after, not at 60 s
+    # r1 exceeds 0.3 m/s within a sim second; the run ends soon after, not at 60 s (at rate: max the world
+    # runs on ~100x real time while the judge's word travels: under load that is several sim seconds)
+    assert sim < 30.0
     results = {r["name"]: r for r in json.loads(res.read_text())["results"]}
     assert not results["slow"]["passed"] and results["slow"]["t"] < 2.0
 

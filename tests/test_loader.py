@@ -52,3 +52,45 @@ def test_anchors_and_merges_work():
 
 def test_empty_document():
     assert load_text("").data == {}
+
+
+@pytest.mark.parametrize(
+    ("text", "pieces"),
+    [
+        ("a: !!python/object:os.system 1\n", [":1:4:", "cannot be read", "plain YAML"]),
+        ("a: !!timestamp nope\n", [":1:4:", "'nope' cannot be read as !!timestamp"]),
+        ("a: !!float abc\n", [":1:4:", "cannot be read as !!float"]),
+        ("[" * 3000 + "]" * 3000 + "\n", [":1:1:", "nested too deeply"]),
+    ],
+)
+def test_values_yaml_cannot_build_are_errors_not_crashes(text: str, pieces: list[str]) -> None:
+    with pytest.raises(ScenarioError) as e:
+        load_text(text)
+    rendered = e.value.render()
+    for piece in pieces:
+        assert piece in rendered, rendered
+
+
+def test_dates_and_binary_stay_text() -> None:
+    # Nothing in a scenario is a date: `2024-01-01` is kept as written, not turned into a datetime.date.
+    assert load_text("a: 2024-01-01\nb: !!binary aGk=\n").data == {"a": "2024-01-01", "b": "aGk="}
+
+
+@pytest.mark.parametrize(
+    ("text", "line", "column", "words"),
+    [
+        ("name: x\nrobots: [\n  {a: 1},\n", 2, 9, "'[' is never closed"),
+        ("name: x\nw: {a: [1, 2], b: 1\nc: 2\n", 2, 4, "'{' is never closed"),
+        ("name: 'abc\n", 1, 7, "a quoted string is never closed"),
+        ("name: x\n\tduration: 1\n", 2, 1, "a tab character"),
+    ],
+)
+def test_yaml_syntax_errors_point_where_the_mistake_starts(
+    text: str, line: int, column: int, words: str
+) -> None:
+    with pytest.raises(ScenarioError) as e:
+        load_text(text)
+    problem = e.value.problems[0]
+    assert (problem.location.line, problem.location.column) == (line, column), problem.render()
+    assert words in problem.message
+    assert problem.hint

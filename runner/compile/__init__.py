@@ -6,6 +6,7 @@ scenario that caused it: xacro, URDF, plugin parameters, message data in the tim
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -36,7 +37,7 @@ from runner.plan import (
 )
 from runner.plugin import BuildContext, PluginConfigError
 from runner.registry import PluginLookupError, load
-from runner.schema import NoCollision, PluginEntry, Robot, Scenario, WorldModel
+from runner.schema import NoCollision, PluginEntry, Record, Robot, Scenario, WorldModel
 from runner.validate import validate_model
 
 _GEOM = {
@@ -63,6 +64,15 @@ def compile_plan(
         plan = compile_worlds(sc, doc, record_path, notices)
     else:
         plan = _compile_world(sc, doc, record_path, notices)
+    if sc.qos:
+        drop = [_full_expr(sc.name, q.topics) for q in sc.qos if q.reliability == "best_effort"]
+        for i, q in enumerate(sc.qos):
+            _check_expr(_full_expr(sc.name, q.topics), doc, ("qos", i, "topics"), q.topics)
+        for part in {id(p): p for p in (plan, *plan.parts())}.values():
+            part.best_effort = drop
+    if sc.zenoh is not None:
+        plan.zenoh = _zenoh_settings(sc, doc)
+        plan.listen = list(sc.zenoh.listen)
     if sc.bridges or sc.ros2 is not None:
         from runner.compile.bridges import attach_bridges
 
@@ -73,6 +83,7 @@ def compile_plan(
 def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices: Notices) -> RunPlan:
     base = doc.base_dir
     packages = PackageMap.for_scenario(base, {k: (base / v) for k, v in sc.packages.items()})
+    packages.allowed = [base / p for p in sc.allow_paths]
     for name, folder in packages.explicit.items():
         if not folder.is_dir():
             raise ScenarioError(
@@ -119,9 +130,7 @@ def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices
     try:
         world.compile()
     except ValueError as e:
-        raise ScenarioError(
-            Problem(f"MuJoCo cannot compile the world: {e}", doc.locate(("robots",)), ("robots",))
-        ) from None
+        raise ScenarioError(_compile_problem(e, sc, doc, world)) from None
     mjcf = world.to_xml()
 
     timeline = [_timeline_entry(sc, i, doc) for i in range(len(sc.timeline))]
@@ -161,6 +170,46 @@ def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices
     )
 
 
+def _compile_problem(e: ValueError, sc: Scenario, doc: Document, world: mujoco.MjSpec) -> Problem:
+    """MuJoCo's compile error ("Error: size 0 must be positive in geom / Element name 'r1/left_wheel'")
+    at the robot (by its namespace prefix) or the world model it is about."""
+    import re
+
+    text = str(e)
+    first = " ".join(text.split("\n")[0].split()).removeprefix("Error: ")
+    m = re.search(r"Element name '([^']*)', id (\d+)", text)
+    element = m.group(1) if m else ""
+    kind = re.search(r" in (\w+)$", first)
+    if m and not element and kind:  # an unnamed geom: named by its body
+        found = [
+            x for x in getattr(world, kind.group(1) + "s", []) if getattr(x, "id", None) == int(m.group(2))
+        ]
+        if found:
+            parent = getattr(found[0], "parent", None)
+            element = found[0].name or (parent.name if parent is not None else "")
+    for i, robot in enumerate(sc.robots):
+        if element.startswith(f"{robot.ns}/"):
+            part = element[len(robot.ns) + 1 :]
+            where: PathKey = ("robots", i, "description")
+            return Problem(
+                f"MuJoCo cannot compile robot {robot.name!r}: {first}" + (f" (at {part!r})" if part else ""),
+                doc.locate(where),
+                where,
+                hint="check that link's <inertial> (positive mass, inertia) and geometry sizes; with xacro, "
+                "the `args:` that set them",
+            )
+    for i, m_ in enumerate(sc.world.models):
+        if element == m_.name:
+            where = ("world", "models", i)
+            return Problem(f"MuJoCo cannot compile model {m_.name!r}: {first}", doc.locate(where), where)
+    where = ("world", "sdf") if sc.world.sdf else ("robots",)
+    return Problem(
+        f"MuJoCo cannot compile the world: {first}" + (f" (at {element!r})" if element else ""),
+        doc.locate(where),
+        where,
+    )
+
+
 def _host(sc: Scenario, doc: Document, name: str | None, where: PathKey) -> str | None:
     """A `host:` that must name one of `hosts:`."""
     if name is not None and name not in sc.hosts:
@@ -189,7 +238,7 @@ def _record_plan(sc: Scenario, doc: Document, record_path: str | None) -> Record
         include=[_full_expr(sc.name, e) for e in rec.include],
         exclude=[_full_expr(sc.name, e) for e in rec.exclude],
     )
-    _check_key_exprs(record, doc)
+    _check_key_exprs(record, doc, rec)
     return record
 
 
@@ -302,8 +351,21 @@ def _world_spec(
             friction=[ground.friction, 0.005, 0.0001],
         )
     rate = _load_sdf(spec, sc, doc, packages, notices) if sc.world.sdf else None
-    for m in sc.world.models:
-        _add_model(spec, m)
+    for i, m in enumerate(sc.world.models):
+        try:
+            _add_model(spec, m)
+        except ValueError as e:  # MuJoCo: "repeated name 'x' in geom" (the ground, a model of the SDF world)
+            where: PathKey = ("world", "models", i, "name")
+            raise ScenarioError(
+                Problem(
+                    f"the world already has something named {m.name!r}",
+                    doc.locate(where),
+                    where,
+                    found=str(e).removeprefix("Error: "),
+                    hint="give the model another name"
+                    + (" (`ground` is the ground plane's)" if m.name == "ground" else ""),
+                )
+            ) from None
     return spec, rate
 
 
@@ -311,8 +373,19 @@ def _load_sdf(
     spec: mujoco.MjSpec, sc: Scenario, doc: Document, packages: PackageMap, notices: Notices
 ) -> float | None:
     assert sc.world.sdf is not None
+    path = doc.base_dir / sc.world.sdf
+    if not path.is_file():
+        raise ScenarioError(
+            Problem(
+                "world file not found" if not path.is_dir() else "this is a folder, not a world file",
+                doc.locate(("world", "sdf")),
+                ("world", "sdf"),
+                expected="an SDF or .world file (relative to the scenario's folder)",
+                found=str(path),
+            )
+        )
     try:
-        sdf = load_sdf_world(spec, doc.base_dir / sc.world.sdf, packages, notices)
+        sdf = load_sdf_world(spec, path, packages, notices)
     except SourceError as e:
         raise ScenarioError(
             [
@@ -487,6 +560,7 @@ def _build_plugins(sc: Scenario, robot: Robot, i: int, model: RobotModel, doc: D
                 where = (*here, "type")
                 raise ScenarioError(Problem(str(e), doc.locate(where), where, hint=e.hint)) from None
             raise fail(str(e), None, e.hint) from None
+        _check_finite(entry, doc, here, fail)
         if src is None or entry.scenario_keys >= set(entry.params):
             params = validate_model(cls.Params, entry.params, doc, (*here, "params"))
         else:
@@ -520,6 +594,41 @@ def _build_plugins(sc: Scenario, robot: Robot, i: int, model: RobotModel, doc: D
             )
         )
     return plans
+
+
+def _non_finite(value: Any, path: tuple[Any, ...] = ()) -> tuple[tuple[Any, ...], float] | None:
+    """(path, value) of the first NaN or infinity in plain data, or None."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return path, value
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    for k, v in items:
+        found = _non_finite(v, (*path, k))
+        if found is not None:
+            return found
+    return None
+
+
+def _check_finite(entry: _Entry, doc: Document, here: PathKey, fail: Any) -> None:
+    """NaN and infinity are no parameter's meaning (a plugin's model may let them through): an error at
+    the scenario's line when the scenario set it, else at the description's."""
+    found = _non_finite(entry.params)
+    if found is None:
+        return
+    path, value = found
+    if entry.scenario_index is not None and path[0] in entry.scenario_keys:
+        where: PathKey = (*here, "params", *path)
+        raise ScenarioError(
+            Problem(
+                "not a finite number",
+                doc.locate(where),
+                where,
+                expected="a finite number",
+                found=repr(value),
+                hint="YAML reads .nan, .inf and numbers beyond 1.8e308 as these",
+            )
+        )
+    shown = ".".join(str(p) for p in path)
+    raise fail(f"{shown} is {value!r}, not a finite number", None, "give a plain, finite number")
 
 
 def _plugin_error(
@@ -610,20 +719,104 @@ def _full_expr(run: str, expr: str) -> str:
     return f"{run}/{expr.lstrip('/')}"
 
 
-def _check_key_exprs(record: RecordPlan, doc: Document) -> None:
+def _check_key_exprs(record: RecordPlan, doc: Document, given: Record | None = None) -> None:
+    """Every include/exclude pattern is a key expression; errors show the pattern as the user wrote it
+    (`given`), not with the run's name in front."""
+    for field_name, exprs in (("include", record.include), ("exclude", record.exclude)):
+        written = list(getattr(given, field_name)) if given is not None else exprs
+        for j, e in enumerate(exprs):
+            _check_expr(e, doc, ("record", field_name, j), written[j])
+
+
+def _zenoh_reason(err: Exception) -> str:
+    """Zenoh's error text without the Rust source location it carries (`Str("x") at .../x.rs:86`)."""
+    import re
+
+    text = re.sub(r"\s+at \S+\.rs:\d+\.?", "", str(err)).strip()
+    quoted = re.fullmatch(r'Str\("(.*)"\)', text)
+    return quoted.group(1) if quoted else text
+
+
+def _zenoh_settings(sc: Scenario, doc: Document) -> dict[str, Any]:
+    """`zenoh:` checked against Zenoh itself (each setting inserted into a config), paths made absolute."""
+    import json
+
     import zenoh
 
-    for field_name, exprs in (("include", record.include), ("exclude", record.exclude)):
-        for j, e in enumerate(exprs):
-            try:
-                zenoh.KeyExpr(e)
-            except Exception:
-                where: PathKey = ("record", field_name, j)
-                raise ScenarioError(
-                    Problem(
-                        f"{e!r} is not a valid key expression",
-                        doc.locate(where),
-                        where,
-                        hint="use chunks separated by '/', '*' for one chunk and '**' for any number",
-                    )
-                ) from None
+    assert sc.zenoh is not None
+    base = doc.base_dir
+    file = None
+    if sc.zenoh.config is not None:
+        path = base / sc.zenoh.config
+        where: PathKey = ("zenoh", "config")
+        if not path.is_file():
+            raise ScenarioError(
+                Problem(
+                    f"file not found: {sc.zenoh.config}",
+                    doc.locate(where),
+                    where,
+                    hint="relative to the scenario",
+                )
+            )
+        try:
+            zenoh.Config.from_file(str(path))
+        except Exception as e:
+            raise ScenarioError(
+                Problem(f"Zenoh cannot read this configuration: {_zenoh_reason(e)}", doc.locate(where), where)
+            ) from None
+        file = str(path.resolve())
+    settings: dict[str, Any] = {}
+    probe = zenoh.Config()
+    for key, value in sc.zenoh.settings.items():
+        where = ("zenoh", "settings", key)
+        if isinstance(value, str) and (base / value).exists():
+            value = str((base / value).resolve())  # a certificate, a key, an ACL file: beside the scenario
+        try:
+            probe.insert_json5(key, json.dumps(value))
+        except Exception as e:
+            raise ScenarioError(
+                Problem(
+                    f"Zenoh refuses the setting {key!r}: {_zenoh_reason(e)}",
+                    doc.locate(where),
+                    where,
+                    hint="a path in Zenoh's configuration, e.g. transport/link/tls/root_ca_certificate",
+                )
+            ) from None
+        settings[key] = value
+    for i, endpoint in enumerate(sc.zenoh.listen):
+        if "/" not in endpoint:
+            where = ("zenoh", "listen", i)
+            raise ScenarioError(
+                Problem(
+                    f"{endpoint!r} is not a Zenoh endpoint",
+                    doc.locate(where),
+                    where,
+                    expected="<protocol>/<address>:<port>, e.g. tcp/127.0.0.1:7447 or tls/127.0.0.1:7447",
+                )
+            )
+    return {"file": file, "settings": settings}
+
+
+def _check_expr(expr: str, doc: Document, where: PathKey, written: str | None = None) -> None:
+    """`expr` is a Zenoh key expression; the error quotes `written` (what the user wrote) and Zenoh's
+    reason."""
+    import re
+
+    import zenoh
+
+    try:
+        zenoh.KeyExpr(expr)
+    except Exception as err:
+        # zenoh's text: "Invalid Key Expr `...`: <why> at <its source file>:<line>."
+        why = re.search(r"`: (.*?)(?: at \S+:\d+\.?)?$", str(err).strip())
+        raise ScenarioError(
+            Problem(
+                f"{(written if written is not None else expr)!r} is not a valid key expression"
+                + (f": {why.group(1)}" if why else ""),
+                doc.locate(where),
+                where,
+                expected="chunks separated by '/' (none empty), '*' for one chunk, '**' for any number "
+                "(e.g. `r1/**`, `*/scan`)",
+                hint="patterns are relative to the run: `r1/scan` is the key <run>/r1/scan",
+            )
+        ) from None

@@ -411,7 +411,7 @@ def _file_entry(
     if gz_type is None:
         problem("gz_type_name is missing", expected="a Gazebo type, e.g. gz.msgs.LaserScan")
     direction = entry.get("direction", "BIDIRECTIONAL")
-    if direction not in _GZ_DIRECTIONS:
+    if not isinstance(direction, str) or direction not in _GZ_DIRECTIONS:
         problem(
             f"unknown direction {direction!r}", "direction", expected="GZ_TO_ROS, ROS_TO_GZ or BIDIRECTIONAL"
         )

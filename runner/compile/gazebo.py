@@ -22,7 +22,9 @@ from lxml import etree
 
 from runner.compile.locate import Locator
 from runner.compile.materials import gazebo_material
-from runner.errors import Notices
+from runner.errors import Notices, SourceError
+
+_NOT_FINITE = {"inf", "-inf", "+inf", "infinity", "-infinity", "nan"}
 
 # Tags whose meaning is GUI-only or debugging, ignored on purpose; listed with this reason.
 _IGNORED_REASONS = {
@@ -204,12 +206,37 @@ class GazeboReader:
     def read(self) -> GazeboInfo:
         for gz in self.root.findall("gazebo"):
             ref = gz.get("reference")
-            if ref:
-                self._reference(gz, ref)
-            else:
-                self._model(gz)
+            try:
+                if ref:
+                    self._reference(gz, ref)
+                else:
+                    self._model(gz)
+            except (ValueError, OverflowError) as e:  # float("many"), int(float("inf")) in a tag's text
+                raise self._not_a_number(gz, e) from None
         self._drop_shadowed()
         return self.info
+
+    def _not_a_number(self, gz: Any, e: Exception) -> SourceError:
+        """A tag whose text should be a number and is not: the error at that tag's line."""
+        m = re.search(r": '(.*)'$", str(e))
+        text = m.group(1) if m else None
+        bad = next(
+            (
+                el
+                for el in gz.iter()
+                if isinstance(el.tag, str)
+                and el.text is not None
+                and (el.text.strip() == text or (text is None and el.text.strip().lower() in _NOT_FINITE))
+            ),
+            None,
+        )
+        el = bad if bad is not None else gz
+        shown = repr(el.text.strip()) if bad is not None and el.text else "a value"
+        return SourceError(
+            f"<{el.tag}> {shown} is not a number that fits here ({e})",
+            *self.where(el),
+            hint="Gazebo tags take plain numbers (an integer for counts such as <samples>)",
+        )
 
     def _drop_shadowed(self) -> None:
         """A classic sensor without a ROS plugin (e.g. TurtleBot3's imu sensor) publishes nothing in

@@ -21,7 +21,15 @@ _SKIP_DIRS = {".git", ".venv", "venv", "node_modules", "__pycache__", "build", "
 class PackageMap:
     explicit: dict[str, Path] = field(default_factory=dict)
     roots: list[Path] = field(default_factory=list)
+    allowed: list[Path] = field(default_factory=list)  # more folders xacro may read (`allow_paths:`)
     _found: dict[str, Path] | None = None
+
+    def readable(self, path: Path, description: Path) -> bool:
+        """Whether xacro, expanding `description`, may read `path`: a file of the scenario's folder or of a
+        package root (and below), of the description's own folder, or of an `allow_paths:` folder."""
+        target = path.resolve()
+        folders = [*self.roots, *self.explicit.values(), description.resolve().parent, *self.allowed]
+        return any(target.is_relative_to(f.resolve()) for f in folders)
 
     @classmethod
     def for_scenario(cls, base_dir: Path, explicit: dict[str, Path] | None = None) -> PackageMap:

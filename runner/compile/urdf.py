@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -57,6 +58,69 @@ class RobotModel:
 _JOINT_TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
 
 
+def _number(text: str, what: str, where: Any, el: Any) -> float:
+    """A number attribute of the URDF, or an error at its line."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise DescriptionError(
+            f"{what} {text!r} is not a number",
+            *where(el),
+            hint="xacro expressions are expanded in .xacro files only; a .urdf needs plain numbers",
+        )
+    return value
+
+
+# URDF attributes that hold numbers; limits may be infinite (unlimited), nothing may be NaN.
+_NUMERIC = {
+    "xyz",
+    "rpy",
+    "value",
+    "ixx",
+    "ixy",
+    "ixz",
+    "iyy",
+    "iyz",
+    "izz",
+    "size",
+    "radius",
+    "length",
+    "scale",
+    "rgba",
+    "damping",
+    "friction",
+    "multiplier",
+    "offset",
+    "k_position",
+    "k_velocity",
+}
+_LIMITS = {"lower", "upper", "effort", "velocity", "soft_lower_limit", "soft_upper_limit"}
+
+
+def _check_numbers(root: Any, where: Any) -> None:
+    """NaN (and, but in limits, infinity) in a number attribute: MuJoCo would only print a warning and
+    build a model that moves to NaN."""
+    for el in root.iter():
+        if not isinstance(el.tag, str) or el.tag in ("gazebo", "plugin"):
+            continue
+        for attr, text in el.attrib.items():
+            if attr not in _NUMERIC and attr not in _LIMITS:
+                continue
+            for token in text.split():
+                try:
+                    value = float(token)
+                except ValueError:
+                    continue  # MuJoCo reports what does not parse
+                if math.isnan(value) or (math.isinf(value) and attr not in _LIMITS):
+                    raise DescriptionError(
+                        f'<{el.tag} {attr}="{text}">: {token!r} is not a finite number',
+                        *where(el),
+                        hint="give a plain number",
+                    )
+
+
 def _check_structure(root: Any, where: Any) -> str:
     """Checks MuJoCo would report badly or not at all; returns the root link's name."""
     link_els = root.findall("link")
@@ -98,9 +162,11 @@ def _check_structure(root: Any, where: Any) -> str:
         if jtype not in ("fixed", "floating", "planar") and j.find("child") is not None:
             link_el = next(e for e in link_els if e.get("name") == child)
             mass = link_el.find("inertial/mass")
-            if mass is not None and float(mass.get("value", "1") or 0) <= 0:
+            value = _number(mass.get("value", "1") or "0", "mass", where, mass) if mass is not None else 1.0
+            if not value > 0:
                 raise DescriptionError(
-                    f"link {child!r} moves (joint {jname!r} is {jtype}) but has zero mass",
+                    f"link {child!r} moves (joint {jname!r} is {jtype}) but has "
+                    + ("zero mass" if value == 0 else f"a negative mass ({value:g})"),
                     *where(mass),
                     hint="give it a positive <mass value=...> and an <inertia>",
                 )
@@ -138,6 +204,7 @@ def urdf_to_model(
     if root.tag != "robot":
         raise DescriptionError(f"the top element is <{root.tag}>, expected <robot>", *where(root))
     root_link = _check_structure(root, where)
+    _check_numbers(root, where)
 
     for mesh in root.iter("mesh"):
         if mesh.getparent() is not None and mesh.getparent().tag == "geometry":
@@ -166,7 +233,7 @@ def urdf_to_model(
     try:
         spec = mujoco.MjSpec.from_string(text)
     except ValueError as e:
-        raise DescriptionError(f"MuJoCo cannot load this URDF: {e}", file) from None
+        raise _mujoco_error(e, root, text, where, file) from None
 
     for geom in spec.geoms:
         if geom.contype or geom.conaffinity:
@@ -178,6 +245,25 @@ def urdf_to_model(
     links = [b.name for b in spec.bodies if b.name and b.name != "world"]
     joints = [j.name for j in spec.joints if j.name and j.name != "root"]
     return RobotModel(spec, root_link, urdf, links, joints, gazebo, transmissions)
+
+
+def _mujoco_error(e: ValueError, root: Any, text: str, where: Any, file: Path | None) -> DescriptionError:
+    """MuJoCo's "XML Error: ... Element 'x', line N" is about the text we gave it: point at the element
+    in the user's file instead (the trees are the same, element for element)."""
+    message = " ".join(str(e).split("\n")[0].split()).removeprefix("XML Error: ")
+    m = re.search(r"Element '([^']*)', line (\d+)", str(e))
+    if m:
+        tag, line = m.group(1), int(m.group(2))
+        ours = [el for el in root.iter() if isinstance(el.tag, str)]
+        given = [el for el in etree.fromstring(text.encode()).iter() if isinstance(el.tag, str)]
+        for mine, theirs in zip(ours, given, strict=False):
+            if theirs.sourceline == line and theirs.tag == tag:
+                return DescriptionError(
+                    f"MuJoCo cannot load this URDF: {message} (in <{tag}>)",
+                    *where(mine),
+                    hint="check that element's attributes: names, numbers and required children",
+                )
+    return DescriptionError(f"MuJoCo cannot load this URDF: {message}", file)
 
 
 def _apply_link_props(spec: mujoco.MjSpec, gazebo: GazeboInfo, timestep: float) -> None:

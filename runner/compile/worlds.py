@@ -78,13 +78,15 @@ def compile_worlds(sc: Scenario, doc: Document, record_path: str | None, notices
 
     timeline_world: list[str] = []
     for i, entry in enumerate(sc.timeline):
-        w, _rest = _split_topic(entry.topic)
+        w, rest = _split_topic(entry.topic)
         timeline_world.append(w)
-        if w not in names:
+        if w not in names or not rest:
             where = ("timeline", i, "topic")
             problems.append(
                 Problem(
-                    f"{entry.topic!r} names no world",
+                    f"{entry.topic!r} names no world"
+                    if w not in names
+                    else f"{entry.topic!r} names no topic",
                     doc.locate(where),
                     where,
                     expected=f"a topic starting with its world: {names[0]}/r1/cmd_vel",
@@ -104,12 +106,12 @@ def compile_worlds(sc: Scenario, doc: Document, record_path: str | None, notices
                     Problem(f"no robot named {a.robot!r}", doc.locate(where), where)  # type: ignore[union-attr]
                 )
         elif a.type in _TOPIC_KINDS:
-            w, _rest = _split_topic(a.topic)  # type: ignore[union-attr]
-            if w not in names:
+            w, rest = _split_topic(a.topic)  # type: ignore[union-attr]
+            if w not in names or not rest:
                 where = ("assertions", i, "topic")
                 problems.append(
                     Problem(
-                        f"{a.topic!r} names no world",  # type: ignore[union-attr]
+                        f"{a.topic!r} names no " + ("world" if w not in names else "topic"),  # type: ignore[union-attr]
                         doc.locate(where),
                         where,
                         expected=f"a topic starting with its world: {names[0]}/r1/scan",

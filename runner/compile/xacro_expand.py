@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import re
 import threading
 import xml.parsers.expat
 from dataclasses import dataclass
@@ -27,6 +28,14 @@ class XacroError(SourceError):
 
 class MissingPackage(XacroError):
     pass
+
+
+class IncludeCycle(XacroError):
+    pass
+
+
+class OutsidePackages(XacroError):
+    """A description read (`<xacro:include>`, `xacro.load_yaml`) a file outside what the scenario trusts."""
 
 
 _lock = threading.Lock()
@@ -55,18 +64,50 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
             )
         return str(root)
 
+    real_parse = xacro.parse
+
+    def parse(inp, filename=None):  # type: ignore[no-untyped-def]
+        # xacro recurses without end on an include cycle (a includes b includes a): stop at the first
+        # file that is already being read. xacro has pushed `filename` on its stack before parsing it.
+        stack = list(getattr(xacro, "filestack", None) or [])
+        if inp is None and filename and len(stack) > 1:
+            again = _same_file_index(stack[:-1], filename)
+            if again is not None:
+                chain = [Path(f).name for f in stack[again:-1]] + [Path(filename).name]
+                includer = Path(stack[-2])
+                raise IncludeCycle(
+                    "include cycle: " + " includes ".join(chain),
+                    includer,
+                    _line_of(includer, Path(filename).name, "include"),
+                    hint="a file cannot include itself, directly or through others; remove one of the "
+                    "<xacro:include> tags",
+                )
+        return real_parse(inp, filename)
+
     with _lock:
         saved = _sa._eval_find, _sa._eval_dict.get("find")
         _sa._eval_find = find
         _sa._eval_dict["find"] = find
+        xacro.parse = parse
         stderr = io.StringIO()
         xacro.all_includes = []
         try:
             with contextlib.redirect_stderr(stderr):
                 doc = xacro.process_file(str(path), mappings={k: str(v) for k, v in args.items()})
             sources = [path] + [Path(f) for f in dict.fromkeys(xacro.all_includes)]
+            for read in sources[1:]:
+                if not packages.readable(read, path):
+                    holder = next((f for f in sources if _line_of(f, read.name)), path)
+                    raise OutsidePackages(
+                        f"{read} is outside the scenario's folder and packages",
+                        holder,
+                        _line_of(holder, read.name),
+                        hint="a robot description may read files of the scenario's folder, its own folder "
+                        "and the packages (`packages:`, SCENARIO_PACKAGE_PATH); list other folders the "
+                        "scenario trusts under `allow_paths:`",
+                    )
             return Expanded(doc.toprettyxml(indent="  "), sources)
-        except MissingPackage:
+        except (MissingPackage, IncludeCycle, OutsidePackages):
             raise
         except xml.parsers.expat.ExpatError as e:
             raise XacroError(
@@ -79,22 +120,70 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
             cause = e.__cause__ or e.__context__
             if isinstance(cause, MissingPackage):
                 raise cause from None
+            if isinstance(cause, IncludeCycle):
+                raise cause from None
             message = " ".join(str(e).split())
-            raise XacroError(message, _current_file(path), hint=_hint(message)) from None
+            missing = getattr(e, "exc", None)
+            if isinstance(missing, FileNotFoundError) and missing.filename:
+                message = f"included file not found: {missing.filename}"
+            file = _current_file(path)
+            file, line = _locate_message(message, file, [path, *map(Path, xacro.all_includes)])
+            raise XacroError(message, file, line, hint=_hint(message)) from None
         finally:
+            xacro.parse = real_parse
             _sa._eval_find, found = saved
             if found is not None:
                 _sa._eval_dict["find"] = found
 
 
-def _line_of(file: Path, needle: str) -> int | None:
+def _line_of(file: Path, needle: str, also: str = "") -> int | None:
+    """The first line of `file` holding `needle` (and `also`, when given)."""
     try:
         for i, line in enumerate(file.read_text(encoding="utf-8", errors="replace").splitlines()):
-            if needle in line:
+            if needle in line and also in line:
                 return i + 1
     except OSError:
         pass
     return None
+
+
+def _same_file_index(stack: list[str | None], filename: str) -> int | None:
+    target = Path(filename).resolve()
+    for i, f in enumerate(stack):
+        if f is not None and Path(f).resolve() == target:
+            return i
+    return None
+
+
+# What to look for in the xacro sources to find the line of an error, from xacro's message.
+_NEEDLES: list[tuple[re.Pattern[str], str, str]] = [
+    (re.compile(r"name '(\w+)' is not defined when evaluating expression '([^']*)'"), "${{{1}", ""),
+    (re.compile(r"name '(\w+)' is not defined"), "{0}", "${"),
+    (re.compile(r"Undefined substitution argument (\S+)"), "$(arg {0})", ""),
+    (re.compile(r"(?:No such file or directory|included file not found): (\S+)"), "@basename", "include"),
+    (re.compile(r"unknown macro name: (?:xacro:)?(\S+)"), "<xacro:{0}", ""),
+    (re.compile(r"Invalid parameter \"(\w+)\""), '{0}="', ""),
+    (re.compile(r"invalid expression: (.+?)(?: when evaluating| \[|$)"), "{0}", ""),
+    (re.compile(r"when evaluating expression '([^']*)'"), "${{{0}", ""),
+]
+
+
+def _locate_message(message: str, file: Path, sources: list[Path]) -> tuple[Path, int | None]:
+    """file:line of what xacro's message is about: found by text in the current file, else in the
+    other files of the expansion."""
+    for pattern, needle_form, also in _NEEDLES:
+        m = pattern.search(message)
+        if not m:
+            continue
+        if needle_form == "@basename":
+            needle = Path(m.group(1).rstrip("'\"")).name
+        else:
+            needle = needle_form.format(*m.groups())
+        for candidate in dict.fromkeys([file, *sources]):
+            line = _line_of(candidate, needle, also)
+            if line is not None:
+                return candidate, line
+    return file, None
 
 
 def _current_file(default: Path) -> Path:
@@ -105,8 +194,12 @@ def _current_file(default: Path) -> Path:
 def _hint(message: str) -> str | None:
     if "Undefined substitution argument" in message:
         return "pass it under `description: {args: {...}}` in the scenario, or give the <xacro:arg> a default"
+    if "missing attribute 'default'" in message:
+        return 'give the <xacro:arg> a default (`default="..."`), or pass it under `description: {args:}`'
     if "is not defined" in message:
         return "a ${...} expression names a property that no <xacro:property> defines"
+    if "when evaluating expression" in message:
+        return "an xacro argument or property of the wrong kind? Check the values passed under `args:`"
     if "No such file" in message or "not found" in message:
         return "check the include's path; $(find pkg) and relative paths are resolved from the including file"
     return None
