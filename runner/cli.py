@@ -274,7 +274,7 @@ def _run_one(
 ) -> tuple[Any, int]:
     from runner.checks.report import Suite, judge_for
     from runner.launch import run_plan
-    from runner.transport import free_port
+    from runner.transport import free_port, use_run_settings
 
     total = plan.duration_ns / 1e9
     progress = None
@@ -304,7 +304,9 @@ def _run_one(
     if plan.hosts:
         endpoints = list(listen or []) or [plan.hosts[host or plan.main_host]]
     else:
-        endpoints = list(listen or []) or [f"tcp/127.0.0.1:{free_port()}"]
+        # loopback only unless told otherwise (--listen, zenoh.listen)
+        endpoints = list(listen or []) or plan.listen or [f"tcp/127.0.0.1:{free_port()}"]
+    use_run_settings(plan.zenoh)  # the scenario's zenoh: (TLS...) for every session of the run
     if not quiet:
         who = f" as host {host!r}" if member else ""
         err.print(

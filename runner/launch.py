@@ -206,7 +206,7 @@ def run_plan(
     except zenoh.ZError as e:
         raise RunError(f"cannot open the Zenoh network on {', '.join(listen)}: {e}") from None
 
-    announced = announce(plan.name, listen)  # `scenario echo/pub/topics` find the local run by it
+    announced = announce(plan.name, listen, plan.zenoh)  # `scenario echo/pub/topics` find the local run by it
     parts = [
         _WorldPart(
             w,

@@ -20,7 +20,7 @@ from typing import Any
 import zenoh
 
 from runner.errors import RunError
-from runner.transport import make_config
+from runner.transport import make_config, use_run_settings
 
 RUNS_DIR = Path(tempfile.gettempdir()) / "scenario-runs"
 
@@ -30,13 +30,18 @@ class RunInfo:
     name: str
     endpoints: list[str]
     pid: int
+    zenoh: dict[str, Any] | None = None  # the run's Zenoh settings (scenario `zenoh:`)
 
 
-def announce(name: str, endpoints: list[str]) -> Path:
-    """Write the run's discovery file; the caller removes it at the end (`withdraw`)."""
+def announce(name: str, endpoints: list[str], zenoh_settings: dict[str, Any] | None = None) -> Path:
+    """Write the run's discovery file (with the run's Zenoh settings: a tool joining a TLS run needs its
+    certificates); the caller removes it at the end (`withdraw`). Readable by this user only."""
     RUNS_DIR.mkdir(parents=True, exist_ok=True)
     path = RUNS_DIR / f"{name}.json"
-    path.write_text(json.dumps({"name": name, "endpoints": endpoints, "pid": os.getpid()}))
+    info = {"name": name, "endpoints": endpoints, "pid": os.getpid(), "zenoh": zenoh_settings}
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    with os.fdopen(fd, "w") as f:
+        f.write(json.dumps(info))
     return path
 
 
@@ -61,7 +66,7 @@ def running_runs() -> list[RunInfo]:
     for path in sorted(RUNS_DIR.glob("*.json")) if RUNS_DIR.is_dir() else []:
         try:
             info = json.loads(path.read_text())
-            run = RunInfo(str(info["name"]), list(info["endpoints"]), int(info["pid"]))
+            run = RunInfo(str(info["name"]), list(info["endpoints"]), int(info["pid"]), info.get("zenoh"))
         except (OSError, ValueError, KeyError, TypeError):
             continue
         if _alive(run.pid):
@@ -78,6 +83,7 @@ def find_run(run: str | None, connect: list[str] | None) -> tuple[str, list[str]
             if len(runs) != 1:
                 raise RunError("with --connect, say which run with --run NAME")
             run = runs[0].name
+        use_run_settings(next((r.zenoh for r in runs if r.name == run), None))
         return run, list(connect)
     chosen = [r for r in runs if run is None or r.name == run]
     if not chosen:
@@ -89,6 +95,7 @@ def find_run(run: str | None, connect: list[str] | None) -> tuple[str, list[str]
         raise RunError(
             "several runs are going: " + ", ".join(r.name for r in chosen) + "; pick one with --run"
         )
+    use_run_settings(chosen[0].zenoh)  # a TLS run: its certificates, for this tool's session too
     return chosen[0].name, [e.replace("0.0.0.0", "127.0.0.1") for e in chosen[0].endpoints]
 
 

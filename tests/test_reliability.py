@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import subprocess
+import time
+from pathlib import Path
 
 import pytest
 
@@ -92,3 +94,111 @@ def test_best_effort_topics_drop_and_every_other_topic_blocks() -> None:
         assert scan.congestion_control == zenoh.CongestionControl.BLOCK
         assert scan.reliability == zenoh.Reliability.RELIABLE
         bus.undeclare_all()
+
+
+def _certificates(folder: Path) -> None:
+    """A self-signed CA and a server certificate for 127.0.0.1 / localhost, made with openssl."""
+
+    def openssl(*args: str) -> None:
+        subprocess.run(["openssl", *args], cwd=folder, check=True, capture_output=True, timeout=60)
+
+    openssl("req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "2", "-subj", "/CN=test-ca",
+            "-keyout", "ca.key", "-out", "ca.pem")  # fmt: skip
+    (folder / "san.ext").write_text("subjectAltName=IP:127.0.0.1,DNS:localhost\n")
+    openssl("req", "-newkey", "rsa:2048", "-nodes", "-subj", "/CN=localhost", "-keyout", "server.key",
+            "-out", "server.csr")  # fmt: skip
+    openssl("x509", "-req", "-in", "server.csr", "-CA", "ca.pem", "-CAkey", "ca.key", "-CAcreateserial",
+            "-days", "2", "-extfile", "san.ext", "-out", "server.pem")  # fmt: skip
+
+
+@pytest.mark.timeout(90)
+def test_a_run_over_tls_and_a_plain_client_that_cannot_join(write_scenario, tmp_path: Path) -> None:
+    import zenoh
+
+    from runner.transport import free_port, make_config
+
+    _certificates(tmp_path)
+    endpoint = f"tls/127.0.0.1:{free_port()}"
+    path = write_scenario(
+        f"""
+        name: secure
+        duration: 30
+        rate: realtime
+        robots:
+          - name: r1
+            description: "{{diffbot}}"
+            pose: {{xyz: [0, 0, 0.06]}}
+            plugins: [{{type: lidar, params: {{link: lidar_link, samples: 8, rate: 10}}}}]
+        zenoh:
+          listen: ["{endpoint}"]
+          settings:
+            transport/link/tls/root_ca_certificate: ca.pem
+            transport/link/tls/listen_certificate: server.pem
+            transport/link/tls/listen_private_key: server.key
+        """
+    )
+    run = subprocess.Popen(
+        scenario_cmd("run", str(path), "-q", "--record", str(tmp_path / "s.mcap")),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        # a tool finds the run, and its certificates, by itself: over TLS, the world's scans
+        deadline = time.monotonic() + 40
+        while True:
+            echo = subprocess.run(
+                scenario_cmd("echo", "r1/scan", "-n", "2", "--run", "secure"),
+                capture_output=True,
+                text=True,
+                timeout=40,
+            )
+            if echo.returncode == 0 or time.monotonic() > deadline or run.poll() is not None:
+                break
+            time.sleep(0.3)  # (the run is still starting)
+        assert run.poll() is None, run.communicate()[1]
+        assert echo.returncode == 0, echo.stderr
+        assert echo.stdout.count("# secure/r1/scan (sensor_msgs/msg/LaserScan)") == 2
+        # a client without the CA cannot even open its session there
+        plain = make_config("client", connect=[endpoint])
+        plain.insert_json5("connect/timeout_ms", "1500")
+        with pytest.raises(zenoh.ZError):
+            zenoh.open(plain)
+        # nor can a plain TCP client on the same port
+        tcp = make_config("client", connect=[endpoint.replace("tls/", "tcp/")])
+        tcp.insert_json5("connect/timeout_ms", "1500")
+        with pytest.raises(zenoh.ZError):
+            zenoh.open(tcp)
+    finally:
+        run.send_signal(2)
+        _out, err = run.communicate(timeout=30)
+    assert "Traceback" not in err
+    scans = [m for topic, _t, _s, m in read_mcap(tmp_path / "s.mcap") if topic == "secure/r1/scan"]
+    assert len(scans) >= 2  # the world, over TLS too, was recorded
+
+
+def test_the_router_listens_on_loopback_unless_told_otherwise(write_scenario) -> None:
+    from runner.compile import compile_plan
+    from runner.loader import load_file
+    from runner.validate import validate_scenario
+
+    doc = load_file(write_scenario("name: quiet\nduration: 1\n"))
+    plan = compile_plan(validate_scenario(doc), doc)
+    assert plan.listen == [] and plan.zenoh is None  # -> the CLI's default, a free port on 127.0.0.1
+    proc = subprocess.run(
+        scenario_cmd("run", str(doc.file), "--no-record"), capture_output=True, text=True, timeout=60
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "Zenoh on tcp/127.0.0.1:" in proc.stderr
+
+
+@pytest.mark.timeout(120)
+def test_a_long_run_keeps_its_memory_flat_and_loses_nothing() -> None:
+    """bench/soak.py, shortened: 5 sim minutes of the demo at rate: max, recorded with --strict."""
+    from bench.soak import soak
+
+    doc = soak(300.0)
+    assert doc["lost"] == 0 and doc["messages_recorded"] > 240_000
+    assert doc["runner_rss_growth_pct"] < 10.0, doc
+    assert doc["world_rss_growth_pct"] < 10.0, doc
+    assert doc["assertions_passed"] == doc["assertions"] > 0

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
 import socket
 import struct
 from collections.abc import Callable, Sequence
@@ -60,8 +61,11 @@ def make_config(
     listen: Sequence[str] = (),
     connect: Sequence[str] = (),
 ) -> zenoh.Config:
-    """A Zenoh config with multicast scouting off: peers find each other only through explicit endpoints."""
-    conf = zenoh.Config()
+    """A Zenoh config with multicast scouting off: peers find each other only through explicit endpoints.
+
+    The run's own Zenoh settings (the scenario's `zenoh:`: TLS, access control...), handed to every process
+    of the run in `SCENARIO_ZENOH`, come first; the session's role and endpoints go on top."""
+    conf = _run_settings()
     conf.insert_json5("mode", json.dumps(mode))
     conf.insert_json5("scouting/multicast/enabled", "false")
     # No gossip either: sessions meet only through the endpoints given (a run's topology is explicit).
@@ -81,6 +85,28 @@ def make_config(
         # A client started a moment before its router keeps retrying instead of failing at once.
         conf.insert_json5("connect/timeout_ms", "10000")
     return conf
+
+
+ZENOH_ENV = "SCENARIO_ZENOH"
+
+
+def _run_settings() -> zenoh.Config:
+    spec = os.environ.get(ZENOH_ENV)
+    if not spec:
+        return zenoh.Config()
+    data = json.loads(spec)
+    conf = zenoh.Config.from_file(data["file"]) if data.get("file") else zenoh.Config()
+    for key, value in data.get("settings", {}).items():
+        conf.insert_json5(key, json.dumps(value))
+    return conf
+
+
+def use_run_settings(settings: dict[str, Any] | None) -> None:
+    """Make the run's Zenoh settings apply to every session this process opens, and to its children."""
+    if settings:
+        os.environ[ZENOH_ENV] = json.dumps(settings)
+    else:
+        os.environ.pop(ZENOH_ENV, None)
 
 
 class Bus(Protocol):
