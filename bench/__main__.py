@@ -549,7 +549,7 @@ def soak(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     seconds = 120.0 if args.quick else 600.0
     doc = run_soak(seconds)
     rows = [(k, v) for k, v in doc.items() if not isinstance(v, list)]
-    grow = max(doc.get("runner_rss_growth_pct", 0.0), doc.get("world_rss_growth_pct", 0.0))
+    grow = max(doc.get(f"{p}_rss_{g}growth_pct", 0.0) for p in ("runner", "world") for g in ("", "peak_"))
     doc["targets"] = {"RSS growth < 10 % and nothing lost": grow < 10.0 and doc["lost"] == 0}
     return doc, table(
         f"soak: two_robots, {seconds:g} s sim at rate: max, recorded, --strict", ("", "value"), rows
