@@ -307,7 +307,8 @@ def messages(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     # one message per type, as the demo publishes it, and its layout as the plugin built it
     samples: dict[str, bytes] = {}
     for _key, type_name, payload, _att in bus.sent:
-        samples.setdefault(type_name, payload)
+        if msgs.is_known(type_name):  # (not the Foxglove scene: protobuf)
+            samples.setdefault(type_name, payload)
     from runner.cdr import Layout
 
     rows = []

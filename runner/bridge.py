@@ -132,6 +132,8 @@ class Bridge:
                 hidden = any(c.startswith("_") for c in rel.split("/"))
                 if graph.processes.get(e.process) != "node" or not rel or hidden or "*" in rel or not e.type:
                     continue
+                if not msgs.is_known(e.type):
+                    continue
                 direction = "SIM_TO_ZENOH" if e.kind == "pub" else "ZENOH_TO_SIM"
                 plan = BridgePlan(
                     where=f"ros2 (/{rel}, node {e.process})",

@@ -693,6 +693,13 @@ def echo(
                         continue
                     if type_name is None:
                         continue
+                    if not msgs.is_known(type_name):  # e.g. the Foxglove scene (protobuf)
+                        out.print(
+                            f"# {got} ({type_name}): {len(payload)} bytes, not a ROS 2 message", markup=False
+                        )
+                        out.print("---", markup=False)
+                        count += 1
+                        continue
                     data = msgs.to_data(msgs.decode(payload, type_name))
                     if field:
                         data = field_of(data, field)

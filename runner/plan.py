@@ -36,6 +36,7 @@ class RobotPlan(BaseModel):
     links: list[str]
     joints: list[str]
     plugins: list[PluginPlan]
+    urdf: str = ""  # the description as URDF (xacro expanded): published on <ns>/robot_description
 
 
 class TimelinePlan(BaseModel):
@@ -82,6 +83,12 @@ class BridgePlan(BaseModel):
     lazy: bool = False
 
 
+class FoxglovePlan(BaseModel):
+    scene: bool = True  # geometry (foxglove.SceneUpdate), every link's tf, robot_description
+    rate: float = 1.0  # scene, tf_static and robot_description are sent again this often (no latching)
+    tf_rate: float = 30.0  # moving links' transforms
+
+
 class RecordPlan(BaseModel):
     enabled: bool
     path: str
@@ -111,6 +118,7 @@ class RunPlan(BaseModel):
     lockstep: list[str] = []  # node names the world waits for at each step
     zenoh: dict[str, Any] | None = None  # {"file": absolute path | None, "settings": {path: value}}
     listen: list[str] = []  # the run's router endpoints (zenoh.listen), unless --listen says otherwise
+    foxglove: FoxglovePlan = FoxglovePlan()  # what the world publishes for a 3D view
     best_effort: list[str] = []  # key expressions whose publishers drop rather than block (qos:)
     bridges: list[BridgePlan] = []  # run by the bridge process (a node of the run)
     ros2: Ros2Plan | None = None  # the run's rmw_zenoh settings, when it appears to ROS 2 as a whole

@@ -421,10 +421,13 @@ class Recorder:
         if ch is None:
             if not self.wanted(key):
                 return
-            if type_name is None or not msgs.is_known(type_name):
+            if type_name is not None and type_name.startswith("foxglove."):
+                ch = self._register(key, type_name)  # (its schema comes from foxglove-sdk)
+            elif type_name is None or not msgs.is_known(type_name):
                 self.unknown[key] = self.unknown.get(key, 0) + 1
                 return
-            ch = self._register(key, msgs.normalize_type(type_name))
+            else:
+                ch = self._register(key, msgs.normalize_type(type_name))
         self._add(ch, seq, stamp, payload)
 
     def _add(self, ch: _Channel, seq: int | None, stamp: int, payload: bytes) -> None:
@@ -450,14 +453,24 @@ class Recorder:
                         print(f"recorder: a reader of {st.key} failed: {e!r}", file=sys.stderr, flush=True)
 
     def _register(self, key: str, type_name: str) -> _Channel:
+        foxglove = type_name.startswith("foxglove.")  # Foxglove's schemas (scene): protobuf
         schema_id = self._schemas.get(type_name)
         if schema_id is None:
-            schema_id = self._mcap.register_schema(
-                name=type_name, encoding="ros2msg", data=msgs.msgdef(type_name).encode()
-            )
+            if foxglove:
+                schema = foxglove_schema(type_name)
+                schema_id = self._mcap.register_schema(
+                    name=schema.name, encoding="protobuf", data=schema.data
+                )
+            else:
+                schema_id = self._mcap.register_schema(
+                    name=type_name, encoding="ros2msg", data=msgs.msgdef(type_name).encode()
+                )
             self._schemas[type_name] = schema_id
         ch = self._mcap.register_channel(
-            topic=key, message_encoding="cdr", schema_id=schema_id, stats=TopicStats(key, type_name)
+            topic=key,
+            message_encoding="protobuf" if foxglove else "cdr",
+            schema_id=schema_id,
+            stats=TopicStats(key, type_name),
         )
         self._channels[key] = ch
         return ch
@@ -494,6 +507,18 @@ class Recorder:
                 self._mcap.finish()
             finally:
                 self._file.close()
+
+
+def foxglove_schema(type_name: str) -> Any:
+    """The protobuf schema (name, encoding, FileDescriptorSet) of a Foxglove message, from foxglove-sdk."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        import foxglove.messages
+
+    cls = getattr(foxglove.messages, type_name.removeprefix("foxglove."))
+    return cls.get_schema()
 
 
 def read_summary(path: Path) -> dict[str, Any]:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from functools import cache
 from importlib.metadata import EntryPoint, entry_points
+from typing import Any
 
 from runner.plugin import Plugin
 
@@ -61,3 +62,14 @@ def load(name: str) -> type[Plugin]:
         raise PluginLookupError(f"{eps[0].value} is not a runner.plugin.Plugin subclass")
     cls.type_name = name
     return cls
+
+
+def drive_frames(plugin_type: str, params: dict[str, Any]) -> tuple[str, str | None] | None:
+    """(odom frame, base frame or None for the root) of a base drive that publishes odom -> base."""
+    try:
+        p = load(plugin_type).Params.model_validate(params)
+    except Exception:
+        return None
+    if "odom_frame" not in type(p).model_fields or not getattr(p, "publish_tf", False):
+        return None
+    return p.odom_frame, p.base_frame

@@ -485,6 +485,21 @@ class Ros2(Strict):
     )
 
 
+class Foxglove(Strict):
+    """What the world publishes so that a recording (or a live run) opens in Foxglove as a 3D view with no
+    set-up: the world's and robots' geometry, every link's transform, each robot's URDF."""
+
+    scene: bool = Field(
+        True,
+        description="Publish `scene` (foxglove.SceneUpdate: boxes, cylinders, spheres, meshes of every "
+        "body), `tf_static`/`tf` (every link, from `world`) and `<ns>/robot_description` (URDF).",
+    )
+    rate: PositiveFloat = Field(
+        1.0, description="How often (per sim second) the scene, static transforms and URDFs are sent again."
+    )
+    tf_rate: PositiveFloat = Field(30.0, description="Transforms of moving links per sim second.")
+
+
 class ZenohSettings(Strict):
     """The run's Zenoh configuration, passed to every session of the run (router, worlds, renderers,
     nodes, bridge, and the command-line tools that join it): TLS, access control, anything Zenoh has."""
@@ -654,6 +669,9 @@ class Scenario(Strict):
         description="Machines of the run by name; worlds and nodes say where they run (`host:`). Without "
         "it, everything runs on this machine. `scenario run FILE` plays the first host (it records and "
         "judges), `scenario run FILE --host NAME` another one, `--local` all of them here.",
+    )
+    foxglove: Foxglove = Field(
+        default_factory=Foxglove, description="The 3D view a recording carries (Foxglove-ready)."
     )
     zenoh: ZenohSettings | None = Field(
         None, description="Zenoh configuration for every session of the run (TLS, access control...)."

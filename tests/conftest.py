@@ -43,13 +43,14 @@ def run_cli(*args: str, timeout: float = 60, cwd: Path | None = None) -> subproc
 
 def read_mcap(path: Path) -> list[tuple[str, str, int, Any]]:
     """(topic, type, log_time, decoded message) for every message, decoded by mcap_ros2 (an independent
-    decoder of the ros2msg/CDR format, not ours)."""
+    decoder of the ros2msg/CDR format, not ours) or, for the Foxglove scene, mcap_protobuf."""
     from mcap.reader import make_reader
+    from mcap_protobuf.decoder import DecoderFactory as ProtobufDecoders
     from mcap_ros2.decoder import DecoderFactory
 
     out = []
     with open(path, "rb") as f:
-        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        reader = make_reader(f, decoder_factories=[DecoderFactory(), ProtobufDecoders()])
         for schema, channel, message, decoded in reader.iter_decoded_messages():
             out.append((channel.topic, schema.name, message.log_time, decoded))
     return out

@@ -26,6 +26,7 @@ from runner.errors import Location, Notices, Problem, ScenarioError, SourceError
 from runner.geometry import rpy_to_quat
 from runner.loader import Document, PathKey
 from runner.plan import (
+    FoxglovePlan,
     NodePlan,
     PluginPlan,
     RecordPlan,
@@ -70,6 +71,9 @@ def compile_plan(
             _check_expr(_full_expr(sc.name, q.topics), doc, ("qos", i, "topics"), q.topics)
         for part in {id(p): p for p in (plan, *plan.parts())}.values():
             part.best_effort = drop
+    fox = FoxglovePlan(**sc.foxglove.model_dump())
+    for part in {id(p): p for p in (plan, *plan.parts())}.values():
+        part.foxglove = fox
     if sc.zenoh is not None:
         plan.zenoh = _zenoh_settings(sc, doc)
         plan.listen = list(sc.zenoh.listen)
@@ -124,6 +128,7 @@ def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices
                 links=model.links,
                 joints=model.joints,
                 plugins=plugins,
+                urdf=model.urdf,
             )
         )
 

@@ -472,7 +472,7 @@ def _mirror_all(topics: _Topics, ros2: Ros2Plan) -> list[BridgePlan]:
     out = []
     for key, (type_name, directions) in sorted(topics.table.items()):
         rel = key[len(topics.run) + 1 :]
-        if _hidden(rel):
+        if _hidden(rel) or not msgs.is_known(type_name):  # (the Foxglove scene is not a ROS 2 type)
             continue
         direction = (
             "BIDIRECTIONAL"

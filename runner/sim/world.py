@@ -212,6 +212,26 @@ class World:
                     self._before.append(_Hook(plugin.before_step, period))
                 if overrides(plugin, "after_step"):
                     self._after.append(_Hook(plugin.after_step, period, forward=plugin.needs_forward))
+        if role == "world" and plan.foxglove.scene:
+            from runner.sim.scene import SceneFeed, link_transforms
+
+            for handle in self.robots:
+                # every link's transform (robot_state_publisher's job), for a robot without a `tf` plugin
+                if not any(pp.type == "tf" for pp in handle.plan.plugins):
+                    ctx = RuntimeContext(
+                        model=self.model,
+                        data=self.data,
+                        robot=handle,
+                        rng=np.random.default_rng([plan.seed, 2**31]),  # (draws nothing)
+                        run=plan.name,
+                        _make_publisher=self._publisher_factory(handle.namespace),
+                        _subscribe=self._subscriber_factory(handle.namespace),
+                    )
+                    tf = link_transforms(handle.plan, plan.foxglove, ctx)
+                    self.plugins.append(tf)
+                    self._after.append(_Hook(tf.after_step, round(1e9 / plan.foxglove.tf_rate)))
+            for fn, period in SceneFeed(self).hooks():
+                self._after.append(_Hook(fn, period))
         if role == "renderer":
             for plugin in self.plugins:
                 plugin.setup()

@@ -35,12 +35,15 @@ def unpack_attachment(data: bytes | None) -> tuple[int, int] | None:
 
 
 def encoding_for(type_name: str) -> zenoh.Encoding:
+    """`application/cdr;<ros type>`; Foxglove's own schemas (`foxglove.SceneUpdate`) are protobuf."""
+    if type_name.startswith("foxglove."):
+        return zenoh.Encoding.APPLICATION_PROTOBUF.with_schema(type_name)
     return zenoh.Encoding.APPLICATION_CDR.with_schema(type_name)
 
 
 def type_from_encoding(encoding: Any) -> str | None:
     text = str(encoding)
-    if text.startswith("application/cdr;"):
+    if text.startswith(("application/cdr;", "application/protobuf;")):
         return text.split(";", 1)[1] or None
     return None
 

@@ -1,0 +1,233 @@
+"""What the world publishes for a 3D view (`foxglove.scene`, on by default): a recording, or a live run,
+opens in Foxglove showing the world and the robots moving, with no set-up.
+
+- `<run>/scene`: `foxglove.SceneUpdate` (protobuf, from foxglove-sdk): one entity per body that has visual
+  geometry, in that body's frame (`world`, `r1/base_link`, `ball`), its geoms as cubes, spheres,
+  cylinders and triangle meshes, with their colours; frame-locked, so they move with the transforms;
+- `<run>/tf_static` and `<run>/tf`: `world` -> each robot's odometry frame (where the robot started, for a
+  robot whose drive publishes odom -> base), and `world` -> each body of the world's own models (moving
+  ones at `tf_rate`);
+- `<run>/<ns>/scene/tf` and `<ns>/scene/tf_static`: every link of a robot relative to its parent (the
+  `tf` plugin's work, run here for a robot whose scenario has no `tf` plugin), from `world` for a robot
+  whose drive does not say where it is;
+- `<run>/<ns>/robot_description`: the robot's URDF (std_msgs/String).
+
+The scene, the static transforms and the URDFs are sent at t = 0 and again every `1/rate` sim seconds:
+the transport has no latching, and a viewer that seeks into a recording needs them near where it lands.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import TYPE_CHECKING, Any
+
+import mujoco
+import numpy as np
+
+from runner import msgs
+from runner.registry import drive_frames
+
+if TYPE_CHECKING:
+    from runner.sim.world import World
+
+TF = "tf2_msgs/msg/TFMessage"
+WORLD = "world"
+VISUAL_GROUPS = 2  # MuJoCo draws geom groups 0-2: world primitives (0) and URDF visuals (1)
+PLANE_SIZE = 20.0  # an infinite MuJoCo plane, drawn this large (m)
+MAX_MESH_FACES = 50_000  # per mesh, beyond that a mesh is drawn by its bounding box
+
+
+def _fox() -> Any:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        import foxglove.messages as fm
+    return fm
+
+
+def _frame(m: mujoco.MjModel, body: int) -> str:
+    return WORLD if body == 0 else (mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, body) or f"body{body}")
+
+
+def scene_update(m: mujoco.MjModel, stamp_ns: int) -> bytes:
+    """Every body's visual geometry as one SceneUpdate, encoded (protobuf)."""
+    fm = _fox()
+    per_body: dict[int, dict[str, list[Any]]] = {}
+    for g in range(m.ngeom):
+        if int(m.geom_group[g]) > VISUAL_GROUPS:
+            continue
+        mat = int(m.geom_matid[g])
+        rgba = m.mat_rgba[mat] if mat >= 0 else m.geom_rgba[g]
+        if rgba[3] <= 0:
+            continue
+        prims = per_body.setdefault(
+            int(m.geom_bodyid[g]), {"cubes": [], "spheres": [], "cylinders": [], "triangles": []}
+        )
+        _add_geom(fm, m, g, rgba, prims)
+    sec, nsec = divmod(stamp_ns, 1_000_000_000)
+    entities = [
+        fm.SceneEntity(
+            timestamp=fm.Timestamp(sec=sec, nsec=nsec),
+            frame_id=_frame(m, body),
+            id=_frame(m, body),
+            frame_locked=True,
+            **{k: v for k, v in prims.items() if v},
+        )
+        for body, prims in sorted(per_body.items())
+    ]
+    return bytes(fm.SceneUpdate(entities=entities).encode())
+
+
+def _pose(fm: Any, pos: Any, quat: Any) -> Any:
+    return fm.Pose(
+        position=fm.Vector3(x=float(pos[0]), y=float(pos[1]), z=float(pos[2])),
+        orientation=fm.Quaternion(x=float(quat[1]), y=float(quat[2]), z=float(quat[3]), w=float(quat[0])),
+    )
+
+
+def _add_geom(fm: Any, m: mujoco.MjModel, g: int, rgba: Any, prims: dict[str, list[Any]]) -> None:
+    t = int(m.geom_type[g])
+    size, pos, quat = m.geom_size[g], m.geom_pos[g], m.geom_quat[g]
+    color = fm.Color(r=float(rgba[0]), g=float(rgba[1]), b=float(rgba[2]), a=float(rgba[3]))
+    pose = _pose(fm, pos, quat)
+    G = mujoco.mjtGeom
+
+    def vec(x: float, y: float, z: float) -> Any:
+        return fm.Vector3(x=float(x), y=float(y), z=float(z))
+
+    if t == G.mjGEOM_BOX:
+        prims["cubes"].append(fm.CubePrimitive(pose=pose, size=vec(*(2 * size)), color=color))
+    elif t == G.mjGEOM_PLANE:
+        sx, sy = (s if s > 0 else PLANE_SIZE / 2 for s in size[:2])
+        prims["cubes"].append(fm.CubePrimitive(pose=pose, size=vec(2 * sx, 2 * sy, 0.001), color=color))
+    elif t in (G.mjGEOM_SPHERE, G.mjGEOM_ELLIPSOID):
+        radii = size if t == G.mjGEOM_ELLIPSOID else (size[0],) * 3
+        prims["spheres"].append(
+            fm.SpherePrimitive(pose=pose, size=vec(*(2 * np.asarray(radii))), color=color)
+        )
+    elif t in (G.mjGEOM_CYLINDER, G.mjGEOM_CAPSULE):
+        r, h = size[0], size[1]
+        prims["cylinders"].append(
+            fm.CylinderPrimitive(
+                pose=pose, size=vec(2 * r, 2 * r, 2 * h), bottom_scale=1.0, top_scale=1.0, color=color
+            )
+        )
+        if t == G.mjGEOM_CAPSULE:  # the two caps
+            rot = np.zeros(9)
+            mujoco.mju_quat2Mat(rot, quat)
+            axis = rot.reshape(3, 3)[:, 2]
+            for sign in (-1.0, 1.0):
+                prims["spheres"].append(
+                    fm.SpherePrimitive(
+                        pose=_pose(fm, pos + sign * h * axis, quat),
+                        size=vec(2 * r, 2 * r, 2 * r),
+                        color=color,
+                    )
+                )
+    elif t == G.mjGEOM_MESH:
+        mesh = int(m.geom_dataid[g])
+        faces = m.mesh_face[m.mesh_faceadr[mesh] : m.mesh_faceadr[mesh] + m.mesh_facenum[mesh]]
+        verts = m.mesh_vert[m.mesh_vertadr[mesh] : m.mesh_vertadr[mesh] + m.mesh_vertnum[mesh]]
+        if len(faces) > MAX_MESH_FACES:
+            lo, hi = verts.min(axis=0), verts.max(axis=0)
+            center = _pose(fm, pos + (lo + hi) / 2, quat)
+            prims["cubes"].append(fm.CubePrimitive(pose=center, size=vec(*(hi - lo)), color=color))
+            return
+        points = [fm.Point3(x=float(x), y=float(y), z=float(z)) for x, y, z in verts[faces.reshape(-1)]]
+        prims["triangles"].append(fm.TriangleListPrimitive(pose=pose, points=points, color=color))
+
+
+def link_transforms(robot: Any, fox: Any, ctx: Any) -> Any:
+    """A `tf` plugin for a robot's links on `scene/tf` and `scene/tf_static` (out of the way of the
+    robot's own `tf` topic, which its drive publishes on)."""
+    from plugins.tf import Tf, TfParams
+
+    driven = any(drive_frames(p.type, p.params) for p in robot.plugins)
+    params = TfParams(
+        rate=fox.tf_rate,
+        topic="scene/tf",
+        static_topic="scene/tf_static",
+        static_period=1.0 / fox.rate,
+        include_root=not driven,
+    )
+    return Tf(params, ctx, "scene_tf")
+
+
+class SceneFeed:
+    """The world's hooks for the 3D view (see the module docstring)."""
+
+    def __init__(self, world: World):
+        plan, m, d = world.plan, world.model, world.data
+        self.world = world
+        rate = plan.foxglove.rate
+        self.period_ns = round(1e9 / rate)
+        self.tf_period_ns = round(1e9 / plan.foxglove.tf_rate)
+        make = world._make_publisher
+        self.scene_out = make(f"{plan.name}/scene", "foxglove.SceneUpdate")
+        self.scene_bytes = scene_update(m, 0)
+        self.descriptions = [
+            (make(f"{plan.name}/{r.namespace}/robot_description", "std_msgs/msg/String"), r.urdf)
+            for r in plan.robots
+            if r.urdf
+        ]
+        robot_bodies = {b for h in world.robots for b in h.body_ids}
+        # world -> odom of each driven robot: where its base started (odometry starts at zero there)
+        self.static: list[tuple[str, str, np.ndarray, np.ndarray]] = []
+        for h in world.robots:
+            frames = next(
+                (f for p in h.plan.plugins if (f := drive_frames(p.type, p.params)) is not None), None
+            )
+            if frames is not None:
+                odom = f"{h.namespace}/{frames[0]}" if h.namespace else frames[0]
+                self.static.append(
+                    (WORLD, odom, np.array(d.xpos[h.root_body]), np.array(d.xquat[h.root_body]))
+                )
+        # the world's own models: moving (a free ball) or not
+        self.moving: list[int] = []
+        for b in range(1, m.nbody):
+            if b in robot_bodies or int(m.body_parentid[b]) != 0:
+                continue
+            if int(m.body_jntnum[b]) > 0:
+                self.moving.append(b)
+            else:
+                self.static.append((WORLD, _frame(m, b), np.array(d.xpos[b]), np.array(d.xquat[b])))
+        self.static_out = make(f"{plan.name}/tf_static", TF) if self.static else None
+        self.tf_out = make(f"{plan.name}/tf", TF) if self.moving else None
+        self._frames = [_frame(m, b) for b in self.moving]
+
+    def hooks(self) -> list[tuple[Any, int]]:
+        out: list[tuple[Any, int]] = [(self.slow, self.period_ns)]
+        if self.tf_out is not None:
+            out.append((self.fast, self.tf_period_ns))
+        return out
+
+    def slow(self, now_ns: int) -> None:
+        world = self.world
+        world.publish_cdr(self.scene_out, self.scene_bytes, now_ns)
+        for out, urdf in self.descriptions:
+            world.publish(out, msgs.T["std_msgs/msg/String"](data=urdf), now_ns)
+        if self.static_out is not None:
+            world.publish(self.static_out, _tf_message(now_ns, self.static), now_ns)
+
+    def fast(self, now_ns: int) -> None:
+        d = self.world.data
+        entries = [(WORLD, f, d.xpos[b], d.xquat[b]) for f, b in zip(self._frames, self.moving, strict=True)]
+        self.world.publish(self.tf_out, _tf_message(now_ns, entries), now_ns)  # type: ignore[arg-type]
+
+
+def _tf_message(now_ns: int, entries: list[tuple[str, str, Any, Any]]) -> Any:
+    T = msgs.T
+    return T[TF](
+        transforms=[
+            T["geometry_msgs/msg/TransformStamped"](
+                header=msgs.header(now_ns, parent),
+                child_frame_id=child,
+                transform=T["geometry_msgs/msg/Transform"](
+                    translation=T["geometry_msgs/msg/Vector3"](x=float(p[0]), y=float(p[1]), z=float(p[2])),
+                    rotation=T["geometry_msgs/msg/Quaternion"](
+                        x=float(q[1]), y=float(q[2]), z=float(q[3]), w=float(q[0])
+                    ),
+                ),
+            )
+            for parent, child, p, q in entries
+        ]
+    )
