@@ -138,18 +138,29 @@ class OdometryWriter:
 
 def tf_message(now_ns: int, parent: str, child: str, pos: Sequence[float], quat_wxyz: Sequence[float]) -> Any:
     """A tf2_msgs/TFMessage holding one transform parent -> child."""
+    return tf_transforms(now_ns, [(parent, child, pos, quat_wxyz)])
+
+
+def tf_transforms(now_ns: int, entries: Sequence[tuple[str, str, Sequence[float], Sequence[float]]]) -> Any:
+    """A tf2_msgs/TFMessage of (parent, child, position, quaternion wxyz) transforms."""
     T = msgs.T
-    tf = T["geometry_msgs/msg/TransformStamped"](
-        header=msgs.header(now_ns, parent),
-        child_frame_id=child,
-        transform=T["geometry_msgs/msg/Transform"](
-            translation=T["geometry_msgs/msg/Vector3"](x=float(pos[0]), y=float(pos[1]), z=float(pos[2])),
-            rotation=T["geometry_msgs/msg/Quaternion"](
-                x=float(quat_wxyz[1]), y=float(quat_wxyz[2]), z=float(quat_wxyz[3]), w=float(quat_wxyz[0])
-            ),
-        ),
+    return T["tf2_msgs/msg/TFMessage"](
+        transforms=[
+            T["geometry_msgs/msg/TransformStamped"](
+                header=msgs.header(now_ns, parent),
+                child_frame_id=child,
+                transform=T["geometry_msgs/msg/Transform"](
+                    translation=T["geometry_msgs/msg/Vector3"](
+                        x=float(pos[0]), y=float(pos[1]), z=float(pos[2])
+                    ),
+                    rotation=T["geometry_msgs/msg/Quaternion"](
+                        x=float(q[1]), y=float(q[2]), z=float(q[3]), w=float(q[0])
+                    ),
+                ),
+            )
+            for parent, child, pos, q in entries
+        ]
     )
-    return T["tf2_msgs/msg/TFMessage"](transforms=[tf])
 
 
 class TransformWriter:

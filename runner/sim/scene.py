@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import numpy as np
 
+from plugins._common import tf_transforms
 from runner import msgs
 from runner.registry import drive_frames
 
@@ -206,28 +207,9 @@ class SceneFeed:
         for out, urdf in self.descriptions:
             world.publish(out, msgs.T["std_msgs/msg/String"](data=urdf), now_ns)
         if self.static_out is not None:
-            world.publish(self.static_out, _tf_message(now_ns, self.static), now_ns)
+            world.publish(self.static_out, tf_transforms(now_ns, self.static), now_ns)
 
     def fast(self, now_ns: int) -> None:
         d = self.world.data
         entries = [(WORLD, f, d.xpos[b], d.xquat[b]) for f, b in zip(self._frames, self.moving, strict=True)]
-        self.world.publish(self.tf_out, _tf_message(now_ns, entries), now_ns)  # type: ignore[arg-type]
-
-
-def _tf_message(now_ns: int, entries: list[tuple[str, str, Any, Any]]) -> Any:
-    T = msgs.T
-    return T[TF](
-        transforms=[
-            T["geometry_msgs/msg/TransformStamped"](
-                header=msgs.header(now_ns, parent),
-                child_frame_id=child,
-                transform=T["geometry_msgs/msg/Transform"](
-                    translation=T["geometry_msgs/msg/Vector3"](x=float(p[0]), y=float(p[1]), z=float(p[2])),
-                    rotation=T["geometry_msgs/msg/Quaternion"](
-                        x=float(q[1]), y=float(q[2]), z=float(q[3]), w=float(q[0])
-                    ),
-                ),
-            )
-            for parent, child, p, q in entries
-        ]
-    )
+        self.world.publish(self.tf_out, tf_transforms(now_ns, entries), now_ns)  # type: ignore[arg-type]
