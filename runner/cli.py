@@ -190,6 +190,16 @@ def run(
         bool,
         typer.Option("--strict", help="Fail (exit 1) if any message published in the run was not recorded."),
     ] = False,
+    foxglove: Annotated[
+        int | None,
+        typer.Option(
+            "--foxglove",
+            metavar="PORT",
+            help="Serve the run live to Foxglove (WebSocket on 127.0.0.1:PORT, e.g. 8765).",
+            min=0,
+            max=65535,
+        ),
+    ] = None,
 ) -> None:
     """Validate, compile and run a scenario; record every message to MCAP; judge its assertions. With a
     `matrix:`, every variant runs and is judged on its own. With `hosts:`, this plays the first (main)
@@ -198,6 +208,7 @@ def run(
     Examples:
       scenario run scenarios/two_robots.yaml
       scenario run scenarios/two_robots.yaml --rate realtime --listen tcp/127.0.0.1:7447
+      scenario run scenarios/two_robots.yaml --rate realtime --foxglove 8765
       scenario run fleet.yaml --host gpu_box
     """
     parsed_rate = _parse_rate(rate)
@@ -228,7 +239,9 @@ def run(
             plan.record.path = str(path.with_name(f"{path.stem}-{i}{path.suffix}"))
         if label and not quiet:
             err.print(f"variant {i}: {label}", markup=False)
-        suite, rc = _run_one(plan, label, quiet, listen, connect, no_judge, None if local else host, strict)
+        suite, rc = _run_one(
+            plan, label, quiet, listen, connect, no_judge, None if local else host, strict, foxglove
+        )
         suites.append(suite)
         code = max(code, rc)
         if rc == 130:
@@ -271,6 +284,7 @@ def _run_one(
     no_judge: bool,
     host: str | None = None,
     strict: bool = False,
+    foxglove: int | None = None,
 ) -> tuple[Any, int]:
     from runner.checks.report import Suite, judge_for
     from runner.launch import run_plan
@@ -315,7 +329,13 @@ def _run_one(
     judge = None if no_judge or member else judge_for(plan)  # the main host judges
     try:
         result = run_plan(
-            plan, listen=endpoints, connect=connect or (), on_progress=on_progress, judge=judge, host=host
+            plan,
+            listen=endpoints,
+            connect=connect or (),
+            on_progress=on_progress,
+            judge=judge,
+            host=host,
+            foxglove_port=foxglove,
         )
     except RunError as e:
         raise _fail(e) from None

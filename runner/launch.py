@@ -181,6 +181,7 @@ def run_plan(
     on_progress: Callable[[int, float], None] | None = None,
     judge: Any = None,
     host: str | None = None,
+    foxglove_port: int | None = None,
 ) -> RunResult:
     """Run a plan (one world, or `plan.worlds`, each a process of its own behind one router and one
     recorder); with a `judge` (runner.checks.judge.Judge), feed it every message it asks for, live, and
@@ -206,6 +207,16 @@ def run_plan(
     except zenoh.ZError as e:
         raise RunError(f"cannot open the Zenoh network on {', '.join(listen)}: {e}") from None
 
+    live = None
+    if foxglove_port is not None:  # `--foxglove PORT`: the run, live, to Foxglove
+        from runner.live import LiveView
+
+        try:
+            live = LiveView(session, plan.name, foxglove_port)
+        except RunError:
+            session.close()
+            raise
+        print(f"Foxglove: connect to ws://127.0.0.1:{live.port}", file=sys.stderr, flush=True)
     announced = announce(plan.name, listen, plan.zenoh)  # `scenario echo/pub/topics` find the local run by it
     parts = [
         _WorldPart(
@@ -397,6 +408,8 @@ def run_plan(
                 s.undeclare()
         if recorder is not None:
             recorder.close()
+        if live is not None:
+            live.close()
         session.close()
         withdraw(announced)
 

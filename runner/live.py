@@ -1,0 +1,74 @@
+"""`scenario run --foxglove PORT`: the run, live, over Foxglove's WebSocket protocol (foxglove-sdk's server).
+
+Every key of the run becomes a channel the first time it carries a message: ROS 2 messages as `cdr` with
+their `ros2msg` schema, the scene as `protobuf`; each message is logged with its sim time. Open Foxglove,
+connect to `ws://127.0.0.1:PORT` and the 3D view, plots and images follow the run as it goes. The server
+listens on loopback unless a host is given.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import threading
+import warnings
+from typing import Any
+
+import zenoh
+
+from runner import msgs
+from runner.errors import RunError
+from runner.transport import type_from_encoding, unpack_attachment
+
+
+class LiveView:
+    def __init__(self, session: zenoh.Session, run: str, port: int, host: str = "127.0.0.1"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)
+            import foxglove
+        self._fox = foxglove
+        self.context = foxglove.Context()
+        try:
+            self.server = foxglove.start_server(
+                name=f"scenario {run}", host=host, port=port, context=self.context
+            )
+        except Exception as e:  # the port is taken, say
+            raise RunError(f"cannot serve Foxglove on {host}:{port}: {e}") from None
+        self.port = self.server.port
+        self._channels: dict[str, Any] = {}
+        self._lock = threading.Lock()
+        self._latest = 0
+        self._sub = session.declare_subscriber(f"{run}/**", self._on_sample)
+
+    def _channel(self, key: str, type_name: str) -> Any:
+        with self._lock:
+            ch = self._channels.get(key)
+            if ch is None:
+                fox = self._fox
+                if type_name.startswith("foxglove."):
+                    from runner.record import foxglove_schema
+
+                    s = foxglove_schema(type_name)
+                    schema, encoding = fox.Schema(name=s.name, encoding="protobuf", data=s.data), "protobuf"
+                else:
+                    data = msgs.msgdef(type_name).encode()
+                    schema, encoding = fox.Schema(name=type_name, encoding="ros2msg", data=data), "cdr"
+                ch = fox.Channel(key, schema=schema, message_encoding=encoding, context=self.context)
+                self._channels[key] = ch
+            return ch
+
+    def _on_sample(self, sample: zenoh.Sample) -> None:
+        type_name = type_from_encoding(sample.encoding)
+        if type_name is None or not (type_name.startswith("foxglove.") or msgs.is_known(type_name)):
+            return
+        att = unpack_attachment(sample.attachment.to_bytes()) if sample.attachment is not None else None
+        if att is not None:
+            self._latest = max(self._latest, att[1])
+        stamp = att[1] if att is not None else self._latest
+        with contextlib.suppress(Exception):  # a viewer's trouble never stops the run
+            self._channel(str(sample.key_expr), type_name).log(sample.payload.to_bytes(), log_time=stamp)
+
+    def close(self) -> None:
+        with contextlib.suppress(Exception):
+            self._sub.undeclare()
+        with contextlib.suppress(Exception):
+            self.server.stop()
