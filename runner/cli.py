@@ -10,6 +10,7 @@ import json
 import math
 import signal
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -594,6 +595,64 @@ def info(mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")]) -> 
             f"every complete chunk read. `scenario recover {mcap}` writes a complete copy.",
             markup=False,
         )
+
+
+@app.command()
+def render(
+    mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")],
+    output: Annotated[Path, typer.Option("--output", "-o", help="The video or picture: .mp4, .gif or .png.")],
+    camera: Annotated[
+        str, typer.Option(help="overview (the whole scene), chase:ROBOT (following it), or a model camera.")
+    ] = "overview",
+    fps: Annotated[float, typer.Option(help="Frames per sim second.", min=1, max=120)] = 15.0,
+    size: Annotated[str, typer.Option(help="WIDTHxHEIGHT in pixels.")] = "640x480",
+    world: Annotated[str | None, typer.Option(help="With several worlds: which one.")] = None,
+) -> None:
+    """Render a recorded run again (MuJoCo, offscreen, CPU where there is no GPU): the robots moving, their
+    paths drawn as they go. A .png is the last frame.
+
+    Examples:
+      scenario render runs/two_robots.mcap -o two_robots.mp4
+      scenario render runs/two_robots.mcap -o r1.gif --camera chase:r1 --size 480x360
+    """
+    from runner import replay
+
+    try:
+        w, h = (int(v) for v in size.lower().split("x"))
+    except ValueError:
+        raise _fail(RunError(f"--size {size!r}: expected WIDTHxHEIGHT, e.g. 640x480")) from None
+    if not mcap.is_file():
+        raise _fail(RunError(f"{mcap}: file not found"))
+    try:
+        rec = replay.load(mcap, world)
+        with _progress_bar("rendering") as bar:
+            n = replay.write(rec, output, camera=camera, width=w, height=h, fps=fps, progress=bar)
+    except RunError as e:
+        raise _fail(e) from None
+    out.print(f"{output}: {n} frames, {rec.times[-1] / 1e9:.1f} s sim, camera {camera}", markup=False)
+
+
+class _progress_bar:
+    """A rich progress bar on stderr, called with (done, total)."""
+
+    def __init__(self, what: str):
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+
+        self.progress = Progress(
+            TextColumn(what), BarColumn(), MofNCompleteColumn(), console=err, transient=True
+        )
+        self.task = self.progress.add_task(what, total=None)
+
+    def __enter__(self) -> Callable[[int, int], None]:
+        self.progress.start()
+
+        def update(done: int, total: int) -> None:
+            self.progress.update(self.task, completed=done, total=total)
+
+        return update
+
+    def __exit__(self, *_exc: object) -> None:
+        self.progress.stop()
 
 
 @app.command()

@@ -10,7 +10,9 @@ opens in Foxglove showing the world and the robots moving, with no set-up.
 - `<run>/<ns>/scene/tf` and `<ns>/scene/tf_static`: every link of a robot relative to its parent (the
   `tf` plugin's work, run here for a robot whose scenario has no `tf` plugin), from `world` for a robot
   whose drive does not say where it is;
-- `<run>/<ns>/robot_description`: the robot's URDF (std_msgs/String).
+- `<run>/<ns>/robot_description`: the robot's URDF (std_msgs/String);
+- `<run>/_model` (once, the compiled MJCF) and `<run>/_state` (qpos and mocap poses, at `tf_rate`): what
+  `scenario render` replays a recording from.
 
 The scene, the static transforms and the URDFs are sent at t = 0 and again every `1/rate` sim seconds:
 the transport has no latching, and a viewer that seeks into a recording needs them near where it lands.
@@ -32,6 +34,7 @@ if TYPE_CHECKING:
     from runner.sim.world import World
 
 TF = "tf2_msgs/msg/TFMessage"
+STATE = "std_msgs/msg/Float64MultiArray"
 WORLD = "world"
 VISUAL_GROUPS = 2  # MuJoCo draws geom groups 0-2: world primitives (0) and URDF visuals (1)
 PLANE_SIZE = 20.0  # an infinite MuJoCo plane, drawn this large (m)
@@ -191,18 +194,28 @@ class SceneFeed:
                 self.moving.append(b)
             else:
                 self.static.append((WORLD, _frame(m, b), np.array(d.xpos[b]), np.array(d.xquat[b])))
+        # for `scenario render`: the model (MJCF) once, and the state (qpos, mocap poses) at tf_rate
+        self.model_out = make(f"{plan.name}/_model", "std_msgs/msg/String")
+        self.mjcf = plan.mjcf
+        self.state_out = make(f"{plan.name}/_state", STATE)
         self.static_out = make(f"{plan.name}/tf_static", TF) if self.static else None
         self.tf_out = make(f"{plan.name}/tf", TF) if self.moving else None
         self._frames = [_frame(m, b) for b in self.moving]
+        T = msgs.T
+        self._layout = T["std_msgs/msg/MultiArrayLayout"](
+            dim=[
+                T["std_msgs/msg/MultiArrayDimension"](label="qpos+mocap", size=m.nq + 7 * m.nmocap, stride=1)
+            ],
+            data_offset=0,
+        )
 
     def hooks(self) -> list[tuple[Any, int]]:
-        out: list[tuple[Any, int]] = [(self.slow, self.period_ns)]
-        if self.tf_out is not None:
-            out.append((self.fast, self.tf_period_ns))
-        return out
+        return [(self.slow, self.period_ns), (self.fast, self.tf_period_ns)]
 
     def slow(self, now_ns: int) -> None:
         world = self.world
+        if now_ns == 0:
+            world.publish(self.model_out, msgs.T["std_msgs/msg/String"](data=self.mjcf), now_ns)
         world.publish_cdr(self.scene_out, self.scene_bytes, now_ns)
         for out, urdf in self.descriptions:
             world.publish(out, msgs.T["std_msgs/msg/String"](data=urdf), now_ns)
@@ -211,5 +224,9 @@ class SceneFeed:
 
     def fast(self, now_ns: int) -> None:
         d = self.world.data
+        state = np.concatenate((d.qpos, d.mocap_pos.reshape(-1), d.mocap_quat.reshape(-1)))
+        self.world.publish(self.state_out, msgs.T[STATE](layout=self._layout, data=state), now_ns)
+        if self.tf_out is None:
+            return
         entries = [(WORLD, f, d.xpos[b], d.xquat[b]) for f, b in zip(self._frames, self.moving, strict=True)]
         self.world.publish(self.tf_out, tf_transforms(now_ns, entries), now_ns)  # type: ignore[arg-type]

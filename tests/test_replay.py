@@ -1,0 +1,81 @@
+"""`scenario render`: a recorded run rendered again from its recorded states, on the CPU."""
+
+from __future__ import annotations
+
+import itertools
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tests.conftest import SCENARIOS, run_cli, scenario_cmd
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    mcap = tmp_path_factory.mktemp("replay") / "demo.mcap"
+    r = subprocess.run(
+        scenario_cmd("run", str(SCENARIOS / "two_robots.yaml"), "--duration", "6", "--no-judge", "-q",
+                     "--record", str(mcap)),
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    return mcap
+
+
+def _robot_pixels(img: np.ndarray) -> tuple[int, int]:
+    """Pixels of r1's red (0.85, 0.2, 0.2) and r2's blue (0.2, 0.35, 0.9), under any lighting."""
+    r, g, b = (img[..., i].astype(int) for i in range(3))
+    red = (r > 120) & (r > 2 * g) & (r > 2 * b)
+    blue = (b > 120) & (b > 1.6 * r) & (b > 1.3 * g)
+    return int(red.sum()), int(blue.sum())
+
+
+@pytest.mark.timeout(120)
+def test_the_video_moves_and_shows_both_robots(recording: Path, tmp_path: Path) -> None:
+    import imageio_ffmpeg
+
+    video = tmp_path / "run.mp4"
+    r = run_cli("render", str(recording), "-o", str(video), "--size", "480x360", "--fps", "5", timeout=100)
+    assert r.returncode == 0, r.stderr
+    assert "31 frames, 6.0 s sim" in r.stdout
+    reader = imageio_ffmpeg.read_frames(str(video))
+    meta = next(reader)
+    assert tuple(meta["size"]) == (480, 360)
+    frames = [np.frombuffer(f, np.uint8).reshape(360, 480, 3) for f in reader]
+    assert len(frames) == 31
+    first, last = frames[0], frames[-1]
+    moved = (np.abs(first.astype(int) - last.astype(int)).max(axis=2) > 30).sum()
+    assert moved > 100, moved  # the robots moved, their paths grew
+    changed = [np.abs(a.astype(int) - b.astype(int)).max() > 40 for a, b in itertools.pairwise(frames)]
+    assert sum(changed) > len(changed) // 2  # motion all along, not one jump
+    red, blue = _robot_pixels(first)  # at t = 0 no path is drawn yet: these are the robots themselves
+    assert red > 25 and blue > 25, (red, blue)
+    red_end, blue_end = _robot_pixels(last)
+    assert red_end > red and blue_end > blue  # and later their paths too
+
+
+@pytest.mark.timeout(120)
+def test_a_picture_a_gif_and_a_chase_camera(recording: Path, tmp_path: Path) -> None:
+    from PIL import Image
+
+    png = tmp_path / "end.png"
+    assert run_cli("render", str(recording), "-o", str(png), timeout=60).returncode == 0
+    with Image.open(png) as img:
+        assert img.size == (640, 480)
+        assert min(_robot_pixels(np.asarray(img.convert("RGB")))) > 30
+    gif = tmp_path / "chase.gif"
+    r = run_cli(
+        "render", str(recording), "-o", str(gif), "--camera", "chase:r2", "--fps", "2", "--size", "160x120"
+    )
+    assert r.returncode == 0, r.stderr
+    with Image.open(gif) as img:
+        assert img.n_frames == 13 and img.size == (160, 120)
+        img.seek(12)
+        _red, blue = _robot_pixels(np.asarray(img.convert("RGB")))
+        assert blue > 50  # the camera follows r2: it fills the middle of the frame
+    bad = run_cli("render", str(recording), "-o", str(tmp_path / "x.avi"))
+    assert bad.returncode == 1 and "write .mp4, .gif or .png" in bad.stderr
+    nobody = run_cli("render", str(recording), "-o", str(gif), "--camera", "chase:r9")
+    assert nobody.returncode == 1 and "no robot 'r9'" in nobody.stderr and "r1, r2" in nobody.stderr
