@@ -500,6 +500,18 @@ def test_cmd(
 
     with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
         suites = list(pool.map(run_one, tasks))
+    reports: dict[str, str] = {}
+    if not no_record:  # one page per scenario, beside its recording
+        from runner.checks.html import write_report
+
+        for s in suites:
+            if s.mcap and Path(s.mcap).is_file():
+                page = Path(s.mcap).with_suffix(".html")
+                try:
+                    write_report(Path(s.mcap), page)
+                    reports[s.name] = str(page)
+                except Exception as e:  # a report is a convenience: never a failed test run
+                    err.print(f"{s.name}: no report: {e}", markup=False)
     table = Table(
         "scenario",
         "assertions",
@@ -507,14 +519,26 @@ def test_cmd(
         "failed",
         "result",
         "time (s)",
+        *(["report"] if reports else []),
         title="Scenarios",
         title_justify="left",
     )
     for s in suites:
         failed = sum(1 for r in s.results if not r.passed)
         verdict = "[green]pass[/]" if s.passed else ("[bold red]ERROR[/]" if s.error else "[bold red]FAIL[/]")
+        link = (
+            [f"[link=file://{Path(reports[s.name]).resolve()}]{reports[s.name]}[/link]"]
+            if s.name in reports
+            else []
+        )
         table.add_row(
-            s.name, str(len(s.results)), str(len(s.results) - failed), str(failed), verdict, f"{s.time_s:.1f}"
+            s.name,
+            str(len(s.results)),
+            str(len(s.results) - failed),
+            str(failed),
+            verdict,
+            f"{s.time_s:.1f}",
+            *(link or ([""] if reports else [])),
         )
     out.print(table)
     for s in suites:
@@ -595,6 +619,42 @@ def info(mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")]) -> 
             f"every complete chunk read. `scenario recover {mcap}` writes a complete copy.",
             markup=False,
         )
+
+
+@app.command()
+def report(
+    mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")],
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="The page (default: NAME.html).")
+    ] = None,
+    scenario: Annotated[
+        Path | None,
+        typer.Option("--scenario", "-s", help="The scenario (default: the one the recording carries)."),
+    ] = None,
+) -> None:
+    """One self-contained HTML page about a run: verdict, trajectory plot, assertions and the signals they
+    check, camera frames, topics. The scenario is read from the recording itself.
+
+    Example: scenario report runs/two_robots.mcap -o two_robots.html
+    """
+    from runner.checks.html import write_report
+
+    if not mcap.is_file():
+        raise _fail(RunError(f"{mcap}: file not found"))
+    plan = None
+    try:
+        if scenario is not None:
+            plans = _load_variants(scenario, str(mcap), None)
+            plan = plans[0][1]
+        target = output or mcap.with_suffix(".html")
+        info = write_report(mcap, target, plan)
+    except (RunError, ScenarioError) as e:
+        raise _fail(e) from None
+    out.print(
+        f"{target}: {info['passed']}/{info['assertions']} assertions pass, {info['charts']} signal plot(s), "
+        f"{info['frames']} camera frame(s)",
+        markup=False,
+    )
 
 
 @app.command()

@@ -24,6 +24,7 @@ from typing import Any
 
 import zenoh
 
+from runner import msgs
 from runner.errors import RunError
 from runner.graph import GraphTokens
 from runner.nodes import NodeError, Nodes, OutputTail
@@ -243,6 +244,11 @@ def run_plan(
             # the recorder's own FIFO subscriber, drained by its thread; undeclared (after recording what
             # it still queued) by recorder.close()
             recorder.subscribe(session, f"{plan.name}/**")
+            # the scenario as compiled, so the recording can be judged and reported on by itself
+            text = msgs.T["std_msgs/msg/String"](data=plan.model_dump_json())
+            recorder.write(
+                f"{plan.name}/_plan", "std_msgs/msg/String", msgs.encode(text, "std_msgs/msg/String"), (0, 0)
+            )
         else:
 
             def on_clock(sample: zenoh.Sample) -> None:

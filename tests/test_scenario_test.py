@@ -54,3 +54,13 @@ def test_pytest_collects_scenarios_with_assertions():
     )
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "9 passed" in proc.stdout
+
+
+@pytest.mark.timeout(120)
+def test_scenario_test_writes_and_links_a_report_per_scenario(tmp_path: Path):
+    out = tmp_path / "runs"
+    proc = run_cli("test", str(SCENARIOS / "two_robots.yaml"), "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    page = out / "two_robots.html"
+    assert page.is_file() and "9 of 9 assertions pass" in page.read_text()
+    assert "two_robots.html" in proc.stdout  # the table's report column

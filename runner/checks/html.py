@@ -1,0 +1,231 @@
+"""`scenario report RUN.mcap -o report.html`: one self-contained HTML page about a recorded run.
+
+What it shows: the scenario (name, description, duration), the run's topics with their counts and rates,
+the assertions judged again from the recording (the same judge as the live run) with a plot of each
+robot's speed and each checked topic's rate over sim time, the trajectory plot, and a few camera frames.
+Pictures are inline (PNG as data URIs, plots as SVG), so the file can be mailed or attached to CI as is.
+The scenario comes from the recording itself (`<run>/_plan`, written at the start of every run).
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import math
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from runner import msgs
+from runner.errors import RunError
+
+COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"]
+STYLE = """
+body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;margin:2em auto;max-width:1000px;
+color:#222;padding:0 1em}h1{margin-bottom:.1em}.sub{color:#666;margin-top:0}table{border-collapse:collapse;
+margin:.5em 0 1.5em}td,th{border-bottom:1px solid #ddd;padding:.25em .8em;text-align:left;font-size:.92em}
+th{background:#f4f4f6}.pass{color:#1a7f37;font-weight:600}.fail{color:#cf222e;font-weight:600}
+.badge{display:inline-block;padding:.2em .7em;border-radius:1em;color:#fff;font-weight:600}
+.ok{background:#1a7f37}.ko{background:#cf222e}figure{margin:0 0 1.5em}figcaption{color:#555;font-size:.9em}
+.frames img{max-width:32%;margin-right:1%}svg{background:#fcfcfd;border:1px solid #e4e4e8}
+"""
+
+
+def load_plan(mcap: Path) -> Any:
+    from mcap.reader import make_reader
+
+    from runner.plan import RunPlan
+
+    with open(mcap, "rb") as f:
+        for _s, channel, message in make_reader(f).iter_messages():
+            if channel.topic.endswith("/_plan"):
+                text = msgs.decode(message.data, "std_msgs/msg/String").data
+                return RunPlan.model_validate_json(text)
+    raise RunError(f"{mcap}: the recording does not carry its scenario; give it with --scenario FILE")
+
+
+def _series(mcap: Path, keys: set[str]) -> dict[str, list[tuple[int, Any]]]:
+    from mcap.reader import make_reader
+
+    out: dict[str, list[tuple[int, Any]]] = {k: [] for k in keys}
+    with open(mcap, "rb") as f:
+        for schema, channel, message in make_reader(f).iter_messages(topics=sorted(keys)):
+            out[channel.topic].append((message.log_time, (schema.name if schema else "", message.data)))
+    return out
+
+
+def svg_chart(
+    title: str, unit: str, lines: list[tuple[str, list[float], list[float]]], bound: float | None = None
+) -> str:
+    """A small line chart: (label, sim times s, values) per line; an optional horizontal bound."""
+    w, h, pad = 640, 200, 40
+    xs = [x for _l, t, _v in lines for x in t] or [0.0, 1.0]
+    ys = [y for _l, _t, v in lines for y in v if math.isfinite(y)] + ([bound] if bound is not None else [])
+    ys = ys or [0.0, 1.0]
+    x0, x1 = min(xs), max(max(xs), min(xs) + 1e-9)
+    y0, y1 = min(0.0, min(ys)), max(ys) * 1.1 or 1.0
+
+    def px(x: float, y: float) -> str:
+        u = pad + (x - x0) / (x1 - x0) * (w - 2 * pad)
+        v = h - pad + (y0 - y) / (y1 - y0) * (h - 2 * pad)
+        return f"{u:.1f},{v:.1f}"
+
+    parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" role="img">']
+    parts.append(f'<text x="{pad}" y="16" font-size="13" font-weight="600">{html.escape(title)}</text>')
+    parts.append(f'<line x1="{pad}" y1="{h - pad}" x2="{w - pad}" y2="{h - pad}" stroke="#999"/>')
+    parts.append(f'<line x1="{pad}" y1="{pad}" x2="{pad}" y2="{h - pad}" stroke="#999"/>')
+    parts.append(f'<text x="{pad - 4}" y="{pad + 4}" font-size="10" text-anchor="end">{y1:.3g}</text>')
+    parts.append(f'<text x="{pad - 4}" y="{h - pad}" font-size="10" text-anchor="end">{y0:.3g}</text>')
+    parts.append(f'<text x="{w - pad}" y="{h - pad + 14}" font-size="10" text-anchor="end">{x1:.3g} s</text>')
+    parts.append(f'<text x="{pad}" y="{h - 8}" font-size="10">{html.escape(unit)}</text>')
+    if bound is not None:
+        a, b = px(x0, bound), px(x1, bound)
+        parts.append(f'<polyline points="{a} {b}" stroke="#cf222e" stroke-dasharray="5,4" fill="none"/>')
+    for i, (label, t, v) in enumerate(lines):
+        colour = COLOURS[i % len(COLOURS)]
+        pts = " ".join(px(a, b) for a, b in zip(t, v, strict=True) if math.isfinite(b))
+        parts.append(f'<polyline points="{pts}" stroke="{colour}" stroke-width="1.8" fill="none"/>')
+        parts.append(
+            f'<text x="{w - pad - 4}" y="{pad + 14 * (i + 1)}" font-size="11" text-anchor="end" '
+            f'fill="{colour}">{html.escape(label)}</text>'
+        )
+    parts.append("</svg>")
+    return "".join(parts)
+
+
+def _png_uri(path_or_rgb: Path | np.ndarray) -> str:
+    if isinstance(path_or_rgb, Path):
+        data = path_or_rgb.read_bytes()
+    else:
+        from PIL import Image
+
+        buf = io.BytesIO()
+        Image.fromarray(path_or_rgb).save(buf, format="PNG")
+        data = buf.getvalue()
+    return "data:image/png;base64," + base64.b64encode(data).decode()
+
+
+def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
+    from runner.checks.judge import truth_key
+    from runner.checks.plot import trajectory_plot
+    from runner.checks.report import judge_recording
+    from runner.record import read_summary
+
+    plan = plan or load_plan(mcap)
+    summary = read_summary(mcap)
+    results = judge_recording(plan, mcap)[0] if plan.assertions else []
+    run = plan.name
+    # signals: each robot's speed (ground truth), each checked topic's rate per sim second
+    truth = {r.name: truth_key(p.name, r.namespace) for p in plan.parts() for r in p.robots}
+    rate_topics = sorted({a["topic"] for a in plan.assertions if a.get("type") == "topic_rate"})
+    rate_keys = {f"{run}/{t.strip('/')}" for t in rate_topics}
+    images = {t["topic"] for t in summary["topics"] if t["type"] == "sensor_msgs/msg/Image"}
+    series = _series(mcap, set(truth.values()) | rate_keys | set(sorted(images)[:1]))
+    charts = []
+    speed_lines = []
+    for name, key in truth.items():
+        t, v = [], []
+        for stamp, (_s, data) in series.get(key, []):
+            odom = msgs.decode(data, "nav_msgs/msg/Odometry")
+            lin = odom.twist.twist.linear
+            t.append(stamp / 1e9)
+            v.append(math.hypot(lin.x, lin.y))
+        if t:
+            speed_lines.append((name, t, v))
+    if speed_lines:
+        bounds = [a.get("max") for a in plan.assertions if a.get("type") == "max_speed"]
+        charts.append(
+            svg_chart("Speed of each robot (ground truth)", "m/s", speed_lines, bounds[0] if bounds else None)
+        )
+    for topic, key in zip(rate_topics, sorted(rate_keys), strict=True):
+        stamps = [s / 1e9 for s, _ in series.get(key, [])]
+        if stamps:
+            whole = max(1, int(stamps[-1]))  # whole sim seconds (a last, partial second would dip)
+            counts = np.histogram(stamps, bins=np.arange(0, whole + 1))[0]
+            secs = np.arange(0, whole) + 0.5
+            charts.append(
+                svg_chart(
+                    f"Rate of {topic}",
+                    "messages per sim second",
+                    [(topic, list(secs), list(counts.astype(float)))],
+                )
+            )
+    frames = []
+    for key in sorted(images)[:1]:
+        picks = series.get(key, [])
+        for _stamp, (_s, data) in [
+            picks[i] for i in np.linspace(0, len(picks) - 1, min(3, len(picks))).astype(int)
+        ]:
+            img = msgs.decode(data, "sensor_msgs/msg/Image")
+            if img.encoding in ("rgb8", "bgr8") and img.height and img.width:
+                arr = np.frombuffer(bytes(img.data), np.uint8).reshape(img.height, img.width, 3)
+                frames.append(_png_uri(arr if img.encoding == "rgb8" else arr[..., ::-1]))
+    with tempfile.TemporaryDirectory() as tmp:
+        plot = trajectory_plot(plan, mcap, results, Path(tmp) / "trajectory.png")
+        trajectory = _png_uri(plot) if plot is not None and plot.exists() else None
+    passed = sum(r.passed for r in results)
+    span = (summary["end_ns"] - summary["start_ns"]) / 1e9
+    h = html.escape
+    rows = "".join(
+        f"<tr><td>{h(t['topic'])}</td><td>{h(t['type'])}</td><td>{t['count']}</td>"
+        f"<td>{(t['count'] - 1) / span:.1f}</td></tr>"
+        if span > 0 and t["count"] > 1
+        else f"<tr><td>{h(t['topic'])}</td><td>{h(t['type'])}</td><td>{t['count']}</td><td>-</td></tr>"
+        for t in summary["topics"]
+        if "/_" not in t["topic"]
+    )
+    results_rows = "".join(
+        f'<tr><td>{h(r.name)}</td><td>{h(r.type)}</td><td class="{"pass" if r.passed else "fail"}">'
+        f"{'pass' if r.passed else 'FAIL'}</td><td>{'' if r.t is None else f'{r.t:.2f}'}</td>"
+        f"<td>{h(str(r.value or ''))}</td><td>{h(str(r.bound or ''))}</td></tr>"
+        for r in results
+    )
+    verdict = (
+        f'<span class="badge {"ok" if passed == len(results) else "ko"}">'
+        f"{passed} of {len(results)} assertions pass</span>"
+        if results
+        else '<span class="badge ok">no assertions</span>'
+    )
+    page = [
+        f'<!doctype html><html><head><meta charset="utf-8"><title>{h(run)}: run report</title>',
+        f"<style>{STYLE}</style></head><body>",
+        f'<h1>{h(run)}</h1><p class="sub">{h(plan.model_dump().get("scenario_file") or "")}</p>',
+        f"<p>{verdict} &nbsp; {span:.2f} s sim, {summary['messages']} messages recorded"
+        + (" (the recording was cut)" if summary.get("cut") else "")
+        + "</p>",
+    ]
+    if trajectory:
+        page.append(
+            f'<figure><img alt="trajectory plot" src="{trajectory}" width="640">'
+            "<figcaption>Paths from above, with the assertions' regions and goals</figcaption></figure>"
+        )
+    if results:
+        page.append(
+            "<h2>Assertions</h2><table><tr><th>assertion</th><th>type</th><th>result</th>"
+            f"<th>at (sim s)</th><th>value</th><th>bound</th></tr>{results_rows}</table>"
+        )
+    if charts:
+        page.append("<h2>Signals</h2>" + "".join(f"<figure>{c}</figure>" for c in charts))
+    if frames:
+        page.append(
+            '<h2>Camera</h2><div class="frames">'
+            + "".join(f'<img alt="camera frame" src="{f}">' for f in frames)
+            + "</div>"
+        )
+    page.append(
+        "<h2>Topics</h2><table><tr><th>topic</th><th>type</th><th>messages</th><th>sim Hz</th></tr>"
+        f"{rows}</table>"
+    )
+    page.append("</body></html>")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text("\n".join(page), encoding="utf-8")
+    return {
+        "assertions": len(results),
+        "passed": passed,
+        "charts": len(charts),
+        "frames": len(frames),
+        "trajectory": trajectory is not None,
+    }
