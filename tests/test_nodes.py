@@ -115,6 +115,8 @@ def test_lockstep_runs_with_a_node_are_identical(write_scenario, tmp_path: Path)
         runs.append(_physics(mcap))
     assert set(runs[0]) == set(runs[1])
     for topic in runs[0]:
+        if topic.endswith("/_plan"):
+            continue  # the compiled scenario names its recording's path, which differs by design
         assert runs[0][topic] == runs[1][topic], topic
     assert len(runs[0]["with_node/r1/odom"]) == 151
 

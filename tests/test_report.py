@@ -29,12 +29,12 @@ def test_the_report_shows_the_verdict_the_plots_and_the_topics(tmp_path: Path) -
     # the scenario comes from the recording itself: no --scenario
     r = run_cli("report", str(mcap), "-o", str(page), timeout=60)
     assert r.returncode == 0, r.stderr
-    assert "9/9 assertions pass, 3 signal plot(s)" in r.stdout
+    assert "9/9 assertions pass, 5 signal plot(s)" in r.stdout  # speed, distance, tilt, 2 topic rates
     text = page.read_text()
     assert "9 of 9 assertions pass" in text
     for name in ("r1_reaches_its_corner", "lidar_at_10_hz", "r2_under_half_a_metre_per_second"):
         assert f"<td>{name}</td>" in text
-    assert text.count("<svg") == 3 and 'src="data:image/png;base64,' in text
+    assert text.count("<svg") == 5 and 'src="data:image/png;base64,' in text
     assert "two_robots/r1/scan" in text and "_truth" not in text  # topics, helpers hidden
     assert not re.search(r'(src|href)="(https?:)?//', text)  # self-contained: nothing fetched
 

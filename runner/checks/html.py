@@ -125,21 +125,35 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
     images = {t["topic"] for t in summary["topics"] if t["type"] == "sensor_msgs/msg/Image"}
     series = _series(mcap, set(truth.values()) | rate_keys | set(sorted(images)[:1]))
     charts = []
-    speed_lines = []
+    speed, travelled, tilt = [], [], []
     for name, key in truth.items():
-        t, v = [], []
+        t, v, dist, tilts = [], [], [], []
+        last = None
         for stamp, (_s, data) in series.get(key, []):
             odom = msgs.decode(data, "nav_msgs/msg/Odometry")
-            lin = odom.twist.twist.linear
+            lin, p, q = odom.twist.twist.linear, odom.pose.pose.position, odom.pose.pose.orientation
             t.append(stamp / 1e9)
             v.append(math.hypot(lin.x, lin.y))
+            here = (p.x, p.y)
+            dist.append((dist[-1] if dist else 0.0) + (math.dist(here, last) if last else 0.0))
+            last = here
+            # the angle between the body's z axis and the world's
+            tilts.append(math.acos(max(-1.0, min(1.0, 1 - 2 * (q.x * q.x + q.y * q.y)))))
         if t:
-            speed_lines.append((name, t, v))
-    if speed_lines:
-        bounds = [a.get("max") for a in plan.assertions if a.get("type") == "max_speed"]
-        charts.append(
-            svg_chart("Speed of each robot (ground truth)", "m/s", speed_lines, bounds[0] if bounds else None)
-        )
+            speed.append((name, t, v))
+            travelled.append((name, t, dist))
+            tilt.append((name, t, tilts))
+    kinds = {a.get("type") for a in plan.assertions}
+
+    def bound(kind: str) -> float | None:
+        return next((a.get("max") for a in plan.assertions if a.get("type") == kind and a.get("max")), None)
+
+    if speed:
+        charts.append(svg_chart("Speed of each robot (ground truth)", "m/s", speed, bound("max_speed")))
+    if travelled and "distance_traveled" in kinds:
+        charts.append(svg_chart("Distance travelled", "m", travelled, bound("distance_traveled")))
+    if tilt and "max_tilt" in kinds:
+        charts.append(svg_chart("Tilt from upright", "rad", tilt, bound("max_tilt")))
     for topic, key in zip(rate_topics, sorted(rate_keys), strict=True):
         stamps = [s / 1e9 for s, _ in series.get(key, [])]
         if stamps:
