@@ -33,7 +33,7 @@ import zenoh
 
 from runner import msgs, ros2
 from runner.graph import GraphTokens
-from runner.plan import BridgePlan, Ros2Plan
+from runner.plan import BridgePlan, Ros2Plan, hidden_topic
 from runner.transport import encoding_for, make_config, meta_key, pack_attachment, unpack_attachment
 
 REMOTE = zenoh.Locality.REMOTE
@@ -129,8 +129,9 @@ class Bridge:
             graph.add_token(str(sample.key_expr))
             for e in graph.endpoints:
                 rel = e.key[len(self.run) + 1 :] if e.key.startswith(self.run + "/") else ""
-                hidden = any(c.startswith("_") for c in rel.split("/"))
-                if graph.processes.get(e.process) != "node" or not rel or hidden or "*" in rel or not e.type:
+                if graph.processes.get(e.process) != "node" or not rel or hidden_topic(rel) or "*" in rel:
+                    continue
+                if not e.type:
                     continue
                 if not msgs.is_known(e.type):
                     continue

@@ -222,7 +222,7 @@ def run(
     suites = []
     code = 0
     for i, (label, plan) in enumerate(plans):
-        for part in {id(p): p for p in [plan, *plan.parts()]}.values():  # every world of the run
+        for part in plan.every_plan():  # the run and every world of it
             if duration is not None:
                 part.duration_ns = round(duration * 1e9)
             if parsed_rate is not None:
@@ -959,6 +959,7 @@ def topics(
     import time
 
     from runner.graph import query_graph
+    from runner.plan import hidden_topic
     from runner.tools import find_run, joined
     from runner.transport import type_from_encoding, unpack_attachment
 
@@ -997,7 +998,7 @@ def topics(
         title=f"{name}: live topics",
     )
     for key in sorted(seen):
-        if not show_all and any(c.startswith("_") for c in key[len(name) + 1 :].split("/")):
+        if not show_all and hidden_topic(key.removeprefix(name + "/")):
             continue  # hidden, as `ros2 topic list` hides `_` topics
         e = seen[key]
         stamps = e["t"]

@@ -22,6 +22,7 @@ from urllib.parse import quote, unquote
 
 import zenoh
 
+from runner.plan import hidden_topic
 from runner.transport import meta_key
 
 ROLES = ("world", "renderer", "node", "bridge", "recorder", "tool")
@@ -60,12 +61,8 @@ class Graph:
         """Without the run's own helper topics (`_truth`, `_contacts`: a chunk starting with `_`), which
         rqt_graph would hide as well."""
         prefix = self.run + "/"
-
-        def hidden(key: str) -> bool:
-            rel = key[len(prefix) :] if key.startswith(prefix) else key
-            return any(chunk.startswith("_") for chunk in rel.split("/"))
-
-        return Graph(self.run, dict(self.processes), {e for e in self.endpoints if not hidden(e.key)})
+        shown = {e for e in self.endpoints if not hidden_topic(e.key.removeprefix(prefix))}
+        return Graph(self.run, dict(self.processes), shown)
 
     def topics(self) -> dict[str, str | None]:
         """Every concrete key: published, or subscribed without wildcards; with its type when known."""

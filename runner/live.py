@@ -57,15 +57,19 @@ class LiveView:
             return ch
 
     def _on_sample(self, sample: zenoh.Sample) -> None:
-        type_name = type_from_encoding(sample.encoding)
-        if type_name is None or not (type_name.startswith("foxglove.") or msgs.is_known(type_name)):
-            return
+        key = str(sample.key_expr)
+        ch = self._channels.get(key)
+        if ch is None:  # a key's first message: its type says whether (and how) it is shown
+            type_name = type_from_encoding(sample.encoding)
+            if type_name is None or not (type_name.startswith("foxglove.") or msgs.is_known(type_name)):
+                return
+            ch = self._channel(key, type_name)
         att = unpack_attachment(sample.attachment.to_bytes()) if sample.attachment is not None else None
         if att is not None:
             self._latest = max(self._latest, att[1])
         stamp = att[1] if att is not None else self._latest
         with contextlib.suppress(Exception):  # a viewer's trouble never stops the run
-            self._channel(str(sample.key_expr), type_name).log(sample.payload.to_bytes(), log_time=stamp)
+            ch.log(sample.payload.to_bytes(), log_time=stamp)
 
     def close(self) -> None:
         with contextlib.suppress(Exception):

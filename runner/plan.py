@@ -132,6 +132,10 @@ class RunPlan(BaseModel):
         """The world plans of the run: `worlds`, or this plan itself."""
         return self.worlds or [self]
 
+    def every_plan(self) -> list[RunPlan]:
+        """This plan and each of its worlds' (once each): for a setting every one of them carries."""
+        return [self, *self.worlds]
+
     @property
     def main_host(self) -> str | None:
         return next(iter(self.hosts), None)
@@ -176,6 +180,12 @@ class RunPlan(BaseModel):
                 seen[(ev.key, "pub")] = TopicPlan(key=ev.key, type=ev.type, direction="pub", owner="timeline")
                 out.append(seen[(ev.key, "pub")])
         return out
+
+
+def hidden_topic(rel: str) -> bool:
+    """The run's own helper topics (`_truth/...`, `_contacts`): a chunk starting with `_`, hidden as ROS
+    hides `_` topics. `rel` is a key without the run's name."""
+    return any(chunk.startswith("_") for chunk in rel.split("/"))
 
 
 def topic_key(run: str, namespace: str, topic: str) -> str:

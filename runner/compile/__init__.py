@@ -69,10 +69,10 @@ def compile_plan(
         drop = [_full_expr(sc.name, q.topics) for q in sc.qos if q.reliability == "best_effort"]
         for i, q in enumerate(sc.qos):
             _check_expr(_full_expr(sc.name, q.topics), doc, ("qos", i, "topics"), q.topics)
-        for part in {id(p): p for p in (plan, *plan.parts())}.values():
+        for part in plan.every_plan():
             part.best_effort = drop
     fox = FoxglovePlan(**sc.foxglove.model_dump())
-    for part in {id(p): p for p in (plan, *plan.parts())}.values():
+    for part in plan.every_plan():
         part.foxglove = fox
     if sc.zenoh is not None:
         plan.zenoh = _zenoh_settings(sc, doc)

@@ -21,7 +21,7 @@ from typing import Any
 from runner import msgs
 from runner.errors import Problem, ScenarioError
 from runner.loader import Document, PathKey, load_file
-from runner.plan import BridgePlan, NodePlan, Ros2Plan, RunPlan
+from runner.plan import BridgePlan, NodePlan, Ros2Plan, RunPlan, hidden_topic
 from runner.schema import Bridge, Ros2, Scenario
 
 _GZ_DIRECTIONS = {"GZ_TO_ROS": "SIM_TO_ZENOH", "ROS_TO_GZ": "ZENOH_TO_SIM", "BIDIRECTIONAL": "BIDIRECTIONAL"}
@@ -83,16 +83,11 @@ class _Topics:
         for key in ([f"{run}/{namespace}/{name}"] if namespace else []) + [f"{run}/{name}"]:
             if key in self.table:
                 return [key]
-        return sorted(k for k in self.table if k.endswith("/" + name) and not _hidden(k[len(run) + 1 :]))
+        return sorted(k for k in self.table if k.endswith("/" + name) and not hidden_topic(k[len(run) + 1 :]))
 
     def names(self) -> str:
-        keys = [k[len(self.run) + 1 :] for k in self.table if not _hidden(k[len(self.run) + 1 :])]
+        keys = [k[len(self.run) + 1 :] for k in self.table if not hidden_topic(k[len(self.run) + 1 :])]
         return ", ".join(sorted(keys))
-
-
-def _hidden(rel: str) -> bool:
-    """The run's own helper topics (`_truth/...`, `_contacts`), hidden like ROS's `_` topics."""
-    return any(chunk.startswith("_") for chunk in rel.split("/"))
 
 
 def _ros2_plan(setting: Ros2 | bool | None, default: Ros2 | None, run: str) -> Ros2Plan | None:
@@ -472,7 +467,7 @@ def _mirror_all(topics: _Topics, ros2: Ros2Plan) -> list[BridgePlan]:
     out = []
     for key, (type_name, directions) in sorted(topics.table.items()):
         rel = key[len(topics.run) + 1 :]
-        if _hidden(rel) or not msgs.is_known(type_name):  # (the Foxglove scene is not a ROS 2 type)
+        if hidden_topic(rel) or not msgs.is_known(type_name):  # (the Foxglove scene is not a ROS 2 type)
             continue
         direction = (
             "BIDIRECTIONAL"

@@ -193,17 +193,8 @@ class World:
                     self._after.append(_Hook(self._render_hook(link), period))
                     continue
                 params = cls.Params.model_validate(pp.params)
-                ctx = RuntimeContext(
-                    model=self.model,
-                    data=self.data,
-                    robot=handle,
-                    # by the plugin's place in the plan, so a renderer process draws the same numbers
-                    rng=np.random.default_rng([plan.seed, index]),
-                    run=plan.name,
-                    _make_publisher=self._publisher_factory(handle.namespace),
-                    _subscribe=self._subscriber_factory(handle.namespace),
-                )
-                plugin = cls(params, ctx, pp.name)
+                # random numbers by the plugin's place in the plan, so a renderer process draws the same
+                plugin = cls(params, self._context(handle, index), pp.name)
                 self.plugins.append(plugin)
                 if role == "renderer":
                     self.render_plugins[index] = plugin
@@ -218,16 +209,7 @@ class World:
             for handle in self.robots:
                 # every link's transform (robot_state_publisher's job), for a robot without a `tf` plugin
                 if not any(pp.type == "tf" for pp in handle.plan.plugins):
-                    ctx = RuntimeContext(
-                        model=self.model,
-                        data=self.data,
-                        robot=handle,
-                        rng=np.random.default_rng([plan.seed, 2**31]),  # (draws nothing)
-                        run=plan.name,
-                        _make_publisher=self._publisher_factory(handle.namespace),
-                        _subscribe=self._subscriber_factory(handle.namespace),
-                    )
-                    tf = link_transforms(handle.plan, plan.foxglove, ctx)
+                    tf = link_transforms(handle.plan, plan.foxglove, self._context(handle, 2**31))
                     self.plugins.append(tf)
                     self._after.append(_Hook(tf.after_step, round(1e9 / plan.foxglove.tf_rate)))
             for fn, period in SceneFeed(self).hooks():
@@ -253,6 +235,18 @@ class World:
             self._setup_contacts(plan.contact_watch)
         for plugin in self.plugins:
             plugin.setup()
+
+    def _context(self, handle: RobotHandle, stream: int) -> RuntimeContext:
+        """What a plugin of this robot works with; its random numbers are the plan seed's stream `stream`."""
+        return RuntimeContext(
+            model=self.model,
+            data=self.data,
+            robot=handle,
+            rng=np.random.default_rng([self.plan.seed, stream]),
+            run=self.plan.name,
+            _make_publisher=self._publisher_factory(handle.namespace),
+            _subscribe=self._subscriber_factory(handle.namespace),
+        )
 
     # ------------------------------------------------------------------------------------- pub / sub
     def _make_publisher(self, key: str, type_name: str) -> _Outgoing:
