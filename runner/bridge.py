@@ -14,7 +14,8 @@ at `SCENARIO_ENDPOINT` (and a ROS 2 Zenoh router, if one is named). For each map
 
 Subscriptions take only messages from other processes, so a BIDIRECTIONAL mapping never feeds itself.
 The process is ready (and the run starts) once everything is declared: nothing the world publishes first
-is missed. It stops on SIGINT/SIGTERM or when its runner goes away.
+is missed. Copies keep the sim topic's QoS (reliable unless `qos:` says best effort). It stops on
+SIGINT/SIGTERM (forwarding what is still on its way first) or when its runner goes away.
 """
 
 from __future__ import annotations
@@ -37,6 +38,8 @@ from runner.plan import BridgePlan, Ros2Plan, hidden_topic
 from runner.transport import encoding_for, make_config, meta_key, pack_attachment, unpack_attachment
 
 REMOTE = zenoh.Locality.REMOTE
+LINGER_QUIET_S = 0.2  # on stop, leave once nothing was forwarded for this long...
+LINGER_MAX_S = 0.8  # ...or after this (within the runner's STOP_GRACE_S)
 
 
 def _json_default(value: Any) -> Any:
@@ -100,6 +103,7 @@ class Bridge:
         self._keep: list[Any] = []
         self._ros_nodes: dict[tuple[int, str, str | None], _RosNode] = {}
         self.forwarded: dict[str, int] = {}
+        self.last_forward = 0.0  # time.monotonic() of the last message forwarded, either way
         for clock in clocks:
             self._keep.append(session.declare_subscriber(clock, self._on_clock))
         self._seen: set[tuple[str, str, str]] = set()
@@ -176,6 +180,7 @@ class Bridge:
         gid = b""
         if p.ros2 is not None:
             key, gid = self._ros_entity(p, "MP")
+            # as rmw_zenoh does for the KEEP_LAST history its tokens announce: drop rather than block
             pub = session.declare_publisher(key, congestion_control=zenoh.CongestionControl.DROP)
         else:
             assert p.key is not None
@@ -185,9 +190,15 @@ class Bridge:
                 if p.encoding == "cdr"
                 else zenoh.Encoding.APPLICATION_JSON.with_schema(type_name)
             )
-            # an outside subscriber that cannot keep up loses messages; it never slows the simulation
+            # the copy keeps the sim topic's QoS: reliable (it waits rather than lose a message, as the
+            # world's own publisher does) unless `qos:` made the topic best effort
             pub = session.declare_publisher(
-                key, encoding=encoding, congestion_control=zenoh.CongestionControl.DROP
+                key,
+                encoding=encoding,
+                congestion_control=zenoh.CongestionControl.DROP
+                if p.best_effort
+                else zenoh.CongestionControl.BLOCK,
+                reliability=zenoh.Reliability.BEST_EFFORT if p.best_effort else zenoh.Reliability.RELIABLE,
             )
         self._keep.append(pub)
         self.graph.publisher(key, type_name)
@@ -217,6 +228,7 @@ class Bridge:
                 attachment = pack_attachment(state["seq"] - 1, stamp)
             pub.put(payload, attachment=attachment)
             self.forwarded[p.where] = self.forwarded.get(p.where, 0) + 1
+            self.last_forward = time.monotonic()
 
         def subscribe() -> None:
             if state["sub"] is None:
@@ -286,6 +298,7 @@ class Bridge:
             sim_pub.put(payload, attachment=pack_attachment(state["seq"], now))
             state["seq"] += 1
             self.forwarded[p.where] = self.forwarded.get(p.where, 0) + 1
+            self.last_forward = time.monotonic()
 
         self._keep.append(session.declare_subscriber(key, on_sample, allowed_origin=REMOTE))
 
@@ -326,6 +339,13 @@ def main() -> int:
             while not stop.wait(0.2):
                 if os.getppid() != parent:
                     break
+            # asked to stop once the worlds have ended: what they published last may still be on its way
+            # through here; forward it before leaving (until quiet, within the runner's grace period)
+            asked = time.monotonic()
+            while time.monotonic() - asked < LINGER_MAX_S:
+                if time.monotonic() - max(asked, bridge.last_forward) >= LINGER_QUIET_S:
+                    break
+                time.sleep(0.02)
         finally:
             ready.undeclare()
             bridge.close()

@@ -81,6 +81,7 @@ class BridgePlan(BaseModel):
     encoding: Literal["cdr", "json"] = "cdr"
     rate: float | None = None  # messages per sim second, at most
     lazy: bool = False
+    best_effort: bool = False  # the sim topic is best effort (`qos:`): its copy drops rather than blocks
 
 
 class FoxglovePlan(BaseModel):

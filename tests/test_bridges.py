@@ -121,6 +121,9 @@ conf.insert_json5("connect/endpoints", json.dumps([sys.argv[1]]))
 conf.insert_json5("scouting/multicast/enabled", "false")
 with zenoh.open(conf) as session:
     pub = session.declare_publisher("outside/r1/cmd_vel")
+    deadline = time.monotonic() + 20
+    while not pub.matching_status.matching and time.monotonic() < deadline:  # until the run listens
+        time.sleep(0.02)
     for _ in range(int(float(sys.argv[2]) / 0.05)):
         pub.put(json.dumps({"linear": {"x": 0.4}, "angular": {"z": 0.0}}))
         time.sleep(0.05)
@@ -292,3 +295,22 @@ def test_a_bridge_file_resolves_under_its_robot(write_scenario) -> None:
     (b,) = plan.bridges
     assert (b.sim_key, b.key, b.direction, b.lazy) == ("two/r2/scan", "r2/scan", "SIM_TO_ZENOH", True)
     assert any(n.argv[-2:] == ["-m", "runner.bridge"] and n.required for n in plan.nodes)
+
+
+def test_a_bridge_copy_keeps_its_topics_qos(write_scenario) -> None:
+    """A bridged copy is reliable like its sim topic, and best effort only where `qos:` made the topic so."""
+    path = write_scenario(
+        TWO.replace(
+            "{bridges}",
+            "[{{topic: r1/scan}}, {{topic: r2/scan}}]\nqos: [{{topics: r1/scan, reliability: best_effort}}]",
+        )
+        .replace("{{", "{")
+        .replace("}}", "}")
+    )
+    from runner.compile import compile_plan
+    from runner.loader import load_file
+    from runner.validate import validate_scenario
+
+    doc = load_file(path)
+    plan = compile_plan(validate_scenario(doc), doc)
+    assert {b.sim_key: b.best_effort for b in plan.bridges} == {"two/r1/scan": True, "two/r2/scan": False}

@@ -18,6 +18,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import zenoh
+
 from runner import msgs
 from runner.errors import Problem, ScenarioError
 from runner.loader import Document, PathKey, load_file
@@ -144,6 +146,10 @@ def attach_bridges(plan: RunPlan, sc: Scenario, doc: Document) -> None:
     run_ros2 = _ros2_plan(sc.ros2, None, sc.name)
     if run_ros2 is not None and run_ros2.topics == "all":
         out += _mirror_all(topics, run_ros2)
+    if plan.best_effort:
+        drop = [zenoh.KeyExpr(e) for e in plan.best_effort]
+        for b in out:
+            b.best_effort = any(e.intersects(zenoh.KeyExpr(b.sim_key)) for e in drop)
     plan.bridges = out
     plan.ros2 = run_ros2
     if out:
