@@ -47,14 +47,80 @@ def load_plan(mcap: Path) -> Any:
     raise RunError(f"{mcap}: the recording does not carry its scenario; give it with --scenario FILE")
 
 
-def _series(mcap: Path, keys: set[str]) -> dict[str, list[tuple[int, Any]]]:
+def _series(
+    mcap: Path, keys: set[str], stamps_only: set[str] = frozenset()
+) -> dict[str, list[tuple[int, Any]]]:
+    """(log time, (schema, data)) of every message on `keys`; for `stamps_only` keys, (log time, None): a
+    rate over a long run of camera images stays a list of numbers."""
     from mcap.reader import make_reader
 
-    out: dict[str, list[tuple[int, Any]]] = {k: [] for k in keys}
+    out: dict[str, list[tuple[int, Any]]] = {k: [] for k in keys | stamps_only}
     with open(mcap, "rb") as f:
-        for schema, channel, message in make_reader(f).iter_messages(topics=sorted(keys)):
-            out[channel.topic].append((message.log_time, (schema.name if schema else "", message.data)))
+        for schema, channel, message in make_reader(f).iter_messages(topics=sorted(keys | stamps_only)):
+            keep = channel.topic in keys
+            out[channel.topic].append(
+                (message.log_time, (schema.name if schema else "", message.data) if keep else None)
+            )
     return out
+
+
+def image_rgb(img: Any) -> np.ndarray | None:
+    """A sensor_msgs/Image as an RGB array to look at: colour as it is, mono and depth as grey (depth
+    scaled to its own range, near bright); None for an encoding we cannot show."""
+    h, w, enc = img.height, img.width, img.encoding
+    if not h or not w:
+        return None
+    raw = np.frombuffer(bytes(img.data), np.uint8)
+    try:
+        if enc in ("rgb8", "bgr8", "rgba8", "bgra8"):
+            ch = 4 if enc.endswith("a8") else 3
+            arr = raw[: h * img.step].reshape(h, img.step)[:, : w * ch].reshape(h, w, ch)[..., :3]
+            return np.ascontiguousarray(arr if enc.startswith("rgb") else arr[..., ::-1])
+        if enc == "mono8":
+            g = raw[: h * img.step].reshape(h, img.step)[:, :w]
+            return np.repeat(g[..., None], 3, axis=2)
+        if enc in ("mono16", "16UC1", "32FC1"):
+            dt = np.dtype("<f4" if enc == "32FC1" else "<u2").newbyteorder(">" if img.is_bigendian else "<")
+            rows = raw[: h * img.step].reshape(h, img.step)[:, : w * dt.itemsize]
+            v = np.ascontiguousarray(rows).view(dt).reshape(h, w).astype(np.float64)
+            ok = np.isfinite(v) & (v > 0)
+            if not ok.any():
+                return np.zeros((h, w, 3), np.uint8)
+            lo, hi = v[ok].min(), v[ok].max()
+            scaled = (v - lo) / max(hi - lo, 1e-9)
+            if enc != "mono16":
+                scaled = 1.0 - scaled  # depth: near is bright
+            g = np.where(ok, 40 + 215 * scaled, 0).astype(np.uint8)
+            return np.repeat(g[..., None], 3, axis=2)
+    except ValueError:  # data shorter than its header says
+        return None
+    return None
+
+
+def _camera_frames(mcap: Path, summary: dict[str, Any], n: int = 3) -> tuple[str, list[Any]]:
+    """Up to n frames, evenly spread over the run, of the first camera that can be shown (colour cameras
+    before depth ones); read one message at a time, so a long run's images never sit in memory."""
+    from mcap.reader import make_reader
+
+    cams = [t for t in summary["topics"] if t["type"] == "sensor_msgs/msg/Image" and "/_" not in t["topic"]]
+    cams.sort(key=lambda t: ("depth" in t["topic"], t["topic"]))
+    for t in cams:
+        count = int(t["count"])
+        want = set(np.linspace(0, count - 1, min(n, count)).astype(int).tolist()) if count else set()
+        frames = []
+        with open(mcap, "rb") as f:
+            for i, (_s, _c, message) in enumerate(make_reader(f).iter_messages(topics=[t["topic"]])):
+                if i not in want:
+                    continue
+                rgb = image_rgb(msgs.decode(message.data, "sensor_msgs/msg/Image"))
+                if rgb is None:
+                    break
+                frames.append(rgb)
+                if len(frames) == len(want):
+                    break
+        if frames:
+            return t["topic"], frames
+    return "", []
 
 
 def svg_chart(
@@ -122,8 +188,7 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
     truth = {r.name: truth_key(p.name, r.namespace) for p in plan.parts() for r in p.robots}
     rate_topics = sorted({a["topic"] for a in plan.assertions if a.get("type") == "topic_rate"})
     rate_keys = {f"{run}/{t.strip('/')}" for t in rate_topics}
-    images = {t["topic"] for t in summary["topics"] if t["type"] == "sensor_msgs/msg/Image"}
-    series = _series(mcap, set(truth.values()) | rate_keys | set(sorted(images)[:1]))
+    series = _series(mcap, set(truth.values()), stamps_only=rate_keys - set(truth.values()))
     charts = []
     speed, travelled, tilt = [], [], []
     for name, key in truth.items():
@@ -167,16 +232,7 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
                     [(topic, list(secs), list(counts.astype(float)))],
                 )
             )
-    frames = []
-    for key in sorted(images)[:1]:
-        picks = series.get(key, [])
-        for _stamp, (_s, data) in [
-            picks[i] for i in np.linspace(0, len(picks) - 1, min(3, len(picks))).astype(int)
-        ]:
-            img = msgs.decode(data, "sensor_msgs/msg/Image")
-            if img.encoding in ("rgb8", "bgr8") and img.height and img.width:
-                arr = np.frombuffer(bytes(img.data), np.uint8).reshape(img.height, img.width, 3)
-                frames.append(_png_uri(arr if img.encoding == "rgb8" else arr[..., ::-1]))
+    camera, frames = _camera_frames(mcap, summary)
     with tempfile.TemporaryDirectory() as tmp:
         plot = trajectory_plot(plan, mcap, results, Path(tmp) / "trajectory.png")
         trajectory = _png_uri(plot) if plot is not None and plot.exists() else None
@@ -225,8 +281,8 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
         page.append("<h2>Signals</h2>" + "".join(f"<figure>{c}</figure>" for c in charts))
     if frames:
         page.append(
-            '<h2>Camera</h2><div class="frames">'
-            + "".join(f'<img alt="camera frame" src="{f}">' for f in frames)
+            f'<h2>Camera</h2><p class="sub">{h(camera)}</p><div class="frames">'
+            + "".join(f'<img alt="camera frame" src="{_png_uri(f)}">' for f in frames)
             + "</div>"
         )
     page.append(
