@@ -121,8 +121,10 @@ conf.insert_json5("connect/endpoints", json.dumps([sys.argv[1]]))
 conf.insert_json5("scouting/multicast/enabled", "false")
 with zenoh.open(conf) as session:
     pub = session.declare_publisher("outside/r1/cmd_vel")
-    deadline = time.monotonic() + 20
-    while not pub.matching_status.matching and time.monotonic() < deadline:  # until the run listens
+    heard = []
+    sub = session.declare_subscriber("outside/r1/odom", heard.append)
+    deadline = time.monotonic() + 30
+    while not heard and time.monotonic() < deadline:  # until the robot is heard: the run is under way
         time.sleep(0.02)
     for _ in range(int(float(sys.argv[2]) / 0.05)):
         pub.put(json.dumps({"linear": {"x": 0.4}, "angular": {"z": 0.0}}))
