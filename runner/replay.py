@@ -30,6 +30,7 @@ class Recording:
     mjcf: str
     times: list[int]  # sim ns of each state
     states: list[np.ndarray]
+    robots: set[str] | None = None  # the scenario's robot names (from its recorded plan), when known
 
 
 def load(mcap: Path, world: str | None = None) -> Recording:
@@ -39,6 +40,7 @@ def load(mcap: Path, world: str | None = None) -> Recording:
 
     mjcf: dict[str, str] = {}
     states: dict[str, list[tuple[int, np.ndarray]]] = {}
+    robots: set[str] | None = None
     try:
         with open(mcap, "rb") as f:
             for _schema, channel, message in make_reader(f).iter_messages(log_time_order=True):
@@ -46,6 +48,8 @@ def load(mcap: Path, world: str | None = None) -> Recording:
                 if topic.endswith("/_model"):
                     text = msgs.decode(message.data, "std_msgs/msg/String").data
                     mjcf.setdefault(topic[: -len("/_model")], text)
+                elif topic.endswith("/_plan") and robots is None:
+                    robots = _robot_names(msgs.decode(message.data, "std_msgs/msg/String").data)
                 elif topic.endswith("/_state"):
                     values = msgs.decode(message.data, "std_msgs/msg/Float64MultiArray").data
                     states.setdefault(topic[: -len("/_state")], []).append(
@@ -62,16 +66,29 @@ def load(mcap: Path, world: str | None = None) -> Recording:
         )
     run = runs[0]
     pairs = states[run]
-    return Recording(run, mjcf[run], [t for t, _ in pairs], [s for _, s in pairs])
+    return Recording(run, mjcf[run], [t for t, _ in pairs], [s for _, s in pairs], robots)
 
 
-def _robots(m: mujoco.MjModel) -> list[tuple[str, int]]:
-    """(robot name, root body) of each robot: bodies of the world whose names have a `<robot>/` prefix."""
+def _robot_names(plan_json: str) -> set[str] | None:
+    from runner.plan import RunPlan
+
+    try:
+        plan = RunPlan.model_validate_json(plan_json)
+    except ValueError:
+        return None
+    return {r.name for p in plan.parts() for r in p.robots}
+
+
+def _robots(m: mujoco.MjModel, names: set[str] | None = None) -> list[tuple[str, int]]:
+    """(robot name, root body) of each robot: the world's top bodies named `<robot>/...`; with the
+    scenario's robot names known, only theirs (an SDF world's models are named `<model>/...` too)."""
     out = []
     for b in range(1, m.nbody):
         name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b) or ""
         if int(m.body_parentid[b]) == 0 and "/" in name:
-            out.append((name.split("/", 1)[0], b))
+            robot = name.split("/", 1)[0]
+            if names is None or robot in names:
+                out.append((robot, b))
     return out
 
 
@@ -111,7 +128,7 @@ def frames(
     d = mujoco.MjData(m)
     m.vis.global_.offwidth = max(int(m.vis.global_.offwidth), width)
     m.vis.global_.offheight = max(int(m.vis.global_.offheight), height)
-    robots = _robots(m)
+    robots = _robots(m, rec.robots)
     cam = mujoco.MjvCamera()
     if camera == "overview":
         center, span = _framing(m, d, rec)
@@ -145,6 +162,7 @@ def frames(
                 d.mocap_pos[:] = state[nq : nq + 3 * nm].reshape(nm, 3)
                 d.mocap_quat[:] = state[nq + 3 * nm : nq + 7 * nm].reshape(nm, 4)
             mujoco.mj_kinematics(m, d)
+            mujoco.mj_comPos(m, d)  # subtree centres of mass: what a tracking (chase) camera looks at
             for k, (_name, body) in enumerate(robots):
                 trails[k].append(np.array(d.xpos[body]))
             if last_only and t + step <= end:

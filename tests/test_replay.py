@@ -71,11 +71,33 @@ def test_a_picture_a_gif_and_a_chase_camera(recording: Path, tmp_path: Path) -> 
     )
     assert r.returncode == 0, r.stderr
     with Image.open(gif) as img:
-        assert img.n_frames == 13 and img.size == (160, 120)
-        img.seek(12)
-        _red, blue = _robot_pixels(np.asarray(img.convert("RGB")))
-        assert blue > 50  # the camera follows r2: it fills the middle of the frame
+        # 13 frames at 2 per second (Pillow merges identical neighbours, adding up their durations)
+        durations = []
+        for frame in range(img.n_frames):
+            img.seek(frame)
+            durations.append(img.info["duration"])
+        assert sum(durations) == 13 * 500 and img.size == (160, 120)
+        for frame in (0, img.n_frames - 1):  # r2 starts at (2, 0) and ends metres away: the camera follows it
+            img.seek(frame)
+            middle = np.asarray(img.convert("RGB"))[40:80, 50:110]
+            assert _robot_pixels(middle)[1] > 30, frame  # r2 is in the middle of the frame
     bad = run_cli("render", str(recording), "-o", str(tmp_path / "x.avi"))
     assert bad.returncode == 1 and "write .mp4, .gif or .png" in bad.stderr
     nobody = run_cli("render", str(recording), "-o", str(gif), "--camera", "chase:r9")
     assert nobody.returncode == 1 and "no robot 'r9'" in nobody.stderr and "r1, r2" in nobody.stderr
+
+
+def test_only_the_scenarios_robots_get_paths() -> None:
+    """An SDF world's models are named `<model>/...` like robots: the recorded plan tells them apart."""
+    import mujoco
+
+    from runner.replay import _robots
+
+    m = mujoco.MjModel.from_xml_string(
+        "<mujoco><worldbody>"
+        '<body name="cafe_table/link"><geom size="0.1"/></body>'
+        '<body name="r1/base_link"><freejoint/><geom size="0.1"/></body>'
+        "</worldbody></mujoco>"
+    )
+    assert [name for name, _b in _robots(m)] == ["cafe_table", "r1"]  # without a plan: a guess
+    assert [name for name, _b in _robots(m, {"r1"})] == ["r1"]
