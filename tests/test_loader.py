@@ -94,3 +94,14 @@ def test_yaml_syntax_errors_point_where_the_mistake_starts(
     assert (problem.location.line, problem.location.column) == (line, column), problem.render()
     assert words in problem.message
     assert problem.hint
+
+
+def test_the_terminal_prints_file_colon_line_as_written() -> None:
+    """rich turns `:100:` into an emoji unless told not to: `world.sdf:100: ...` must stay as written."""
+    from runner.cli import err, out
+
+    for console in (out, err):
+        with console.capture() as cap:
+            console.print("warning: my_world.sdf:100: SDF <wind> ignored", markup=False)
+            console.print("world.sdf:1:  warning:smile:")
+        assert "my_world.sdf:100: SDF" in cap.get() and ":smile:" in cap.get()
