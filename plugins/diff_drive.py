@@ -236,13 +236,21 @@ class WheelDrive(Plugin):
             pos: Sequence[float] = (self.x, self.y, 0.0)
             half = self.yaw / 2.0
             quat: Sequence[float] = (math.cos(half), 0.0, 0.0, math.sin(half))
+            linear: Sequence[float] = (v, 0.0, 0.0)  # what the wheels say
+            angular: Sequence[float] = (0.0, 0.0, w)
         else:
             d = self.ctx.data
             pos = d.xpos[self.base].tolist()
             quat = d.xquat[self.base].tolist()
             self.yaw = quat_to_yaw(quat)
+            # the twist is the true one too (in the body's frame, as gazebo_ros_diff_drive's WORLD source
+            # gives it), not the wheels' claim: a skidding or dragging robot reports what it does
+            mujoco.mj_objectVelocity(self.ctx.model, d, mujoco.mjtObj.mjOBJ_XBODY, self.base, self._vel, 1)
+            ang, lin = self._vel[:3], self._vel[3:]
+            linear = (float(lin[0]), float(lin[1]), 0.0)
+            angular = (0.0, 0.0, float(ang[2]))
         if self.odom_out:
-            self.odom_out.publish(now_ns, pos, quat, (v, 0.0, 0.0), (0.0, 0.0, w))
+            self.odom_out.publish(now_ns, pos, quat, linear, angular)
         if self.tf_out:
             self.tf_out.publish(now_ns, pos, quat)
 

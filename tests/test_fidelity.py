@@ -80,12 +80,19 @@ def test_diff_drive_world_odometry_is_the_truth(write_scenario):
     bus = _scenario(
         write_scenario,
         3.0,
-        "{type: diff_drive, params: {odometry_source: world}}, {type: ground_truth}",
+        # wheels said to be 1.5x their size: they turn slower than the command needs, and would claim it
+        "{type: diff_drive, params: {odometry_source: world, wheel_radius: 0.075}}, {type: ground_truth}",
         _cmd(0.0, 0.2, ang=0.5),
     )
     (_, odom), (_, truth) = messages(bus, "r1/odom")[-1], messages(bus, "r1/ground_truth")[-1]
     assert odom.pose.pose.position.x == pytest.approx(truth.pose.pose.position.x, abs=1e-9)
     assert _yaw(odom) == pytest.approx(_yaw(truth), abs=1e-9)
+    # the twist is the truth too (body frame), not the wheels' claim of 0.2 m/s and 0.5 rad/s
+    tw, true_tw = odom.twist.twist, truth.twist.twist
+    speed = math.hypot(true_tw.linear.x, true_tw.linear.y)
+    assert speed < 0.2 / 1.3  # the robot really is slower than commanded
+    assert math.hypot(tw.linear.x, tw.linear.y) == pytest.approx(speed, rel=0.02)
+    assert tw.angular.z == pytest.approx(true_tw.angular.z, rel=0.02)
 
 
 @pytest.mark.timeout(60)
