@@ -68,9 +68,9 @@ from runner.gl import (  # noqa: F401  (re-exported for the camera plugins and t
 )
 from runner.plugin import BuildContext, PluginConfigError, RatedParams
 
-# The compiler gives every world an offscreen framebuffer of this size (runner/compile/__init__.py):
-# no camera image can be larger.
-OFFSCREEN_MAX = (1280, 960)
+# The compiler gives every world an offscreen framebuffer of at least 1280x960 (runner/compile/__init__.py);
+# a larger camera grows it, up to this (what any GL implementation offers).
+OFFSCREEN_MAX = (8192, 8192)
 
 IMAGE = "sensor_msgs/msg/Image"
 CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
@@ -190,6 +190,9 @@ def add_camera(ctx: BuildContext, link: str, name: str, p: CameraParams) -> str:
             param,
             hint=f"use at most width {w} and height {h}",
         )
+    # a full-HD camera (TurtleBot3 Waffle's R200 says 1920x1080) grows the framebuffer it renders into
+    vis = ctx.spec.visual.global_
+    vis.offwidth, vis.offheight = max(int(vis.offwidth), p.width), max(int(vis.offheight), p.height)
     body = ctx.body(link)
     cam_name = camera_name(name)
     if ctx.spec.camera(cam_name) is not None:

@@ -248,7 +248,7 @@ def test_images_follow_the_moving_robot(tmp_path: Path):
 @pytest.mark.parametrize(
     ("params", "where", "text"),
     [
-        ("{width: 2000}", "width", "offscreen framebuffer"),
+        ("{width: 9000}", "width", "offscreen framebuffer"),
         ("{near: 5, far: 1}", "params", "far"),
         ("{depth_topic: camera/image_raw}", "params", "same topic"),
     ],
@@ -269,3 +269,33 @@ def test_bad_camera_params_are_scenario_errors(tmp_path: Path, params: str, wher
         plan_of(path)
     msg = str(e.value)
     assert text in msg and where in msg and ":6" in msg, msg
+
+
+FULL_HD = f"""
+name: t
+duration: 0.1
+rate: max
+world:
+  models:
+    - {{name: red, shape: box, size: [0.4, 0.4, 0.4], pose: {{xyz: [1.5, 0, 0.2]}}, rgba: [1, 0, 0, 1]}}
+robots:
+  - name: r1
+    description: "{DIFFBOT}"
+    pose: {{xyz: [0, 0, 0.05]}}
+    plugins:
+      - type: camera
+        params: {{pose: {{xyz: [{CAM_X}, 0, {CAM_Z}]}}, width: 1920, height: 1080, rate: 10}}
+"""
+
+
+@pytest.mark.timeout(60)
+def test_a_full_hd_camera_grows_the_framebuffer(tmp_path: Path):
+    """TurtleBot3 Waffle's R200 asks for 1920x1080, more than the default 1280x960 framebuffer."""
+    path = tmp_path / "hd.yaml"
+    path.write_text(FULL_HD)
+    _, bus = simulate(path)
+    (_, first), *_ = messages(bus, "r1/camera/image_raw")
+    img = _image(first)
+    assert img.shape == (1080, 1920, 3)
+    red = (img[..., 0] > 120) & (img[..., 1] < 60) & (img[..., 2] < 60)
+    assert red[:, 800:1120].mean() > 0.1  # the red box ahead, in the middle: the whole image is rendered

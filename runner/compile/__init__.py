@@ -117,6 +117,9 @@ def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices
         frame = world.worldbody.add_frame(pos=list(pos), quat=list(rpy_to_quat(robot.pose.rpy)))
         prefix = f"{robot.ns}/"
         world.attach(model.spec, prefix=prefix, frame=frame)
+        # a robot's camera may have grown its framebuffer: the world's is the one cameras render into
+        g, rg = world.visual.global_, model.spec.visual.global_
+        g.offwidth, g.offheight = max(g.offwidth, rg.offwidth), max(g.offheight, rg.offheight)
         robots.append(
             RobotPlan(
                 name=robot.name,
