@@ -55,3 +55,28 @@ def test_explicit_package_map_wins(tmp_path: Path):
     pm = PackageMap.for_scenario(tmp_path, {"dup": other})
     assert pm.find("dup") == other
     assert pm.find("nope") is None
+
+
+def test_a_urdf_named_file_that_uses_xacro_is_expanded(tmp_path: Path):
+    """Launch files run xacro on `.urdf` files too (nav2's sam_bot): the content decides, not the name."""
+    from runner.compile import compile_plan
+    from runner.loader import load_file
+    from runner.validate import validate_scenario
+
+    (tmp_path / "bot.urdf").write_text(
+        '<robot name="bot" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:arg name="size" default="0.3"/><xacro:property name="w" value="$(arg size)"/>'
+        '<link name="base"><collision><geometry><box size="${w} ${w} 0.1"/></geometry></collision>'
+        '<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/>'
+        "</inertial></link></robot>"
+    )
+    (tmp_path / "s.yaml").write_text(
+        "name: s\nrobots:\n  - {name: r1, description: {file: bot.urdf, args: {size: '0.5'}}}\n"
+    )
+    doc = load_file(tmp_path / "s.yaml")
+    plan = compile_plan(validate_scenario(doc), doc)
+    import mujoco
+
+    m = mujoco.MjModel.from_xml_string(plan.mjcf)
+    box = [g for g in range(m.ngeom) if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX]
+    assert [round(float(x), 3) for x in m.geom_size[box[0]]] == [0.25, 0.25, 0.05]  # the arg reached it

@@ -438,6 +438,16 @@ def _description_path(robot: Robot, base: Path) -> Path:
     return (base / robot.desc.file).resolve()
 
 
+def _looks_like_xacro(path: Path) -> bool:
+    """A file whatever its name that uses xacro (launch files run xacro on `.urdf` files too: nav2's
+    sam_bot is one): it declares the xacro namespace or uses xacro elements."""
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return False
+    return "xmlns:xacro" in text or "<xacro:" in text
+
+
 def _robot_model(
     robot: Robot, i: int, doc: Document, packages: PackageMap, notices: Notices, timestep: float
 ) -> RobotModel:
@@ -458,7 +468,7 @@ def _robot_model(
             )
         )
     try:
-        if path.suffix == ".xacro" or path.name.endswith(".urdf.xacro"):
+        if path.suffix == ".xacro" or _looks_like_xacro(path):
             args = {k: _xacro_str(v) for k, v in robot.desc.args.items()}
             result = expand(path, args, packages)
             return urdf_to_model(

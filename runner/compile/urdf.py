@@ -68,7 +68,7 @@ def _number(text: str, what: str, where: Any, el: Any) -> float:
         raise DescriptionError(
             f"{what} {text!r} is not a number",
             *where(el),
-            hint="xacro expressions are expanded in .xacro files only; a .urdf needs plain numbers",
+            hint="a plain URDF needs plain numbers; ${...} is expanded in files that declare xmlns:xacro",
         )
     return value
 
