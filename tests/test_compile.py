@@ -116,3 +116,26 @@ def test_missing_world_file_points_at_the_scenario_line(write_scenario):
         plan_of(write_scenario("name: w\nworld:\n  sdf: nowhere.world\n"))
     text = e.value.render()
     assert "nowhere.world" in text and ":3:3: world.sdf" in text
+
+
+def test_a_record_pattern_that_matches_no_topic_is_warned(tmp_path):
+    from runner.compile import compile_plan
+    from runner.errors import Notices
+    from runner.loader import load_file
+    from runner.validate import validate_scenario
+    from tests.conftest import DIFFBOT
+
+    path = tmp_path / "s.yaml"
+    path.write_text(
+        "name: s\n"
+        f"robots:\n  - {{name: r1, description: '{DIFFBOT}', plugins: [{{type: lidar, params: {{link: lidar_link}}}}]}}\n"
+        "record:\n  exclude: ['*/camera/**', r1/scan, _state, scene]\n"
+    )
+    doc = load_file(path)
+    notices = Notices()
+    compile_plan(validate_scenario(doc), doc, notices=notices)
+    said = [(n.message, n.location.line, n.hint) for n in notices if "record." in n.message]
+    assert len(said) == 1, said  # r1/scan, _state and scene are topics of the run; no camera is
+    message, line, hint = said[0]
+    assert message == "record.exclude[0] '*/camera/**' matches none of the run's topics" and line == 5
+    assert "r1/scan" in hint

@@ -81,7 +81,42 @@ def compile_plan(
         from runner.compile.bridges import attach_bridges
 
         attach_bridges(plan, sc, doc)
+    _check_record_patterns(plan, sc, doc, notices)
     return plan
+
+
+def _check_record_patterns(plan: RunPlan, sc: Scenario, doc: Document, notices: Notices) -> None:
+    """A `record.exclude` (or `include`) pattern that matches none of the run's topics is most likely a
+    typo, and a costly one (the camera images it was meant to leave out fill the disk): say so."""
+    import zenoh
+
+    rec = plan.record
+    if not rec.enabled:
+        return
+    keys = set()
+    for part in plan.every_plan():
+        keys |= {t.key for t in part.topics()}
+        keys |= {f"{part.name}/{k}" for k in ("scene", "tf", "tf_static", "_model", "_state", "_plan")}
+        keys |= {f"{part.name}/{r.namespace}/robot_description".replace("//", "/") for r in part.robots}
+        keys |= {f"{part.name}/_truth/x", f"{part.name}/_contacts"}
+    known = [zenoh.KeyExpr(k) for k in keys]
+    nodes = " (or a node publishes it)" if plan.nodes else ""
+    for field_name, written, full in (
+        ("exclude", sc.record.exclude, rec.exclude),
+        ("include", sc.record.include, rec.include),
+    ):
+        for i, (text, expr) in enumerate(zip(written, full, strict=True)):
+            if any(zenoh.KeyExpr(expr).intersects(k) for k in known):
+                continue
+            where = doc.locate(("record", field_name, i))
+            sample = sorted(k[len(plan.name) + 1 :] for k in keys if "/_" not in k)[:6]
+            notices.add(
+                f"record.{field_name}[{i}] {text!r} matches none of the run's topics{nodes}",
+                where.file,
+                where.line,
+                hint="patterns are relative to the run, e.g. r1/camera/** or */camera/**; topics: "
+                + ", ".join(sample),
+            )
 
 
 def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices: Notices) -> RunPlan:
