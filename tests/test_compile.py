@@ -139,3 +139,42 @@ def test_a_record_pattern_that_matches_no_topic_is_warned(tmp_path):
     message, line, hint = said[0]
     assert message == "record.exclude[0] '*/camera/**' matches none of the run's topics" and line == 5
     assert "r1/scan" in hint
+
+
+def test_a_robot_placed_inside_something_is_warned(tmp_path):
+    from runner.compile import compile_plan
+    from runner.errors import Notices
+    from runner.loader import load_file
+    from runner.validate import validate_scenario
+    from tests.conftest import DIFFBOT
+
+    path = tmp_path / "s.yaml"
+    path.write_text(
+        "name: s\n"
+        "world:\n  models:\n"
+        "    - {name: crate, shape: box, size: [1, 1, 1], pose: {xyz: [3, 0, 0.5]}}\n"
+        "robots:\n"
+        f"  - {{name: free, description: '{DIFFBOT}', pose: {{xyz: [0, 0, 0.06]}}}}\n"
+        f"  - {{name: stuck, description: '{DIFFBOT}', pose: {{xyz: [3, 0, 0.06]}}}}\n"
+    )
+    doc = load_file(path)
+    notices = Notices()
+    compile_plan(validate_scenario(doc), doc, notices=notices)
+    said = [n for n in notices if "inside" in n.message]
+    assert len(said) == 1, [n.render() for n in notices]
+    assert said[0].message.startswith("robot 'stuck' starts 0.") and "inside 'crate" in said[0].message
+    assert said[0].location.line == 7 and "move the robot's pose" in (said[0].hint or "")
+    # wheels 5 cm into the ground (posed at z = 0) are not worth a word; half a metre is
+    text = (
+        path.read_text()
+        .replace("xyz: [3, 0, 0.06]", "xyz: [3, 3, -0.5]")
+        .replace("[0, 0, 0.06]", "[0, 0, 0]")
+    )
+    path.write_text(text)
+    doc = load_file(path)
+    notices = Notices()
+    compile_plan(validate_scenario(doc), doc, notices=notices)
+    said = [n.message for n in notices if "inside" in n.message]
+    assert len(said) == 1 and said[0].startswith("robot 'stuck' starts") and "inside 'ground'" in said[0], (
+        said
+    )

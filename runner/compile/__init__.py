@@ -85,6 +85,59 @@ def compile_plan(
     return plan
 
 
+START_OVERLAP_M = 0.03  # a robot this deep inside something at t = 0 is warned about
+START_OVERLAP_GROUND_M = 0.1  # ...or this deep in the ground
+
+
+def _check_start_overlaps(m: mujoco.MjModel, sc: Scenario, doc: Document, notices: Notices) -> None:
+    """A robot placed inside something (another robot, a wall, the ground) is shoved out at the first step,
+    often somewhere odd (under the floor): say where it starts and what it is inside. A mesh collides as
+    its convex hull, so a building's walls made of one mesh are a solid block: the hint says so."""
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    robots = {f"{r.ns}/": i for i, r in enumerate(sc.robots)}
+
+    def owner(geom: int) -> tuple[int | None, str]:
+        body = int(m.geom_bodyid[geom])
+        root = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.body_rootid[body])) or ""
+        what = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, geom) or (
+            mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, body) or "the world"
+        )
+        robot = next((i for prefix, i in robots.items() if root.startswith(prefix)), None)
+        return robot, what
+
+    plane = int(mujoco.mjtGeom.mjGEOM_PLANE)
+    worst: dict[tuple[int, str], tuple[float, bool]] = {}
+    for c in d.contact[: d.ncon]:
+        # wheels a few centimetres into the ground (a robot posed at z = 0) just pop up: not worth a word
+        on_ground = plane in (int(m.geom_type[c.geom1]), int(m.geom_type[c.geom2]))
+        if c.dist > -(START_OVERLAP_GROUND_M if on_ground else START_OVERLAP_M):
+            continue
+        (r1, w1), (r2, w2) = owner(int(c.geom1)), owner(int(c.geom2))
+        for robot, other, other_robot, geom in ((r1, w2, r2, int(c.geom2)), (r2, w1, r1, int(c.geom1))):
+            if robot is None or other_robot == robot:
+                continue
+            name = sc.robots[other_robot].name if other_robot is not None else other
+            mesh = int(m.geom_type[geom]) == int(mujoco.mjtGeom.mjGEOM_MESH)
+            key = (robot, name)
+            if -c.dist > worst.get(key, (0.0, False))[0]:
+                worst[key] = (-float(c.dist), mesh)
+    for (robot, name), (depth, mesh) in sorted(worst.items()):
+        where = doc.locate(("robots", robot, "pose"))
+        notices.add(
+            f"robot {sc.robots[robot].name!r} starts {depth:.2f} m inside {name!r}: the first step shoves "
+            "them apart",
+            where.file,
+            where.line,
+            hint="move the robot's pose"
+            + (
+                "; a mesh collides as its convex hull (walls made of one mesh are a solid block)"
+                if mesh
+                else ""
+            ),
+        )
+
+
 def _check_record_patterns(plan: RunPlan, sc: Scenario, doc: Document, notices: Notices) -> None:
     """A `record.exclude` (or `include`) pattern that matches none of the run's topics is most likely a
     typo, and a costly one (the camera images it was meant to leave out fill the disk): say so."""
@@ -171,9 +224,10 @@ def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices
         )
 
     try:
-        world.compile()
+        compiled = world.compile()
     except ValueError as e:
         raise ScenarioError(_compile_problem(e, sc, doc, world)) from None
+    _check_start_overlaps(compiled, sc, doc, notices)
     mjcf = world.to_xml()
 
     timeline = [_timeline_entry(sc, i, doc) for i in range(len(sc.timeline))]
