@@ -103,10 +103,21 @@ def _framing(m: mujoco.MjModel, d: mujoco.MjData, rec: Recording) -> tuple[np.nd
             center, half = m.geom_aabb[g][:3], m.geom_aabb[g][3:]
             rot = d.geom_xmat[g].reshape(3, 3)
             points += list(d.geom_xpos[g] + (center + corners * half) @ rot.T)
-    for state in rec.states[:: max(1, len(rec.states) // 50)]:
+    # geoms of bodies that can move (their root body has joints), seen whole wherever they go: a box
+    # pushed to the edge stays in the picture
+    moving = [
+        g
+        for g in range(m.ngeom)
+        if int(m.body_jntnum[int(m.body_rootid[int(m.geom_bodyid[g])])]) > 0
+        and int(m.geom_type[g]) != int(mujoco.mjtGeom.mjGEOM_PLANE)
+    ]
+    for state in [*rec.states[:: max(1, len(rec.states) // 50)], rec.states[-1]]:
         d.qpos[:] = state[: m.nq]
         mujoco.mj_kinematics(m, d)
         points += list(d.xpos[1:])
+        for g in moving:
+            center, half = m.geom_aabb[g][:3], m.geom_aabb[g][3:]
+            points += list(d.geom_xpos[g] + (center + corners * half) @ d.geom_xmat[g].reshape(3, 3).T)
     if not points:
         return np.array(m.stat.center), 2.0 * float(m.stat.extent)
     pts = np.array(points)
@@ -132,6 +143,9 @@ def frames(
     cam = mujoco.MjvCamera()
     if camera == "overview":
         center, span = _framing(m, d, rec)
+        # the shadow map must cover what is framed, or its edge speckles the floor (shadow acne)
+        extent = max(float(m.stat.extent), 1e-6)
+        m.vis.map.shadowclip = max(float(m.vis.map.shadowclip), max(25.0, 3.0 * span) / extent)
         cam.type = mujoco.mjtCamera.mjCAMERA_FREE
         cam.lookat[:] = center
         cam.distance = 1.3 * span / (2 * np.tan(np.radians(float(m.vis.global_.fovy)) / 2))

@@ -85,6 +85,7 @@ def compile_plan(
     return plan
 
 
+SHADOW_REACH_M = 25.0  # the sun's shadow map reaches this far (m) at least
 START_OVERLAP_M = 0.03  # a robot this deep inside something at t = 0 is warned about
 START_OVERLAP_GROUND_M = 0.1  # ...or this deep in the ground
 
@@ -228,6 +229,11 @@ def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices
     except ValueError as e:
         raise ScenarioError(_compile_problem(e, sc, doc, world)) from None
     _check_start_overlaps(compiled, sc, doc, notices)
+    # the sun's shadow map covers shadowclip x the model's extent around its centre; at its edge the floor
+    # shows shadow acne (black speckles), in camera images and renders of a small world: cover 25 m at least
+    extent = float(compiled.stat.extent)
+    if extent > 0:
+        world.visual.map.shadowclip = max(float(world.visual.map.shadowclip), SHADOW_REACH_M / extent)
     mjcf = world.to_xml()
 
     timeline = [_timeline_entry(sc, i, doc) for i in range(len(sc.timeline))]
