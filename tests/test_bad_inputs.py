@@ -43,7 +43,7 @@ def test_real_console_script_exits_1_without_traceback(tmp_path: Path) -> None:
 MESH_URDF = """<?xml version="1.0"?>
 <robot name="m">
   <link name="base_link">
-    <visual><geometry><mesh filename="{uri}"/></geometry></visual>
+    <collision><geometry><mesh filename="{uri}"/></geometry></collision>
     <inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
   </link>
 </robot>

@@ -1,16 +1,58 @@
-"""Meshes MuJoCo cannot read (Collada, PLY, ...) converted to binary STL with trimesh, cached by content."""
+"""Mesh files made ready for MuJoCo, with the problems of real robot packages found before MuJoCo sees them.
+
+MuJoCo reads binary STL (up to 200000 triangles) and OBJ. Everything else is converted with trimesh and
+cached under `$XDG_CACHE_HOME/scenario-runner/meshes`, keyed by the file's content, its format and the
+converter's version (`_RECIPE`, trimesh's version): a change to any of them makes a new file. So are:
+
+- ASCII STL (many ROS packages ship it; MuJoCo reads binary STL only). A binary STL whose 80-byte header
+  happens to begin with "solid" is told apart by its size (84 + 50 bytes a triangle) and by its bytes;
+- binary STL with more than 200000 triangles, which MuJoCo refuses: written as OBJ;
+- COLLADA, in metres: `<asset><unit meter="0.01"/>` scales the mesh, as Gazebo's loader does. `<up_axis>`
+  is ignored, as Gazebo and RViz ignore it: ROS meshes are drawn Z-up whatever the tag says, and a Y_UP
+  tag (pycollada's and Blender's default) on such a mesh would otherwise tip the robot over.
+
+`prepare_mesh` says plainly what is wrong with a file that is not a mesh: a Git LFS pointer left in place of
+the mesh, an empty placeholder, a file without triangles, one cut short. It also tells a flat mesh (all its
+vertices in one plane: no volume, no convex hull), which MuJoCo can draw (with `inertia="shell"`) but
+cannot collide with; what to do about that is the caller's choice (a visual or a collision).
+"""
 
 from __future__ import annotations
 
 import hashlib
+import math
 import os
+from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 MUJOCO_MESH_FORMATS = {".stl", ".obj", ".msh"}
 
+# Bumped whenever the conversion changes what it writes (v2: COLLADA units, ASCII STL, OBJ for big meshes),
+# so that files converted by an older version are not reused.
+_RECIPE = "v2"
+MAX_STL_TRIANGLES = 200_000  # MuJoCo's STL reader refuses more
+_LFS_POINTER = b"version https://git-lfs.github.com/spec/v1"
+_STL_RECORD = np.dtype([("normal", "<f4", (3,)), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+_FLAT = 1e-9  # thickness / size below which a mesh is flat
+
 
 class MeshError(Exception):
-    pass
+    """A mesh file MuJoCo cannot use. `str()` is `mesh NAME: REASON`; `reason` and `hint` apart."""
+
+    def __init__(self, message: str, hint: str | None = None, reason: str | None = None):
+        super().__init__(message)
+        self.hint = hint
+        self.reason = reason if reason is not None else message
+
+
+@dataclass(frozen=True)
+class PreparedMesh:
+    file: Path  # what MuJoCo reads: the file itself or a cached conversion
+    triangles: int  # 0 when not looked at (.msh)
+    flat: bool  # all vertices in one plane (or line): zero volume, no convex hull
+    extent: tuple[float, float, float] = (0.0, 0.0, 0.0)  # bounding box size, in the file's units (metres)
 
 
 def mesh_cache() -> Path:
@@ -19,26 +61,211 @@ def mesh_cache() -> Path:
 
 
 def convert_mesh(path: Path) -> Path:
-    """A file MuJoCo reads with the same geometry as `path`: `path` itself, or a cached STL conversion."""
-    if path.suffix.lower() in MUJOCO_MESH_FORMATS:
-        return path
-    data = path.read_bytes()
-    out = mesh_cache() / f"{hashlib.sha256(data).hexdigest()[:20]}.stl"
-    if out.is_file():
-        return out
-    try:
-        import trimesh
+    """A file MuJoCo reads with the same geometry as `path`: `path` itself, or a cached conversion."""
+    return prepare_mesh(path).file
 
-        loaded = trimesh.load(path, force="mesh")
-        if loaded.is_empty:
-            raise ValueError("no triangles")
-        out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = out.with_suffix(f".{os.getpid()}.tmp")
-        loaded.export(tmp, file_type="stl")
-        tmp.replace(out)
+
+_MEMO: dict[tuple[str, int, int, str], PreparedMesh] = {}  # (path, size, mtime, cache): one look a run
+
+
+def prepare_mesh(path: Path) -> PreparedMesh:
+    """`path` made ready for MuJoCo (converted if need be) and looked at; a `MeshError` says what is wrong."""
+    try:
+        st = path.stat()
+    except OSError as e:
+        raise _error(path, f"cannot be read ({e.strerror or e})") from None
+    memo_key = (str(path), st.st_size, st.st_mtime_ns, str(mesh_cache()))
+    memo = _MEMO.get(memo_key)
+    if memo is not None and memo.file.is_file():
+        return memo
+    try:
+        data = path.read_bytes()
+    except OSError as e:
+        raise _error(path, f"cannot be read ({e.strerror or e})") from None
+    _check_not_a_placeholder(path, data)
+    suffix = path.suffix.lower()
+    if suffix == ".stl" and not _is_ascii_stl(data):
+        prepared = _binary_stl(path, data)
+    elif suffix == ".obj":
+        prepared = _obj(path, data)
+    elif suffix == ".msh":
+        prepared = PreparedMesh(path, 0, False)
+    else:
+        prepared = _convert(path, data)
+    _MEMO[memo_key] = prepared
+    return prepared
+
+
+def _error(path: Path, reason: str, hint: str | None = None) -> MeshError:
+    return MeshError(f"mesh {path.name}: {reason}", hint=hint, reason=reason)
+
+
+def _why(e: BaseException) -> str:
+    """`Type: message`, once: pycollada's messages already begin with their type's name."""
+    name, text = type(e).__name__, str(e).strip()
+    if not text:
+        return name
+    return text if text.startswith(name) else f"{name}: {text}"
+
+
+def _check_not_a_placeholder(path: Path, data: bytes) -> None:
+    if not data.strip():
+        raise _error(
+            path,
+            "the file is empty" + (f" ({len(data)} bytes of blanks)" if data else " (0 bytes)"),
+            hint="it is a placeholder for the real mesh: get the file from the package's repository",
+        )
+    if data.startswith(_LFS_POINTER):
+        size = next(
+            (line.split()[1].decode() for line in data.splitlines() if line.startswith(b"size ")), None
+        )
+        raise _error(
+            path,
+            "this is a Git LFS pointer, not the mesh (a small text file left in place of the real one"
+            + (f", which is {size} bytes" if size else "")
+            + ")",
+            hint="run `git lfs pull` in the repository the package comes from (or download the real file)",
+        )
+
+
+def _is_ascii_stl(data: bytes) -> bool:
+    """Begins with `solid` and reads as text; a binary STL whose header begins with "solid" has the size
+    its triangle count gives (84 + 50 bytes a triangle) and bytes no text has."""
+    if data[:1024].lstrip()[:5].lower() != b"solid":
+        return False
+    if len(data) >= 84 and len(data) == 84 + 50 * int.from_bytes(data[80:84], "little"):
+        return False
+    # A binary STL has NUL bytes right after its header (zero coordinates, the attribute word of each
+    # triangle, almost always 0); text has none.
+    return b"\0" not in data[:4096]
+
+
+def _binary_stl(path: Path, data: bytes) -> PreparedMesh:
+    if len(data) < 84:
+        raise _error(path, f"not an STL file ({len(data)} bytes, shorter than a binary STL's header)")
+    count = int.from_bytes(data[80:84], "little")
+    if count == 0:
+        raise _error(path, "the STL file has no triangles", hint="export the mesh again")
+    if len(data) < 84 + 50 * count:
+        raise _error(
+            path,
+            f"the binary STL is cut short: its header says {count} triangles, the file holds "
+            f"{(len(data) - 84) // 50}",
+            hint="the file was truncated (an interrupted download or copy): get it again",
+        )
+    if count > MAX_STL_TRIANGLES:
+        return _convert(path, data)  # MuJoCo's STL reader stops at 200000 triangles; its OBJ reader does not
+    vertices = np.frombuffer(data, _STL_RECORD, count=count, offset=84)["v"].reshape(-1, 3)
+    return _looked_at(path, vertices.astype(np.float64), count)
+
+
+def _obj(path: Path, data: bytes) -> PreparedMesh:
+    """MuJoCo reads OBJ itself: only looked at (vertices, triangles) for the clear messages."""
+    coords: list[str] = []
+    triangles = 0
+    for line in data.decode("utf-8", "replace").splitlines():
+        if line.startswith(("v ", "v\t")):
+            coords.extend(line.split()[1:4])
+        elif line.startswith(("f ", "f\t")):
+            triangles += max(len(line.split()) - 3, 0)
+    try:
+        vertices = np.array(coords, dtype=np.float64).reshape(-1, 3)
+    except ValueError:
+        return PreparedMesh(path, triangles, False)  # odd vertex lines: MuJoCo's reader has the last word
+    if triangles == 0:
+        raise _error(path, "the OBJ file has no faces (no triangles)", hint="export the mesh again")
+    return _looked_at(path, vertices, triangles)
+
+
+def _looked_at(file: Path, vertices: np.ndarray, triangles: int, source: Path | None = None) -> PreparedMesh:
+    """`file` with what its vertices tell; an error (about `source`, the user's file) for what MuJoCo
+    cannot load at all."""
+    source = source or file
+    if len(vertices) == 0:
+        raise _error(source, "the mesh has no vertices", hint="export the mesh again")
+    if not np.isfinite(vertices).all():
+        raise _error(source, "the mesh has vertices that are not numbers (NaN or infinite)")
+    flat = _flat(vertices)
+    if flat and len(np.unique(vertices, axis=0)) < 4:
+        raise _error(
+            source,
+            f"the mesh has fewer than 4 distinct vertices ({triangles} triangle(s)); MuJoCo needs at least 4",
+        )
+    extent = np.ptp(vertices, axis=0)
+    return PreparedMesh(file, triangles, flat, (float(extent[0]), float(extent[1]), float(extent[2])))
+
+
+def _flat(vertices: np.ndarray) -> bool:
+    """All vertices in one plane (or on a line, or one point), to a relative tolerance."""
+    if len(vertices) < 4:
+        return True
+    centred = vertices - vertices.mean(axis=0)
+    size = float(np.ptp(centred, axis=0).max())
+    if size == 0.0:
+        return True
+    _, axes = np.linalg.eigh(centred.T @ centred)
+    thickness = float(np.ptp(centred @ axes[:, 0]))
+    return thickness <= _FLAT * size
+
+
+def _collada_unit(path: Path) -> float:
+    """`<asset><unit meter="..."/>` of a COLLADA file: metres per unit of its coordinates (1 without)."""
+    from lxml import etree
+
+    meter = "1"
+    for _, el in etree.iterparse(str(path), events=("end",), recover=True, huge_tree=True):
+        tag = etree.QName(el).localname if isinstance(el.tag, str) else ""
+        if tag == "unit" and el.getparent() is not None and etree.QName(el.getparent()).localname == "asset":
+            meter = el.get("meter", "1")
+        if tag == "asset":
+            break
+    try:
+        value = float(meter)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise _error(path, f'<unit meter="{meter}"> is not a positive number')
+    return value
+
+
+def _convert(path: Path, data: bytes) -> PreparedMesh:
+    """The mesh as MuJoCo reads it (binary STL, or OBJ past 200000 triangles), cached by what makes it."""
+    import trimesh
+
+    suffix = path.suffix.lower()
+    recipe = f"{_RECIPE}\0{suffix}\0trimesh {trimesh.__version__}\0".encode()
+    key = hashlib.sha256(recipe + data).hexdigest()[:24]
+    cache = mesh_cache()
+    for ext in (".stl", ".obj"):
+        cached = cache / f"{key}{ext}"
+        if cached.is_file():
+            return prepare_mesh(cached) if ext == ".stl" else _obj(cached, cached.read_bytes())
+    what = "ASCII STL" if suffix == ".stl" else suffix or "this format"
+    try:
+        loaded = trimesh.load(path, file_type=suffix.lstrip(".") or None, force="mesh")
+        if suffix == ".dae":
+            unit = _collada_unit(path)
+            if unit != 1.0:
+                loaded.apply_scale(unit)
+    except MeshError:
+        raise
     except Exception as e:
-        raise MeshError(
-            f"mesh {path.name}: cannot convert {path.suffix} to a format MuJoCo reads "
-            f"({type(e).__name__}: {e})"
+        raise _error(
+            path,
+            f"cannot convert {what} to a format MuJoCo reads ({_why(e)})",
+            hint="export it as binary STL or OBJ",
         ) from None
-    return out
+    if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
+        raise _error(
+            path,
+            "the mesh has no triangles (nothing to draw or collide with)",
+            hint="export the mesh again; lines and points are not meshes",
+        )
+    ext = ".stl" if len(loaded.faces) <= MAX_STL_TRIANGLES else ".obj"
+    out = cache / f"{key}{ext}"
+    prepared = _looked_at(out, np.asarray(loaded.vertices, dtype=np.float64), len(loaded.faces), path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(f"{out.name}.{os.getpid()}.tmp")
+    loaded.export(tmp, file_type=ext.lstrip("."))
+    tmp.replace(out)
+    return prepared

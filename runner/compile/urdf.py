@@ -2,8 +2,13 @@
 
 - `fusestatic`/`discardvisual` are off, so fixed-joint links (lidar_link, imu_link) stay bodies a sensor
   can be mounted on and visuals are kept (group 1, no collision);
-- mesh URIs (`package://`, `model://`, `file://`, relative) are rewritten to real paths; Collada (and other
-  formats MuJoCo cannot read) are converted to STL with trimesh;
+- mesh URIs (`package://`, `model://`, `file://`, relative) are rewritten to real paths; Collada (in its
+  `<unit>`), ASCII STL and other formats MuJoCo cannot read are converted (runner.compile.meshes);
+- a mesh that cannot be had (package or file not found, unreadable, a Git LFS pointer, broken, no
+  triangles) is an error when a `<collision>` uses it: the robot would fall through the floor or drive
+  through walls. When a `<visual>` uses it, the visual is left out with a warning (file:line), as Gazebo
+  goes on without it: visuals only matter to cameras and renders. A flat mesh (no volume) may be drawn but
+  not collided with (MuJoCo collides with convex hulls): an error in a `<collision>`;
 - `<gazebo>` tags are read (runner.compile.gazebo): materials, friction, contact stiffness, gravity, sensors
   and plugins;
 - `<transmission>` (ROS 1 style) and `<ros2_control>` joints are collected so the compiler can give them
@@ -24,7 +29,7 @@ from lxml import etree
 
 from runner.compile.gazebo import GazeboInfo, parse, read_gazebo
 from runner.compile.locate import Locator
-from runner.compile.meshes import MUJOCO_MESH_FORMATS, MeshError, convert_mesh
+from runner.compile.meshes import MeshError, PreparedMesh, prepare_mesh
 from runner.compile.packages import PackageMap, resolve_uri
 from runner.errors import Notices, SourceError
 
@@ -206,9 +211,10 @@ def urdf_to_model(
     root_link = _check_structure(root, where)
     _check_numbers(root, where)
 
-    for mesh in root.iter("mesh"):
-        if mesh.getparent() is not None and mesh.getparent().tag == "geometry":
-            _rewrite_mesh(mesh, packages, base_dir, where, notices)
+    shell: set[str] = set()  # mesh files without a volume (flat or tiny): MuJoCo weighs them as shells
+    meshes = [m for m in root.iter("mesh") if m.getparent() is not None and m.getparent().tag == "geometry"]
+    for mesh in meshes:  # a list: a mesh that cannot be had takes its <visual> out of the tree
+        _rewrite_mesh(mesh, packages, base_dir, where, notices, shell)
 
     gazebo = read_gazebo(
         root,
@@ -235,6 +241,10 @@ def urdf_to_model(
     except ValueError as e:
         raise _mujoco_error(e, root, text, where, file) from None
 
+    for mesh_asset in spec.meshes:
+        if mesh_asset.file in shell:
+            # its volume is zero: MuJoCo's default (volume) inertia refuses it, a shell's does not
+            mesh_asset.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
     for geom in spec.geoms:
         if geom.contype or geom.conaffinity:
             geom.group = COLLISION_GROUP
@@ -295,33 +305,79 @@ def _apply_link_props(spec: mujoco.MjSpec, gazebo: GazeboInfo, timestep: float) 
                 geom.solref = [max(2.0 * timestep, 2.0 * math.pi * math.sqrt(mass / props.kp)), 1.0]
 
 
-def _rewrite_mesh(mesh: Any, packages: PackageMap, base_dir: Path, where: Any, notices: Notices) -> None:
+class _NoMesh(Exception):
+    """Why a <mesh> cannot be used, and a hint."""
+
+    def __init__(self, message: str, hint: str | None):
+        super().__init__(message)
+        self.hint = hint
+
+
+# A mesh whose bounding box (scaled) holds less than this (m^3) has no volume MuJoCo can weigh (it needs
+# 1e-15): a 10 um part, or a unit mistake.
+_TINY_VOLUME = 1e-12
+
+
+def _rewrite_mesh(
+    mesh: Any, packages: PackageMap, base_dir: Path, where: Any, notices: Notices, shell: set[str]
+) -> None:
+    """Point `mesh` at a file MuJoCo reads. What cannot be had is an error in a <collision>, a warning
+    in a <visual>, which is then left out (the module's docstring says why)."""
+    role_el = mesh.getparent().getparent()  # <visual> or <collision>
+    visual = role_el is not None and role_el.tag == "visual"
     uri = mesh.get("filename", "")
+    location = where(mesh)  # before the filename is rewritten: xacro sources are searched for it
+    try:
+        prepared = _find_mesh(uri, packages, base_dir)
+    except _NoMesh as e:
+        if not visual:
+            raise DescriptionError(str(e), *location, hint=e.hint) from None
+        notices.add(f"visual {e}; the visual is left out", *location, hint=e.hint)
+        link = role_el.getparent()
+        if link is not None:
+            link.remove(role_el)
+        return
+    scale = _scale(mesh)
+    flat = prepared.flat or 0.0 in scale
+    if flat and not visual:
+        raise DescriptionError(
+            f"collision mesh {uri!r} is flat (all its vertices lie in one plane): MuJoCo collides with a "
+            "mesh's convex hull, which needs a volume",
+            *location,
+            hint="give this <collision> a thin <box> instead (Gazebo takes flat meshes, MuJoCo does not)",
+        )
+    volume = math.prod(abs(x * k) for x, k in zip(prepared.extent, scale, strict=True))
+    if flat or (prepared.triangles and volume < _TINY_VOLUME):
+        shell.add(str(prepared.file))
+    mesh.set("filename", str(prepared.file))
+
+
+def _find_mesh(uri: str, packages: PackageMap, base_dir: Path) -> PreparedMesh:
     path = resolve_uri(uri, packages, base_dir)
     if path is None:
         pkg = uri.split("/")[2] if "://" in uri else uri
-        raise DescriptionError(
+        raise _NoMesh(
             f"mesh {uri!r}: package {pkg!r} not found",
-            *where(mesh),
-            hint="add it under `packages:` in the scenario; searched: " + ", ".join(packages.searched()),
+            "add it under `packages:` in the scenario; searched: " + ", ".join(packages.searched()),
         )
     if not path.is_file():
-        raise DescriptionError(
+        raise _NoMesh(
             f"mesh {uri!r} not found (looked at {path})",
-            *where(mesh),
-            hint="check the file name and its case; package:// paths are relative to the package folder",
+            "check the file name and its case; package:// paths are relative to the package folder",
         )
-    path = path.resolve()
-    if path.suffix.lower() not in MUJOCO_MESH_FORMATS:
-        path = _convert_mesh(path, mesh, where)
-    mesh.set("filename", str(path))
-
-
-def _convert_mesh(path: Path, mesh: Any, where: Any) -> Path:
     try:
-        return convert_mesh(path)
+        return prepare_mesh(path.resolve())
     except MeshError as e:
-        raise DescriptionError(str(e), *where(mesh), hint="export it as STL or OBJ") from None
+        raise _NoMesh(f"mesh {uri!r}: {e.reason}", e.hint or "export it as binary STL or OBJ") from None
+
+
+def _scale(mesh: Any) -> tuple[float, float, float]:
+    """The <mesh scale="x y z">; MuJoCo reports a malformed one."""
+    try:
+        values = [float(v) for v in (mesh.get("scale") or "1 1 1").split()]
+    except ValueError:
+        return (1.0, 1.0, 1.0)
+    return (values[0], values[1], values[2]) if len(values) == 3 else (1.0, 1.0, 1.0)
 
 
 _INTERFACES: dict[str, Literal["position", "velocity", "effort"]] = {
