@@ -3,9 +3,11 @@
 Uses MuJoCo's own sensors on a site at the IMU link (gyro, accelerometer, framequat). As on a real IMU
 and in Gazebo, linear acceleration includes the reaction to gravity (+9.81 m/s² up at rest).
 
-Errors, per axis in the IMU frame: a constant bias (`*_bias`, plus a random part drawn once at setup from
-`*_bias_stddev` with the plugin's seeded generator, so a run is repeatable) and white Gaussian noise
-(`*_stddev`, drawn at every message). The covariances in the message are those of the white noise.
+Errors, per axis in the IMU frame: a constant bias (`*_bias`, plus a random part drawn once at setup with
+the plugin's seeded generator, so a run is repeatable) and white Gaussian noise (`*_stddev`, drawn at every
+message). The random part is Gazebo's IMU noise bias: drawn from N(`*_bias_mean`, `*_bias_stddev`) and, where
+`*_bias_mean` is not zero, negated with probability 1/2 (SDF `<bias_mean>`, `<bias_stddev>`). The covariances
+in the message are those of the white noise.
 """
 
 from __future__ import annotations
@@ -42,6 +44,16 @@ class ImuParams(RatedParams):
     linear_acceleration_bias_stddev: float = Field(
         0.0, ge=0, description="Random bias per axis, drawn once at start (Gaussian), m/s²."
     )
+    angular_velocity_bias_mean: Vector3 = Field(
+        (0.0, 0.0, 0.0),
+        description="Mean of the random bias per axis, rad/s; its sign is drawn at start (+ or -, as "
+        "Gazebo's <bias_mean>).",
+    )
+    linear_acceleration_bias_mean: Vector3 = Field(
+        (0.0, 0.0, 0.0),
+        description="Mean of the random bias per axis, m/s²; its sign is drawn at start (+ or -, as "
+        "Gazebo's <bias_mean>).",
+    )
 
 
 class Imu(Plugin):
@@ -77,10 +89,12 @@ class Imu(Plugin):
         self.bias_w = np.array(p.angular_velocity_bias, dtype=float)
         self.bias_a = np.array(p.linear_acceleration_bias, dtype=float)
         # drawn only when asked for, so that the noise sequence of a scenario without them is unchanged
-        if p.angular_velocity_bias_stddev:
-            self.bias_w += self.ctx.rng.normal(0.0, p.angular_velocity_bias_stddev, 3)
-        if p.linear_acceleration_bias_stddev:
-            self.bias_a += self.ctx.rng.normal(0.0, p.linear_acceleration_bias_stddev, 3)
+        self.bias_w += _random_bias(
+            self.ctx.rng, p.angular_velocity_bias_mean, p.angular_velocity_bias_stddev
+        )
+        self.bias_a += _random_bias(
+            self.ctx.rng, p.linear_acceleration_bias_mean, p.linear_acceleration_bias_stddev
+        )
         T = msgs.T
         template = T["sensor_msgs/msg/Imu"](
             header=msgs.header(0, self.frame_id),
@@ -124,6 +138,17 @@ class Imu(Plugin):
         qw, qx, qy, qz = q.tolist()
         _QUAT.pack_into(buf, self.at_q, qx, qy, qz, qw)
         self.pub.publish_cdr(self.layout.encode(now_ns), now_ns)
+
+
+def _random_bias(rng: np.random.Generator, mean: Vector3, stddev: float) -> np.ndarray:
+    """Gazebo's noise bias, per axis: N(mean, stddev), negated with probability 1/2 (the sign is drawn only
+    where the mean is not zero: a zero-mean bias is symmetric already)."""
+    bias = np.array(mean, dtype=float)
+    if stddev:
+        bias += rng.normal(0.0, stddev, 3)
+    if any(mean):
+        bias *= np.where(rng.random(3) < 0.5, -1.0, 1.0)
+    return bias
 
 
 _VEC = struct.Struct("<3d")

@@ -1,18 +1,21 @@
 """URDF `<gazebo>` extension tags -> our plugins and MuJoCo properties (Gazebo classic and Harmonic).
 
 - `<gazebo reference="link">`: materials (`Gazebo/Red`, or `<material><diffuse>`), `mu1`/`mu2` (friction),
-  `kp`/`kd` (contact stiffness and damping), `turnGravityOff`/`gravity`, and `<sensor>`s;
+  `kp`/`kd` (contact stiffness and damping), `turnGravityOff`/`gravity`, and `<sensor>`s; these keys as text
+  or, as Gazebo's URDF parser also takes them, as a `value` attribute (`<mu1 value="0.5"/>`);
 - `<gazebo>` (no reference): model plugins (`<plugin filename=...>`) and `<static>`;
 - sensors: ray/gpu_ray/lidar/gpu_lidar -> `lidar`; camera -> `camera`; depth/depth_camera/rgbd_camera ->
-  `depth_camera`; imu -> `imu`; with the topic names their ROS plugin (classic `topicName`,
-  `cameraName`+`imageTopicName`, ROS 2 `<ros><remapping>`) or Harmonic `<topic>` gives, placed under the
-  robot's namespace.
+  `depth_camera`; imu -> `imu` (SDF noise with its bias); with the topic names their ROS plugin gives
+  (classic `topicName`, `cameraName`+`imageTopicName`..., ROS 2 `<camera_name>` or the sensor's name and
+  `<ros><remapping>`) or Harmonic `<topic>`, placed under the robot's namespace, and the rate of the sensor
+  as the plugin throttles it (classic `<updateRate>`).
 
 What is not understood is listed as a notice (tag, file, line), never dropped silently and never fatal.
 """
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -82,10 +85,15 @@ class GazeboInfo:
 
 
 class _Reader:
-    """Reads children of one element by any of several spellings and remembers which were used."""
+    """Reads children of one element by any of several spellings and remembers which were used.
 
-    def __init__(self, el: Any):
+    `attr_values`: a child's `value` attribute stands for its text, as in the URDF extension keys of a
+    `<gazebo>` block (`<mu1 value="0.5"/>` is `<mu1>0.5</mu1>` to Gazebo's URDF parser, the attribute
+    winning when both are given). Plugin and sensor parameters are SDF and have no such form."""
+
+    def __init__(self, el: Any, attr_values: bool = False):
         self.el = el
+        self.attr_values = attr_values
         self.used: set[str] = set()
 
     def child(self, *names: str) -> Any | None:
@@ -107,9 +115,11 @@ class _Reader:
 
     def text(self, *names: str) -> str | None:
         el = self.child(*names)
-        if el is None or el.text is None:
+        if el is None:
             return None
-        return el.text.strip()
+        if self.attr_values and el.get("value") is not None:
+            return str(el.get("value")).strip()
+        return el.text.strip() if el.text is not None else None
 
     def float(self, *names: str) -> float | None:
         t = self.text(*names)
@@ -259,7 +269,7 @@ class GazeboReader:
         self.info.plugins = [p for p in self.info.plugins if p in keep]
 
     def _reference(self, gz: Any, link: str) -> None:
-        r = _Reader(gz)
+        r = _Reader(gz, attr_values=True)
         props = self.info.links.setdefault(link, LinkProps())
         mat = r.child("material")
         if mat is not None:
@@ -292,10 +302,11 @@ class GazeboReader:
         self.ignored(r, f'<gazebo reference="{link}">')
 
     def _material(self, el: Any) -> tuple[float, float, float, float] | None:
-        if el.text and el.text.strip():
-            rgba = gazebo_material(el.text)
+        name = el.get("value") or el.text  # <material value="Gazebo/Red"/> is <material>Gazebo/Red</material>
+        if name and name.strip():
+            rgba = gazebo_material(name)
             if rgba is None:
-                self.note(el, f"unknown Gazebo material {el.text.strip()!r}; the URDF colour is kept")
+                self.note(el, f"unknown Gazebo material {name.strip()!r}; the URDF colour is kept")
             return rgba
         script = el.find("script/name")
         if script is not None and script.text:
@@ -312,7 +323,7 @@ class GazeboReader:
         return None
 
     def _model(self, gz: Any) -> None:
-        r = _Reader(gz)
+        r = _Reader(gz, attr_values=True)
         if r.bool("static"):
             self.info.static = True
         for plugin in r.children("plugin"):
@@ -330,7 +341,7 @@ class GazeboReader:
         rate = r.float("update_rate", "updateRate")
         pose = _floats(r.text("pose"), 6)
         base_topic = _topic(r.text("topic"))
-        frame = self.frame(r.text("gz_frame_id", "frame_id", "frameName"))
+        frame = self.frame(r.text("gz_frame_id", "ignition_frame_id", "frame_id", "frameName"))
         plugins = r.children("plugin")
         common: dict[str, Any] = {"link": link}
         if rate:
@@ -339,28 +350,33 @@ class GazeboReader:
             common["pose"] = {"xyz": pose[:3], "rpy": pose[3:]}
         if kind in ("ray", "gpu_ray", "lidar", "gpu_lidar"):
             params = {**common, **self._lidar(r, el, context)}
-            ros = self._sensor_plugins(plugins, context, ("out", "scan"))
+            ros = self._sensor_plugins(plugins, context, ("out", "scan"), name, kind)
             params["topic"] = ros.get("topic") or base_topic or "scan"
             params["frame_id"] = ros.get("frame") or frame
+            if ros.get("noise"):  # gazebo_ros_block_laser adds its <gaussianNoise> to the sensor's noise
+                params["noise_stddev"] = math.hypot(params.get("noise_stddev", 0.0), ros["noise"])
             self.add(el, "lidar", name, params, implicit=not (ros or base_topic))
         elif kind == "camera":
             params = {**common, **self._camera(r, el, context)}
-            ros = self._sensor_plugins(plugins, context, ("image_raw", "image"))
+            ros = self._sensor_plugins(plugins, context, ("image_raw", "image"), name, kind)
             image = ros.get("topic") or (_join(base_topic, "image") if base_topic else "camera/image_raw")
             params["image_topic"] = image
             params["info_topic"] = ros.get("info") or _sibling(image, "camera_info")
             params["frame_id"] = ros.get("frame") or frame
+            self._plugin_rate(params, rate, ros)
             self.add(el, "camera", name, params, implicit=not (ros or base_topic))
         elif kind in ("depth", "depth_camera", "rgbd_camera", "rgbd"):
             params = {**common, **self._camera(r, el, context)}
-            ros = self._sensor_plugins(plugins, context, ("image_raw", "image"))
+            ros = self._sensor_plugins(plugins, context, ("image_raw", "image"), name, kind)
+            info_topic = _topic(el.findtext("camera/camera_info_topic"))  # gz-sensors; no ROS plugin reads it
             if not ros and kind in ("depth", "depth_camera"):
-                # Harmonic depth camera: depth image on <topic>, points on <topic>/points
+                # Harmonic depth camera: depth image on <topic>, points on <topic>/points, CameraInfo beside
                 topic = base_topic or "depth_camera"
                 params.update(
                     depth_topic=topic,
                     points_topic=_join(topic, "points"),
                     info_topic=_sibling(topic, "camera_info"),
+                    depth_info_topic=info_topic or _sibling(topic, "camera_info"),
                     publish_color=False,
                 )
             elif not ros:
@@ -370,36 +386,39 @@ class GazeboReader:
                     image_topic=_join(topic, "image"),
                     depth_topic=_join(topic, "depth_image"),
                     points_topic=_join(topic, "points"),
-                    info_topic=_join(topic, "camera_info"),
+                    info_topic=info_topic or _join(topic, "camera_info"),
                 )
             else:
-                cam = ros.get("camera") or "camera"
                 params.update(
-                    image_topic=ros.get("topic") or _join(cam, "image_raw"),
-                    depth_topic=ros.get("depth") or _join(cam, "depth/image_raw"),
-                    points_topic=ros.get("points") or _join(cam, "points"),
-                    info_topic=ros.get("info") or _join(cam, "camera_info"),
+                    image_topic=ros["topic"],
+                    info_topic=ros["info"],
+                    depth_topic=ros["depth"],
+                    depth_info_topic=ros["depth_info"],
+                    points_topic=ros["points"],
                 )
-            info_topic = _topic(el.findtext("camera/camera_info_topic"))
-            if info_topic:
-                params["info_topic"] = info_topic
             params["frame_id"] = ros.get("frame") or frame
+            self._plugin_rate(params, rate, ros)
             self.add(el, "depth_camera", name, params)
         elif kind == "imu":
-            params = {**common, **self._imu(r, el)}
-            ros = self._sensor_plugins(plugins, context, ("out", "imu"))
+            params = {**common, **self._imu(r, el, context)}
+            ros = self._sensor_plugins(plugins, context, ("out", "imu"), name, kind)
             params["topic"] = ros.get("topic") or base_topic or "imu"
             params["frame_id"] = ros.get("frame") or frame
-            if ros.get("noise") and not params.get("angular_velocity_stddev"):
-                params["angular_velocity_stddev"] = ros["noise"]
-                params["linear_acceleration_stddev"] = ros["noise"]
+            noise = ros.get("noise")
+            if noise:
+                # ROS 1 gazebo_ros_imu_sensor adds N(0, gaussianNoise) to every rate, acceleration and
+                # quaternion component, on top of the sensor's own noise
+                for key in ("angular_velocity_stddev", "linear_acceleration_stddev"):
+                    params[key] = math.hypot(params.get(key, 0.0), noise)
+                params["orientation_stddev"] = 2.0 * noise  # a quaternion component of s is an angle of 2s
+            self._plugin_rate(params, rate, ros)
             self.add(el, "imu", name, params, implicit=not (ros or base_topic))
         elif kind == "contact":
             if link is None:
                 self.note(el, f"{context} outside a <gazebo reference=...> block has no link; ignored")
                 return
             r.child("contact")  # <collision> names: we report every contact of the link
-            ros = self._sensor_plugins(plugins, context, ("bumper_states", "bumper"))
+            ros = self._sensor_plugins(plugins, context, ("bumper_states", "bumper"), name, kind)
             params = {**common, "topic": ros.get("topic") or base_topic or "bumper"}
             params["frame_id"] = ros.get("frame") or frame
             self.add(el, "contact", name, params)
@@ -413,20 +432,59 @@ class GazeboReader:
             return
         self.ignored(r, context)
 
-    def _noise(self, el: Any | None) -> float | None:
-        if el is None:
+    @staticmethod
+    def _plugin_rate(params: dict[str, Any], sensor_rate: float | None, ros: dict[str, Any]) -> None:
+        """A ROS 1 plugin's own rate (camera `<updateRate>`, imu `<updateRateHZ>`) throttles the sensor: the
+        plugin publishes a frame when at least 1/rate has passed since the last one it published. With a
+        sensor `<update_rate>` as well, it publishes every ceil(sensor / plugin)-th frame (30 and 10 Hz: 10;
+        10 and 30 Hz: 10; 30 and 20 Hz: 15); without one (Gazebo: as fast as possible), at its own rate."""
+        plugin_rate = ros.get("rate")
+        if not plugin_rate or plugin_rate <= 0:
+            return
+        if sensor_rate and sensor_rate > 0:
+            params["rate"] = sensor_rate / max(1, math.ceil(sensor_rate / plugin_rate - 1e-9))
+        else:
+            params["rate"] = plugin_rate
+
+    def _noise(self, parent: Any | None, what: str = "this sensor") -> float | None:
+        """The stddev of a `<noise>` under `parent`; a mean or bias is not modelled here (reported)."""
+        spec = self._noise_spec(parent)
+        if spec is None:
             return None
-        noise = el.find("noise")
+        if spec.mean:
+            self.note(
+                spec.el, f"a non-zero noise <mean> is ignored for {what} (use a bias in the plugin params)"
+            )
+        if spec.bias_mean or spec.bias_stddev:
+            self.note(spec.el, f"a noise bias (<bias_mean>, <bias_stddev>) is not modelled for {what}")
+        return spec.stddev or None
+
+    def _noise_spec(self, parent: Any | None) -> _NoiseSpec | None:
+        """SDF `<noise>` (gaussian, with a bias drawn once per run from N(bias_mean, bias_stddev) with a
+        random sign); what it has that we do not model (quantization, dynamic bias) is reported."""
+        if parent is None:
+            return None
+        noise = parent.find("noise")
         if noise is None:
             return None
         kind = (noise.get("type") or noise.findtext("type") or "gaussian").strip()
+        if kind.lower() == "none":
+            return None
         if kind.lower() not in ("gaussian", "gaussian_quantized"):
             self.note(noise, f"noise type {kind!r} is treated as gaussian")
-        mean = noise.findtext("mean")
-        if mean and float(mean) != 0.0:
-            self.note(noise, "a non-zero noise mean is ignored (use a bias in the plugin params)")
-        sd = noise.findtext("stddev")
-        return float(sd) if sd else None
+
+        def num(tag: str) -> float:
+            text = noise.findtext(tag)
+            return float(text) if text and text.strip() else 0.0
+
+        for child in noise:
+            if not isinstance(child.tag, str) or child.tag in _NOISE_TAGS:
+                continue
+            if child.tag == "precision" and (child.text or "").strip() and float(child.text) != 0.0:
+                self.note(child, "noise <precision> is ignored (readings are not quantized)")
+            elif child.tag != "precision" and not _zero(child.text):
+                self.note(child, f"noise <{child.tag}> is ignored")
+        return _NoiseSpec(num("stddev"), num("mean"), num("bias_mean"), num("bias_stddev"), noise)
 
     def _lidar(self, r: _Reader, el: Any, context: str) -> dict[str, Any]:
         ray = r.child("ray", "lidar")
@@ -457,7 +515,7 @@ class GazeboReader:
             _put(out, "range_min", rng, "min")
             _put(out, "range_max", rng, "max")
             _put(out, "resolution", rng, "resolution")
-        noise = self._noise(ray)
+        noise = self._noise(ray, "a lidar")
         if noise:
             out["noise_stddev"] = noise
         known = {"scan", "range", "noise", "visibility_mask"}
@@ -491,7 +549,7 @@ class GazeboReader:
             out["near"] = float(near)
         if far:
             out["far"] = float(far)
-        noise = self._noise(cam)
+        noise = self._noise(cam, "a camera")
         if noise:
             out["noise_stddev"] = noise
         known = {"horizontal_fov", "image", "clip", "noise", "camera_info_topic", "depth_camera"}
@@ -500,28 +558,62 @@ class GazeboReader:
                 self.note(child, f"<{child.tag}> in {context} <camera> is ignored")
         return out
 
-    def _imu(self, r: _Reader, el: Any) -> dict[str, Any]:
+    def _imu(self, r: _Reader, el: Any, context: str) -> dict[str, Any]:
+        """SDF imu noise, per axis: white noise (its stddev; the largest of the axes, as our imu takes one),
+        a constant <mean>, and a bias drawn once per run from N(bias_mean, bias_stddev) with a random sign."""
         imu = r.child("imu")
         out: dict[str, Any] = {}
         if imu is None:
             return out
-        for block, key in (
-            ("angular_velocity", "angular_velocity_stddev"),
-            ("linear_acceleration", "linear_acceleration_stddev"),
-        ):
-            sds = [self._noise(imu.find(f"{block}/{axis}")) for axis in ("x", "y", "z")]
-            sds = [s for s in sds if s]
-            if sds:
-                out[key] = max(sds)
-        # classic (SDF 1.4) style: <imu><noise><rate><stddev>, <accel><stddev>
+        for key in ("angular_velocity", "linear_acceleration"):
+            specs = [self._noise_spec(imu.find(f"{key}/{axis}")) for axis in ("x", "y", "z")]
+            self._imu_noise(out, key, specs)
+        # classic (SDF 1.4) style: <imu><noise><type/><rate>..</rate><accel>..</accel></noise>, for all axes
         n = imu.find("noise")
         if n is not None:
-            _put(out, "angular_velocity_stddev", n, "rate/stddev")
-            _put(out, "linear_acceleration_stddev", n, "accel/stddev")
+            for block, key in (("rate", "angular_velocity"), ("accel", "linear_acceleration")):
+                spec = self._noise_spec_classic(n, block)
+                if spec is not None:
+                    self._imu_noise(out, key, [spec] * 3)
+        for child in imu:
+            if isinstance(child.tag, str) and child.tag not in _IMU_TAGS:
+                self.note(child, f"<{child.tag}> in {context} <imu> is ignored")
         return out
 
-    def _sensor_plugins(self, plugins: list[Any], context: str, out_names: tuple[str, ...]) -> dict[str, Any]:
-        """The ROS plugin inside a sensor: where it publishes (classic and ROS 2 spellings)."""
+    def _noise_spec_classic(self, noise: Any, block: str) -> _NoiseSpec | None:
+        el = noise.find(block)
+        if el is None:
+            return None
+        kind = (noise.findtext("type") or "gaussian").strip().lower()
+        if kind == "none":
+            return None
+
+        def num(tag: str) -> float:
+            text = el.findtext(tag)
+            return float(text) if text and text.strip() else 0.0
+
+        return _NoiseSpec(num("stddev"), num("mean"), num("bias_mean"), num("bias_stddev"), el)
+
+    @staticmethod
+    def _imu_noise(out: dict[str, Any], key: str, specs: list[_NoiseSpec | None]) -> None:
+        if not any(specs):
+            return
+        s = [spec or _NoiseSpec() for spec in specs]
+        sd = max(x.stddev for x in s)
+        if sd:
+            out[f"{key}_stddev"] = sd
+        if any(x.mean for x in s):  # Gazebo adds the white noise's mean to every reading: a constant bias
+            out[f"{key}_bias"] = [x.mean for x in s]
+        if any(x.bias_mean for x in s):
+            out[f"{key}_bias_mean"] = [x.bias_mean for x in s]
+        bias_sd = max(x.bias_stddev for x in s)
+        if bias_sd:
+            out[f"{key}_bias_stddev"] = bias_sd
+
+    def _sensor_plugins(
+        self, plugins: list[Any], context: str, out_names: tuple[str, ...], sensor: str, kind: str
+    ) -> dict[str, Any]:
+        """The ROS plugin inside a sensor: where it publishes (classic and ROS 2 spellings), its own rate."""
         found: dict[str, Any] = {}
         for p in plugins:
             filename = p.get("filename", "")
@@ -536,77 +628,185 @@ class GazeboReader:
                 continue
             ros = self._ros_block(r)
             remap = ros["remap"]
-            cam = _topic(r.text("cameraName", "camera_name"))
-            if cam:
-                found["camera"] = cam
-            prefix = cam if base in _CAMERA_PLUGINS else None
-            topic = _topic(r.text("topicName", "topic_name", "bumperTopicName"))
-            image = _topic(r.text("imageTopicName", "image_topic_name"))
-            info = _topic(r.text("cameraInfoTopicName", "camera_info_topic_name"))
-            depth = _topic(r.text("depthImageTopicName", "depth_image_topic_name"))
-            points = _topic(r.text("pointCloudTopicName", "point_cloud_topic_name"))
-            for out in out_names:
-                if out in remap:
-                    topic = topic or remap[out]
+            rates: tuple[str, ...] = ()
             if base in _CAMERA_PLUGINS:
-                image = image or remap.get("image_raw") or "image_raw"
-                info = info or remap.get("camera_info") or "camera_info"
-                depth = depth or remap.get("depth/image_raw") or "depth/image_raw"
-                points = points or remap.get("points") or "points"
-                found["topic"] = _join(prefix, image)
-                found["info"] = _join(prefix, info)
-                found["depth"] = _join(prefix, depth)
-                found["points"] = _join(prefix, points)
-                found["color"] = True
-            elif topic:
-                found["topic"] = topic
-            frame = r.text("frameName", "frame_name")
-            if frame:
-                found["frame"] = self.frame(frame)
-            noise = r.float("gaussianNoise")
-            if noise:
-                found["noise"] = noise
+                found.update(self._camera_plugin(r, filename, base, remap, sensor, kind, context))
+                rates = () if found["ros2"] else ("updateRate",)
+            else:
+                frame = r.text("frameName", "frame_name")
+                if frame:
+                    found["frame"] = self.frame(frame)
+                topic = _topic(r.text("topicName", "topic_name", "bumperTopicName"))
+                for out in out_names:
+                    if out in remap:
+                        topic = topic or remap[out]
+                if topic:
+                    found["topic"] = topic
+                ros2 = any(
+                    p.find(t) is not None for t in ("ros", "frame_name", "initial_orientation_as_reference")
+                )
+                if base == "gazebo_ros_imu_sensor" and not ros2:
+                    # ROS 1: <updateRateHZ> throttles, <gaussianNoise> adds to the sensor's noise
+                    rates = ("updateRateHZ",)
+                    found["noise"] = r.float("gaussianNoise")
+                    offset = r.text("rpyOffset")
+                    if offset is not None and (_floats(offset, 3) is None or any(_floats(offset, 3) or [])):
+                        self.note(p.find("rpyOffset"), f"<rpyOffset> in {context} is ignored")
+                    r.mark("xyzOffset")  # read and unused by the plugin itself
+                elif base == "gazebo_ros_block_laser":
+                    found["noise"] = r.float("gaussianNoise")
+                if base == "gazebo_ros_imu_sensor" and r.bool("initial_orientation_as_reference"):
+                    self.note(
+                        p.find("initial_orientation_as_reference"),
+                        "<initial_orientation_as_reference> true is ignored: the orientation is reported "
+                        "in the world frame (REP 145), as with false",
+                    )
+                out_type = r.text("output_type")
+                if out_type and out_type.split("/")[-1] != "LaserScan":
+                    self.note(p.find("output_type"), f"<output_type> {out_type} is published as a LaserScan")
+            for tag in rates:
+                value = r.float(tag)
+                if value and value > 0:
+                    found["rate"] = value
+            for tag in ("updateRate", "update_rate", "updateRateHZ"):
+                el = p.find(tag)
+                if el is None or tag in rates:
+                    continue
+                r.mark(tag)
+                if not _zero(el.text):
+                    self.note(
+                        el,
+                        f"<{tag}> is not read by {filename!r}"
+                        + (" (ROS 2)" if found.get("ros2") else "")
+                        + ": Gazebo ignores it too; the sensor's <update_rate> sets the rate",
+                    )
             r.mark(
                 "alwaysOn",
                 "always_on",
-                "updateRate",
-                "update_rate",
                 "robotNamespace",
                 "bodyName",
                 "output_type",
                 "min_intensity",
-                "pointCloudCutoff",
-                "pointCloudCutoffMax",
-                "Cx",
-                "Cy",
-                "CxPrime",
-                "focalLength",
-                "distortionK1",
-                "distortionK2",
-                "distortionK3",
-                "distortionT1",
-                "distortionT2",
-                "distortion_k1",
-                "distortion_k2",
-                "distortion_k3",
-                "distortion_t1",
-                "distortion_t2",
-                "hack_baseline",
-                "hackBaseline",
-                "updateRateHZ",
+                "hokuyoMinIntensity",
+                "initial_orientation_as_reference",
+                "radiation_type",
                 "min_range",
                 "max_range",
-                "initial_orientation_as_reference",
             )
-            nonzero = [
-                t
-                for t in ("distortionK1", "distortionK2", "distortionK3", "distortionT1", "distortionT2")
-                if (p.findtext(t) or "0").strip() not in ("0", "0.0", "0.00000000")
-            ]
-            for t in nonzero:
-                self.note(p.find(t), f"<{t}> in {context} is ignored (images are not distorted)")
             self.ignored(r, f"<plugin filename={filename!r}>")
-        return found
+        found.pop("ros2", None)
+        return {k: v for k, v in found.items() if v is not None}
+
+    def _camera_plugin(
+        self,
+        r: _Reader,
+        filename: str,
+        base: str,
+        remap: dict[str, str],
+        sensor: str,
+        kind: str,
+        context: str,
+    ) -> dict[str, Any]:
+        """Topics of the gazebo_ros camera plugins.
+
+        ROS 2 (gazebo_ros_pkgs for ROS 2, `libgazebo_ros_camera.so`): `<camera_name>` (default: the sensor's
+        name) + `/image_raw`, `/camera_info`, and for depth sensors `/depth/image_raw`, `/depth/camera_info`,
+        `/points`; `<ros><remapping>` rules match those whole names, as ROS 2 remapping does
+        (`mycam/image_raw:=mycam/image_demo`). The rate is the sensor's `<update_rate>`.
+
+        ROS 1 (`libgazebo_ros_camera.so`, `libgazebo_ros_depth_camera.so`, `libgazebo_ros_openni_kinect.so`):
+        `<cameraName>` (default: none) + `imageTopicName` (image_raw), `cameraInfoTopicName` (camera_info),
+        `depthImageTopicName` (depth/image_raw), `depthImageCameraInfoTopicName` (depth/camera_info),
+        `pointCloudTopicName` (points); a name with a leading '/' is not under `<cameraName>`.
+        `<updateRate>` throttles the sensor (see `_plugin_rate`).
+
+        The same file name is both: a `<ros>` block, `<camera_name>` or `<frame_name>` is ROS 2; otherwise
+        ROS 1 naming tags or `<updateRate>` are ROS 1; a plugin with neither is taken as ROS 2."""
+        p = r.el
+        ros2 = base in ("gazebo_ros_camera", "gazebo_ros_multicamera") and (
+            any(p.find(t) is not None for t in _ROS2_CAMERA_DECISIVE)
+            or not any(p.find(t) is not None for t in _ROS1_CAMERA_EVIDENCE)
+        )
+        depth = kind != "camera"
+        out: dict[str, Any] = {"ros2": ros2}
+        frame = r.text("frame_name" if ros2 else "frameName")
+        if frame:
+            out["frame"] = self.frame(frame)
+        for t in _DISTORTION:  # ROS 1 and early ROS 2 spellings: the images are ideal either way
+            el = p.find(t)
+            if el is not None:
+                r.mark(t)
+                if not _zero(el.text):
+                    self.note(el, f"<{t}> in {context} is ignored (images are not distorted)")
+        if ros2:
+            cam = _topic(r.text("camera_name")) if p.find("camera_name") is not None else _topic(sensor)
+            names = {
+                "topic": _join(cam, "image_raw"),
+                "info": _join(cam, "camera_info"),
+                "depth": _join(cam, "depth/image_raw"),
+                "depth_info": _join(cam, "depth/camera_info"),
+                "points": _join(cam, "points"),
+            }
+            mine = set(names.values()) if depth else {names["topic"], names["info"]}
+            for key, topic in names.items():
+                out[key] = remap.get(topic) or topic
+            for src, dst in remap.items():
+                if src not in mine and not src.startswith("__") and src != _join(cam, "image_trigger"):
+                    self.note(
+                        p.find("ros"),
+                        f"remapping {src}:={dst} matches none of this camera's topics ("
+                        + ", ".join(sorted(mine))
+                        + "): ROS 2 applies it to none either",
+                        hint=f"name the whole topic, as {names['topic']}:=...",
+                    )
+            own, other = _ROS2_CAMERA_PARAMS, _ROS1_CAMERA_PARAMS
+        else:
+            raw_cam = r.text("cameraName")
+            cam = _topic(raw_cam) if raw_cam else None
+
+            def name(tag: str, default: str) -> str:
+                text = r.text(tag)
+                if text and text.startswith("/"):  # absolute: not under <cameraName>
+                    return _topic(text) or default
+                return _join(cam, _topic(text) or default)
+
+            out.update(
+                topic=name("imageTopicName", "image_raw"),
+                info=name("cameraInfoTopicName", "camera_info"),
+                depth=name("depthImageTopicName", "depth/image_raw"),
+                depth_info=name("depthImageCameraInfoTopicName", "depth/camera_info"),
+                points=name("pointCloudTopicName", "points"),
+            )
+            own, other = _ROS1_CAMERA_PARAMS, _ROS2_CAMERA_PARAMS
+        r.mark(*(t for t in own if p.find(t) is not None))
+        if ros2 and r.bool("triggered"):
+            self.note(p.find("triggered"), "<triggered> is ignored: the camera publishes at its rate")
+        for tag in other:
+            el = p.find(tag)
+            if el is None:
+                continue
+            r.mark(tag)
+            if not _zero(el.text) and tag not in _HARMLESS and (el.text or "").strip().lower() != "true":
+                self.note(
+                    el,
+                    f"<{tag}> is a ROS {'1' if ros2 else '2'} parameter; the ROS {'2' if ros2 else '1'} "
+                    f"{filename!r} does not read it (Gazebo ignores it too)",
+                )
+        for tag in ("pointCloudCutoff", "pointCloudCutoffMax", "min_depth", "max_depth"):
+            el = p.find(tag)
+            if el is not None and tag in own and depth:
+                self.note(
+                    el, f"<{tag}> is not applied: depth and points span the clip planes (<near>..<far>)"
+                )
+        for tag in ("Cx", "Cy", "CxPrime", "focalLength", "cx", "cy", "focal_length"):
+            el = p.find(tag)
+            if el is not None and tag in own and not _zero(el.text):
+                self.note(el, f"<{tag}> is not applied: CameraInfo is the ideal pinhole of <horizontal_fov>")
+        for el in r.leftovers():
+            if el.tag not in _CAMERA_KNOWN and el.tag not in _IGNORED_REASONS:
+                r.mark(el.tag)
+                self.note(el, f"<{el.tag}> is not a parameter of {filename!r}: Gazebo ignores it too")
+        return out
 
     def _ros_block(self, r: _Reader) -> dict[str, Any]:
         """ROS 2 `<ros><namespace>..</namespace><remapping>a:=b</remapping></ros>` and classic
@@ -682,6 +882,27 @@ def _plugin_base(filename: str) -> str:
     return re.sub(r"^(ignition-gazebo|gz-sim)\d*-", "gz-sim-", base)
 
 
+def _zero(text: str | None) -> bool:
+    """An unset, zero or false parameter value."""
+    if text is None or not text.strip():
+        return True
+    try:
+        return float(text) == 0.0
+    except ValueError:
+        return text.strip().lower() == "false"
+
+
+@dataclass
+class _NoiseSpec:
+    """SDF `<noise>`: white noise N(mean, stddev) at every reading plus a bias drawn once per run."""
+
+    stddev: float = 0.0
+    mean: float = 0.0
+    bias_mean: float = 0.0
+    bias_stddev: float = 0.0
+    el: Any = None
+
+
 def _sibling(topic: str, name: str) -> str:
     head = topic.rsplit("/", 1)[0] if "/" in topic else ""
     return _join(head, name)
@@ -695,7 +916,74 @@ _FORMATS = {
     "L8": "mono8",
     "L_INT8": "mono8",
 }
-_DISTORTION = ("distortionK1", "distortionK2", "distortionK3", "distortionT1", "distortionT2")
+_DISTORTION = (
+    "distortionK1",
+    "distortionK2",
+    "distortionK3",
+    "distortionT1",
+    "distortionT2",
+    "distortion_k1",
+    "distortion_k2",
+    "distortion_k3",
+    "distortion_t1",
+    "distortion_t2",
+)
+# Camera plugin parameters, ROS 1 (gazebo_ros_camera_utils, depth_camera, openni_kinect) and ROS 2
+# (gazebo_ros_camera); the distortion ones and <updateRate> are handled on their own.
+_ROS1_CAMERA_PARAMS = {
+    "cameraName",
+    "imageTopicName",
+    "cameraInfoTopicName",
+    "depthImageTopicName",
+    "depthImageCameraInfoTopicName",
+    "pointCloudTopicName",
+    "triggerTopicName",
+    "frameName",
+    "pointCloudCutoff",
+    "pointCloudCutoffMax",
+    "Cx",
+    "Cy",
+    "CxPrime",
+    "focalLength",
+    "hackBaseline",
+    "borderCrop",
+    "autoDistortion",
+}
+_ROS2_CAMERA_PARAMS = {
+    "ros",
+    "camera_name",
+    "frame_name",
+    "hack_baseline",
+    "cx",
+    "cy",
+    "focal_length",
+    "min_depth",
+    "max_depth",
+    "border_crop",
+    "triggered",
+}
+_ROS2_CAMERA_DECISIVE = ("ros", "camera_name", "frame_name")
+_ROS1_CAMERA_EVIDENCE = (
+    "cameraName",
+    "imageTopicName",
+    "cameraInfoTopicName",
+    "depthImageTopicName",
+    "depthImageCameraInfoTopicName",
+    "pointCloudTopicName",
+    "robotNamespace",
+    "frameName",
+    "updateRate",
+)
+_CAMERA_KNOWN = (
+    _ROS1_CAMERA_PARAMS
+    | _ROS2_CAMERA_PARAMS
+    | set(_DISTORTION)
+    | {"updateRate", "update_rate", "updateRateHZ", "robotNamespace", "alwaysOn", "always_on"}
+)
+# Read by one ROS version and not the other, but with no effect on what is published.
+_HARMLESS = {"hackBaseline", "hack_baseline", "borderCrop", "border_crop", "autoDistortion"}
+_NOISE_TAGS = {"type", "mean", "stddev", "bias_mean", "bias_stddev"}
+_IMU_TAGS = {"angular_velocity", "linear_acceleration", "noise"}
 _CAMERA_PLUGINS = {
     "gazebo_ros_camera",
     "gazebo_ros_depth_camera",
@@ -848,6 +1136,8 @@ def _joint_states(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[s
 
 
 def _imu_model(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str, dict[str, Any]]:
+    """ROS 1 gazebo_ros_imu (a model plugin): N(0, <gaussianNoise>) on every rate and acceleration, and
+    nothing else; it reads no `<imu>` block (TurtleBot3's is not used by Gazebo either)."""
     noise = r.float("gaussianNoise")
     params: dict[str, Any] = {
         "link": r.text("bodyName", "body_name"),
@@ -859,12 +1149,17 @@ def _imu_model(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str,
     }
     imu = r.child("imu")
     if imu is not None:
-        rate_sd, accel_sd = imu.findtext("noise/rate/stddev"), imu.findtext("noise/accel/stddev")
-        if rate_sd:
-            params["angular_velocity_stddev"] = float(rate_sd)
-        if accel_sd:
-            params["linear_acceleration_stddev"] = float(accel_sd)
-    r.mark("xyzOffset", "rpyOffset", "xyzOffsets", "rpyOffsets")
+        g.note(
+            imu,
+            f"<imu> is not a parameter of {r.el.get('filename')!r}: Gazebo ignores it too (the plugin adds "
+            f"only <gaussianNoise>, here {noise or 0.0})",
+            hint="give the noise in the scenario: plugins: [{type: imu, params: {angular_velocity_stddev: "
+            "..., linear_acceleration_stddev: ..., angular_velocity_bias_mean: [...]}}]",
+        )
+    for tag in ("xyzOffset", "rpyOffset", "xyzOffsets", "rpyOffsets"):
+        el = r.child(tag)
+        if el is not None and (_floats(el.text, 3) is None or any(_floats(el.text, 3) or [])):
+            g.note(el, f"<{tag}> in {r.el.get('filename')!r} is ignored")
     return "imu", params
 
 
