@@ -565,11 +565,11 @@ def test_missing_mesh_and_unsupported_mesh_format(tmp_path: Path) -> None:
         "missing.sdf",
         """
         <sdf version="1.6"><model name="m"><static>true</static><link name="l">
-          <visual name="v"><geometry><mesh><uri>model://nowhere/a.stl</uri></mesh></geometry></visual>
+          <collision name="c"><geometry><mesh><uri>model://nowhere/a.stl</uri></mesh></geometry></collision>
         </link></model></sdf>
         """,
     )
-    with pytest.raises(SdfError, match=r"model://nowhere/a\.stl") as info:
+    with pytest.raises(SdfError, match=r"model://nowhere/a\.stl") as info:  # a visual's: a notice
         _load(bad)
     assert info.value.line == 2
 

@@ -1,8 +1,8 @@
 """Where ROS packages live, without ROS: `$(find pkg)`, `package://pkg/...`, `model://...`.
 
-Lookup order: packages given explicitly, then any folder holding a `package.xml` whose `<name>` matches,
-under the scenario's folder and the folders in SCENARIO_PACKAGE_PATH, ROS_PACKAGE_PATH and
-GZ_SIM_RESOURCE_PATH.
+Lookup order: packages given explicitly, then any folder holding a `package.xml` whose `<name>` matches
+(or a Gazebo model folder, holding a `model.config` or a `model.sdf`, by its folder name), under the
+scenario's folder and the folders in SCENARIO_PACKAGE_PATH, ROS_PACKAGE_PATH and GZ_SIM_RESOURCE_PATH.
 """
 
 from __future__ import annotations
@@ -54,7 +54,9 @@ class PackageMap:
                         if name and name not in found:
                             found[name] = Path(dirpath)
                         dirnames[:] = []  # a package does not nest packages
-                    elif "model.config" in filenames:  # Gazebo model folder: model://<folder name>
+                    elif "model.config" in filenames or "model.sdf" in filenames:
+                        # A Gazebo model folder (model://<folder name>): Gazebo takes a folder that holds a
+                        # model.sdf without a model.config too.
                         found.setdefault(Path(dirpath).name, Path(dirpath))
             self._found = found
         return self._found

@@ -6,17 +6,29 @@ What is read:
 - `<model>`: `<static>`, `<pose>` (with `relative_to` sibling frames, `<frame>`s), nested `<model>` and
   `<include>` (poses compose), `<link>`, `<joint>` (fixed, revolute, continuous, prismatic, ball);
 - `<link>`: `<pose>`, `<inertial>`, `<gravity>`, `<light>`, `<collision>` and `<visual>` with box, cylinder,
-  sphere, capsule, ellipsoid, plane and STL/OBJ mesh geometry, `<material>` colours (rgba or the classic
-  `Gazebo/...` script names), `<surface>` friction (`mu`/`mu2`: the smaller), contact stiffness (`kp`/`kd`)
-  and collide bitmasks;
-- `<include>`: `model://ground_plane` and `model://sun` are built in; any other `model://NAME` is a folder
-  with a `model.config` found through the `PackageMap`; `file://`, `package://` and relative paths work too.
+  cone (a convex mesh), sphere, capsule, ellipsoid, plane and STL/OBJ mesh geometry, `<material>` colours
+  (rgba or the classic `Gazebo/...` script names), `<surface>` friction (`mu`/`mu2`: the smaller), contact
+  stiffness (`kp`/`kd`) and collide bitmasks;
+- `<include>`: `model://ground_plane` and `model://sun` (and Fuel's OpenRobotics `Ground Plane` and `Sun`)
+  are built in; any other `model://NAME` (or Fuel model NAME) is a folder with a `model.config` or a
+  `model.sdf` found through the `PackageMap`; `file://`, `package://` and relative paths work too.
+
+Relative paths (`file://models/a.dae`, `meshes/a.stl`) are looked up beside the SDF file, beside the files
+that include it, then in the scenario's folder and the package roots; never in the current directory.
+
+The ground: a static horizontal plane at z=0 of the file is the world's ground (the scenario's `ground`
+geom takes its friction, collide bitmask and colour where the scenario does not set them), not a second
+plane; a second one in the file is left out with a notice.
 
 Names: every body and geom of a model is `<model>/<link>` (nested: `<model>/<sub>/<link>`), geoms
 `<model>/<link>/<collision or visual name>`, so they never clash with robots (which live under `<ns>/`).
 
 Anything else is listed once per tag name as a notice (file and line of the first one), never fatal, never
-silent. Malformed XML and missing required elements raise `SdfError` (a `SourceError`).
+silent; custom elements (`<gz:...>`, whose namespace is seldom declared) are skipped quietly. A visual's
+mesh that is missing or unreadable is a notice (the visual is left out); a static collision mesh far from
+convex is a notice (MuJoCo collides with its convex hull). Malformed XML, missing required elements and
+missing files (included models, collision meshes: all of them, in one error) raise `SdfError` (a
+`SourceError`).
 """
 
 from __future__ import annotations
@@ -27,20 +39,36 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
+from urllib.parse import unquote
 
 import mujoco
+import numpy as np
 from lxml import etree
 
 from runner.compile.materials import gazebo_material
 from runner.compile.meshes import MeshError, convert_mesh
-from runner.compile.packages import PackageMap, resolve_uri
+from runner.compile.packages import URI_RE, PackageMap
 from runner.compile.urdf import COLLISION_GROUP
 from runner.errors import Notices, SourceError
 from runner.geometry import rpy_to_quat
+from runner.schema import Ground
 
 
 class SdfError(SourceError):
-    """The SDF/world file itself is wrong, or something it refers to cannot be found."""
+    """The SDF/world file itself is wrong, or something it refers to cannot be found. `problems` holds each
+    problem (file, line, hint of its own) when one error reports several (every missing model and mesh of
+    a world); the message lists them all, with the first one's file and line."""
+
+    def __init__(
+        self,
+        message: str,
+        file: Path | None,
+        line: int | None = None,
+        hint: str | None = None,
+        problems: list[SdfError] | None = None,
+    ):
+        super().__init__(message, file, line, hint)
+        self.problems: list[SdfError] = problems or [self]
 
 
 @dataclass
@@ -55,6 +83,7 @@ class SdfWorld:
     models: list[str] = field(default_factory=list)  # top-level models added: bodies are `<model>/...`
     free_bodies: list[str] = field(default_factory=list)  # bodies that were given a free joint
     ground: bool = False  # this file added the ground plane (geom `ground`)
+    ground_model: str | None = None  # the file's own ground plane (its link) that became the ground geom
 
 
 # ------------------------------------------------------------------------------------------- small maths
@@ -179,7 +208,8 @@ _WHY = {
     "placement_frame": "placement frames are not supported; <pose> places the model's own frame",
 }
 
-_GEOM_KEYS = {"box", "cylinder", "sphere", "capsule", "ellipsoid", "plane", "mesh", "empty"}
+_GEOM_KEYS = {"box", "cylinder", "cone", "sphere", "capsule", "ellipsoid", "plane", "mesh", "empty"}
+_CONE_SEGMENTS = 48
 _GEOM_SKIPPED = {"heightmap", "polyline", "image"}
 
 
@@ -187,6 +217,7 @@ _GEOM_SKIPPED = {"heightmap", "polyline", "image"}
 class _Src:
     path: Path
     version: tuple[int, int] | None
+    chain: tuple[Path, ...] = ()  # the files that included this one, outermost first
 
 
 @dataclass
@@ -246,13 +277,28 @@ class _Loader:
             "joint": {j.name for j in spec.joints if j.name},
         }
         self.meshes: dict[tuple[str, tuple[float, ...]], str] = {}
-        self.had_ground = any(g.type == _PLANE for g in spec.worldbody.geoms)
+        self.convex_checked: set[tuple[str, tuple[float, ...]]] = set()
+        # The world's ground so far: the scenario's (`world.ground`), a plane named `ground`; which part of
+        # this file is the ground (label, file, line), once one is.
+        planes = [g for g in spec.worldbody.geoms if g.type == _PLANE]
+        self.ground_geom: mujoco.MjsGeom | None = next((g for g in planes if g.name == "ground"), None)
+        if self.ground_geom is None and planes:
+            self.ground_geom = planes[0]
+        self.ground_owner: tuple[str, Path, int | None] | None = None
+        self.ground_link: str | None = None
+        self.missing: list[SdfError] = []  # files not found: reported together at the end
         self.result: SdfWorld | None = None
 
     # ------------------------------------------------------------------------------------- notices
-    def note(self, message: str, src: _Src | Path | None, el: etree._Element | None = None) -> None:
+    def note(
+        self,
+        message: str,
+        src: _Src | Path | None,
+        el: etree._Element | None = None,
+        hint: str | None = None,
+    ) -> None:
         file = src.path if isinstance(src, _Src) else src
-        self.notices.add(message, file, el.sourceline if el is not None else None)
+        self.notices.add(message, file, el.sourceline if el is not None else None, hint)
 
     def skip(self, el: etree._Element, src: _Src) -> None:
         tag = el.tag if isinstance(el.tag, str) else str(el.tag)
@@ -268,7 +314,7 @@ class _Loader:
     def check(self, el: etree._Element, src: _Src, handled: Iterable[str]) -> None:
         handled = set(handled)
         for ch in el:
-            if isinstance(ch.tag, str) and ch.tag not in handled and ch.tag not in _QUIET:
+            if isinstance(ch.tag, str) and ch.tag not in handled and ch.tag not in _QUIET and not _custom(ch):
                 self.skip(ch, src)
 
     def flush(self) -> None:
@@ -308,23 +354,28 @@ class _Loader:
             raise SdfError(
                 f"SDF file {str(path)!r} not found", path, hint="paths are relative to the scenario"
             )
+        try:
+            data = _xml_bytes(path)
+        except OSError as e:
+            raise SdfError(f"cannot read {str(path)!r}: {e.strerror or e}", path) from None
         parser = etree.XMLParser(
             remove_comments=True, remove_pis=True, resolve_entities=False, no_network=True
         )
         try:
-            root = etree.parse(str(path), parser).getroot()
+            root = etree.fromstring(data, parser, base_url=str(path))
         except etree.XMLSyntaxError as e:
             if "Namespace prefix" not in str(e.msg):
-                raise SdfError(
-                    f"not well-formed XML: {e.msg}",
-                    path,
-                    e.lineno,
-                    hint="check that every tag is closed and attribute values are quoted",
-                ) from None
-            # An undeclared prefix (`<gz:...>`): read the file anyway, the element is dropped later.
-            self.notices.add(f"XML: {e.msg}; read anyway", path, e.lineno)
-            parser = etree.XMLParser(remove_comments=True, remove_pis=True, recover=True, no_network=True)
-            root = etree.parse(str(path), parser).getroot()
+                raise _malformed(e.msg, path, e.lineno) from None
+            # An undeclared prefix (`<gz:policies>`, the usual gz-sim extension elements, whose `xmlns:gz`
+            # is seldom declared): read the file anyway; prefixed elements are custom elements, which SDF
+            # readers skip. Any other error found on the way is still an error.
+            parser = etree.XMLParser(
+                remove_comments=True, remove_pis=True, resolve_entities=False, no_network=True, recover=True
+            )
+            root = etree.fromstring(data, parser, base_url=str(path))
+            for entry in parser.error_log:
+                if entry.type != etree.ErrorTypes.NS_ERR_UNDEFINED_NAMESPACE:
+                    raise _malformed(entry.message, path, entry.line) from None
         if root is None or root.tag != "sdf":
             tag = None if root is None else root.tag
             raise SdfError(
@@ -340,10 +391,22 @@ class _Loader:
             version = (int(m.group(1)), int(m.group(2))) if m else None
             if version is None or not (1, 0) <= version <= (1, 12):
                 self.notices.add(f"SDF version {text!r} is not one this reader knows (1.4-1.9)", path, 1)
-        return root, _Src(path, version)
+        return root, _Src(path, version, tuple(self.stack))
 
     # ----------------------------------------------------------------------------------------- load
     def load(self, path: Path) -> SdfWorld:
+        """Reads the file; files it refers to that are missing are all listed in one error at the end."""
+        try:
+            result = self.read(path)
+        except SdfError as e:
+            if self.missing:
+                raise _together([*self.missing, e]) from None
+            raise
+        if self.missing:
+            raise _together(self.missing)
+        return result
+
+    def read(self, path: Path) -> SdfWorld:
         root, src = self.parse(path)
         self.result = result = SdfWorld(file=src.path)
         self.stack.append(src.path)
@@ -645,16 +708,20 @@ class _Loader:
                     base = found
             pose = base @ local
 
-        bare = uri.rstrip("/")
-        if bare in ("model://ground_plane", "model://sun"):
+        builtin = _builtin(uri)
+        if builtin is not None:
             world_pose = parent @ (pose or _IDENTITY)
-            if bare.endswith("sun"):
+            if builtin == "sun":
                 self.sun(world_pose)
             else:
                 self.ground(world_pose, src, el)
-            return name or bare[len("model://") :], None
+            return name or builtin, None
 
-        file = self.resolve_include(uri, src, uri_el)
+        try:
+            file = self.resolve_include(uri, src, uri_el)
+        except SdfError as e:  # listed with every other missing file at the end; the model is left out
+            self.missing.append(e)
+            return name or uri, None
         if file in self.stack:
             raise self.error(f"include {uri!r} includes itself", src, uri_el)
         root, inc_src = self.parse(file, (src, uri_el))
@@ -685,13 +752,24 @@ class _Loader:
             self.stack.pop()
 
     def resolve_include(self, uri: str, src: _Src, at: etree._Element) -> Path:
-        searched = "; searched: " + (", ".join(self.packages.searched()) or "nothing")
+        searched = ", ".join(self.packages.searched()) or "nothing"
         if uri.startswith(("http://", "https://")):
+            # A Fuel model (`https://fuel.gazebosim.org/1.0/<owner>/models/<name>[/<version>]`) is used
+            # when a folder of that name is found through the package map; nothing is downloaded.
+            name = _download_name(uri)
+            for candidate in dict.fromkeys([name, name.lower(), name.lower().replace(" ", "_")]):
+                root = self.packages.find(candidate) if candidate else None
+                if root is not None:
+                    target = self.model_file(root, src, at, uri) if root.is_dir() else root
+                    return target.resolve()
             raise self.error(
                 f"include {uri!r}: models are not downloaded",
                 src,
                 at,
-                hint="download the model folder and put it under a folder listed in `packages:`",
+                hint=f"download the model (`gz fuel download -u '{uri}'`, or from its web page) and make its "
+                f"folder (the one that holds model.sdf) known as {name!r}: `packages: {{{name!r}: "
+                f"path/to/folder}}` in the scenario, or a folder named {name!r} under the scenario's folder "
+                f"or a folder on SCENARIO_PACKAGE_PATH; searched: {searched}",
             )
         if uri.startswith("model://"):
             name, _, rest = uri[len("model://") :].partition("/")
@@ -701,19 +779,22 @@ class _Loader:
                     f"model {uri!r} not found",
                     src,
                     at,
-                    hint="a model is a folder named after it holding a model.config; add its parent folder "
-                    "under `packages:` or to GZ_SIM_RESOURCE_PATH" + searched,
+                    hint="a model is a folder named after it holding a model.config or a model.sdf; add its "
+                    f"parent folder under `packages:` or to SCENARIO_PACKAGE_PATH; searched: {searched}",
                 )
             target = root / rest if rest else root
         else:
-            found = resolve_uri(uri, self.packages, src.path.parent)
+            found, looked, hint = self.find_file(uri, src, "include")
             if found is None:
-                raise self.error(f"include {uri!r}: package not found", src, at, hint=searched.lstrip("; "))
+                where = "looked at " + ", ".join(str(p) for p in looked) if looked else "not found"
+                raise self.error(f"include {uri!r}: {where}", src, at, hint=hint)
             target = found
         if target.is_dir():
             target = self.model_file(target, src, at, uri)
         if not target.is_file():
-            raise self.error(f"include {uri!r}: {target} does not exist", src, at, hint=searched.lstrip("; "))
+            raise self.error(
+                f"include {uri!r}: {target} does not exist", src, at, hint=f"searched: {searched}"
+            )
         return target.resolve()
 
     def model_file(self, folder: Path, src: _Src, at: etree._Element, uri: str) -> Path:
@@ -721,7 +802,9 @@ class _Loader:
         if not config.is_file():
             if (folder / "model.sdf").is_file():
                 return folder / "model.sdf"
-            raise self.error(f"include {uri!r}: {folder} has no model.config", src, at)
+            raise self.error(
+                f"include {uri!r}: {folder} holds neither a model.config nor a model.sdf", src, at
+            )
         try:
             root = etree.parse(str(config), etree.XMLParser(remove_comments=True, no_network=True)).getroot()
         except etree.XMLSyntaxError as e:
@@ -969,7 +1052,8 @@ class _Loader:
         g = el.find("geometry")
         if g is None:
             raise self.error(f"a <{kind}> of link {link.body!r} has no <geometry>", src, el)
-        kw = self.shape(g, src, link, local, visual)
+        what = f"{kind} {el.get('name') or kind!r} of {link.body!r}"
+        kw = self.shape(g, src, link, local, visual, what)
         if kw is None:
             return None
         kw["name"] = el.get("name") or kind
@@ -978,13 +1062,16 @@ class _Loader:
         else:
             kw.update(group=COLLISION_GROUP, rgba=list(rgba or _GREY))
             self.surface(el.find("surface"), src, kw, link, mass)
+        if kw.pop("_ground", False):
+            self.take_ground(kw, visual, src, el)
+            return None
         kw["pos"] = list(kw.pop("_pose").p)  # type: ignore[attr-defined]
         return kw
 
     def shape(
-        self, g: etree._Element, src: _Src, link: _Link, local: _Pose, visual: bool
+        self, g: etree._Element, src: _Src, link: _Link, local: _Pose, visual: bool, what: str
     ) -> dict[str, object] | None:
-        shapes = [c for c in g if isinstance(c.tag, str)]
+        shapes = [c for c in g if isinstance(c.tag, str) and not _custom(c)]
         known = [c for c in shapes if c.tag in _GEOM_KEYS]
         for c in shapes:
             if c.tag not in _GEOM_KEYS:
@@ -996,7 +1083,7 @@ class _Loader:
                 "a <geometry> has no shape",
                 src,
                 g,
-                hint="one of: box, cylinder, sphere, capsule, ellipsoid, plane, mesh",
+                hint="one of: box, cylinder, cone, sphere, capsule, ellipsoid, plane, mesh",
             )
         s = known[0]
         pose = local
@@ -1012,6 +1099,14 @@ class _Loader:
             length = self.child_float(s, "length", src)
             kind = G.mjGEOM_CYLINDER if s.tag == "cylinder" else G.mjGEOM_CAPSULE
             kw.update(type=kind, size=[r, length / 2, 0])
+        elif s.tag == "cone":
+            r = self.child_float(s, "radius", src)
+            length = self.child_float(s, "length", src)
+            if r <= 0 or length <= 0:
+                raise self.error(
+                    f"a <cone> needs a positive radius and length, found {r} and {length}", src, s
+                )
+            kw.update(type=G.mjGEOM_MESH, meshname=self.cone_mesh(r, length))
         elif s.tag == "sphere":
             kw.update(type=G.mjGEOM_SPHERE, size=[self.child_float(s, "radius", src), 0, 0])
         elif s.tag == "ellipsoid":
@@ -1032,12 +1127,14 @@ class _Loader:
             else:
                 if up[2] < 1 - 1e-9:
                     self.note("this plane is not horizontal; MuJoCo planes are infinite", src, s)
-                elif self.had_ground and abs(world.p[2]) < 1e-6:
-                    self.note("the world already has a ground plane; this plane at z=0 is left out", src, s)
-                    return None
+                elif abs(world.p[2]) < 1e-6:
+                    role = self.ground_role(link, src, s)
+                    if role == "drop":
+                        return None
+                    kw["_ground"] = role == "ground"
                 kw.update(type=_PLANE, size=[sx / 2, sy / 2, 0.05])
         elif s.tag == "mesh":
-            mesh = self.mesh(s, src)
+            mesh = self.mesh(s, src, visual=visual, what=what, convex_check=link.static and not visual)
             if mesh is None:
                 return None
             kw.update(type=G.mjGEOM_MESH, meshname=mesh)
@@ -1046,27 +1143,59 @@ class _Loader:
         kw["_pose"] = pose
         return kw
 
+    def cone_mesh(self, radius: float, length: float) -> str:
+        """A cone as SDF (and gz-sim) draws it: axis +Z, base at -length/2, apex at +length/2. MuJoCo has no
+        cone; the mesh is convex, so colliding with its hull is exact."""
+        key = ("<cone>", (radius, length))
+        if key in self.meshes:
+            return self.meshes[key]
+        n = _CONE_SEGMENTS
+        angles = [2 * math.pi * i / n for i in range(n)]
+        verts = [(radius * math.cos(a), radius * math.sin(a), -length / 2) for a in angles]
+        verts += [(0.0, 0.0, length / 2), (0.0, 0.0, -length / 2)]  # apex n, base centre n + 1
+        faces: list[int] = []
+        for i in range(n):
+            j = (i + 1) % n
+            faces += [i, j, n, j, i, n + 1]  # side (outward, counter-clockwise), base (facing -Z)
+        name = self.unique("mesh", f"sdf/cone_{radius:g}x{length:g}")
+        self.spec.add_mesh(name=name, uservert=[c for v in verts for c in v], userface=faces)
+        self.meshes[key] = name
+        return name
+
     def need(self, el: etree._Element, tag: str, src: _Src) -> etree._Element:
         c = el.find(tag)
         if c is None:
             raise self.error(f"<{el.tag}> needs a <{tag}>", src, el)
         return c
 
-    def mesh(self, s: etree._Element, src: _Src) -> str | None:
+    def mesh(
+        self, s: etree._Element, src: _Src, *, visual: bool, what: str, convex_check: bool
+    ) -> str | None:
+        """The MuJoCo mesh of a <mesh> (None: left out). A visual's mesh that is missing or unreadable is
+        a notice (the visual is left out, as Gazebo goes on); a collision's is an error, collected so that
+        one run lists them all. `what` names the geom in messages."""
         uri_el = self.need(s, "uri", src)
         uri = (uri_el.text or "").strip()
         scale_el = s.find("scale")
         scale = self.floats(scale_el, src, 3) if scale_el is not None else (1.0, 1.0, 1.0)
         if s.find("submesh") is not None:
             self.note("<submesh> is not supported; the whole mesh is used", src, s.find("submesh"))
-        path = resolve_uri(uri, self.packages, src.path.parent)
+
+        def fail(message: str, hint: str) -> None:
+            if visual:
+                self.note(f"{message}; the visual is left out", src, uri_el, hint=hint)
+            else:
+                self.missing.append(self.error(f"{message} ({what})", src, uri_el, hint=hint))
+
+        path, looked, hint = self.find_file(uri, src, "mesh")
         if path is None or not path.is_file():
-            raise self.error(
-                f"mesh {uri!r} not found" + (f" (looked at {path})" if path else ""),
-                src,
-                uri_el,
-                hint="searched: " + ", ".join(self.packages.searched()),
-            )
+            where = f"looked at {', '.join(str(p) for p in looked)}" if looked else hint
+            fail(f"mesh {uri!r} not found ({where})", hint)
+            return None
+        unreadable = _unreadable(path)
+        if unreadable:
+            fail(f"mesh {path} {unreadable[0]}", unreadable[1])
+            return None
         if path.suffix.lower() not in _MESH_FORMATS:
             try:
                 path = convert_mesh(path)
@@ -1080,17 +1209,92 @@ class _Loader:
                     None,
                 )
                 if alt is None:
-                    self.note(f"{e}; left out", src, uri_el)
+                    fail(
+                        str(e),
+                        "convert it to STL or OBJ (e.g. with Blender or trimesh) and point the <uri> at it",
+                    )
                     return None
                 self.note(f"{e}; using {alt.name} instead", src, uri_el)
                 path = alt
         key = (str(path.resolve()), tuple(scale))
+        if convex_check and key not in self.convex_checked:
+            self.convex_checked.add(key)
+            self.check_convex(Path(key[0]), scale, uri, what, src, uri_el)
         if key in self.meshes:
             return self.meshes[key]
         name = self.unique("mesh", f"sdf/{path.stem}")
         self.spec.add_mesh(name=name, file=key[0], scale=list(scale))
         self.meshes[key] = name
         return name
+
+    def find_file(self, uri: str, src: _Src, kind: str) -> tuple[Path | None, list[Path], str]:
+        """Where `uri` points, the places looked at, and a hint for when it is not there.
+
+        `package://` and `model://` go through the package map. A relative path (`file://models/a.dae`,
+        `meshes/a.stl`) is looked up beside the SDF file, beside each file that included it, then in the
+        scenario's folder and the package roots (SCENARIO_PACKAGE_PATH, GZ_SIM_RESOURCE_PATH...), never
+        in the current directory, so that a world loads the same from anywhere."""
+        m = URI_RE.match(uri)
+        roots = ", ".join(self.packages.searched()) or "nothing"
+        if m:
+            root = self.packages.find(m.group(2))
+            if root is None:
+                what = "model" if m.group(1) == "model" else "package"
+                return (
+                    None,
+                    [],
+                    f"no {what} named {m.group(2)!r}: a model is a folder named after it holding a "
+                    "model.config or a model.sdf, a package a folder with a package.xml; add its parent "
+                    f"folder under `packages:` or to SCENARIO_PACKAGE_PATH; searched: {roots}",
+                )
+            target = root / m.group(3)
+            return (target if target.exists() else None), [target], f"{m.group(2)!r} is {root}"
+        if uri.startswith(("http://", "https://")):
+            m = _FUEL_FILE.match(unquote(uri))
+            if m is None:
+                return None, [], "nothing is downloaded: download the file and point the <uri> at it"
+            text = m.group("rest")  # a file of a Fuel model: in the downloaded model folder, beside its SDF
+        else:
+            text = uri[len("file://") :] if uri.startswith("file://") else uri
+        rel = Path(text)
+        if rel.is_absolute():
+            return (rel if rel.exists() else None), [rel], "the path is absolute"
+        looked: list[Path] = []
+        for base in [src.path.parent, *(f.parent for f in reversed(src.chain)), *self.packages.roots]:
+            candidate = Path(base).resolve() / rel
+            if candidate in looked:
+                continue
+            looked.append(candidate)
+            if candidate.exists():
+                return candidate, looked, ""
+        hint = (
+            f"a relative {kind} path is looked up beside the SDF file, beside the files that include it, "
+            "then in the scenario's folder and the folders on SCENARIO_PACKAGE_PATH / GZ_SIM_RESOURCE_PATH"
+            + ("; inside a model folder, model://<model>/... is the portable form" if kind == "mesh" else "")
+        )
+        return None, looked, hint
+
+    def check_convex(
+        self, path: Path, scale: tuple[float, ...], uri: str, what: str, src: _Src, at: etree._Element
+    ) -> None:
+        """A static collision mesh far from convex is a notice: MuJoCo collides with its convex hull, so
+        a building's four walls in one mesh are a solid block that swallows whatever is inside."""
+        stats = _hull_and_volume(path, scale)
+        if stats is None:
+            return
+        hull, volume = stats
+        if hull - volume < _NONCONVEX_MIN_EXCESS or hull < _NONCONVEX_RATIO * volume:
+            return
+        ratio = f"{hull / volume:.0f}" if volume > 0 else "many"
+        self.note(
+            f"collision mesh {uri!r} ({what}) is far from convex: MuJoCo collides with its convex hull, "
+            f"{ratio} times the mesh's volume ({hull:.3g} m³ against {volume:.3g} m³), so the space "
+            "it encloses is solid",
+            src,
+            at,
+            hint="give the model primitive collision shapes (a <box> per wall), or split the mesh into "
+            "convex parts, one <collision> each",
+        )
 
     def colour(self, v: etree._Element, src: _Src) -> tuple[float, ...]:
         rgba: tuple[float, ...] = _GREY
@@ -1124,7 +1328,12 @@ class _Loader:
     ) -> None:
         if s is None:
             return
-        self.check(s, src, {"friction", "contact"})
+        self.check(s, src, {"friction", "contact", "bounce"})
+        bounce = s.find("bounce")
+        if bounce is not None:
+            self.check(bounce, src, {"restitution_coefficient", "threshold"})
+            if self.child_float(bounce, "restitution_coefficient", src, 0.0) > 0:
+                self.skip(bounce, src)  # "restitution is not simulated": only when some is asked for
         fr = s.find("friction")
         if fr is not None:
             self.check(fr, src, {"ode"})
@@ -1177,10 +1386,15 @@ class _Loader:
 
     # ------------------------------------------------------------------------------------- builtins
     def ground(self, pose: _Pose, src: _Src, el: etree._Element) -> None:
+        """`model://ground_plane`: the world's ground as it is (the scenario's), or a plain one."""
         assert self.result is not None
-        if self.had_ground:
+        if self.ground_owner is not None:
+            self.duplicate_ground(src, el)
             return
-        self.spec.worldbody.add_geom(
+        self.ground_owner = ("model://ground_plane", src.path, el.sourceline)
+        if self.ground_geom is not None:
+            return
+        self.ground_geom = self.spec.worldbody.add_geom(
             name=self.unique("geom", "ground"),
             type=_PLANE,
             size=[0, 0, 0.05],
@@ -1189,8 +1403,64 @@ class _Loader:
             rgba=list(_GROUND_RGBA),
             friction=[1.0, 0.005, 0.0001],
         )
-        self.had_ground = True
         self.result.ground = True
+
+    def duplicate_ground(self, src: _Src, el: etree._Element) -> None:
+        assert self.ground_owner is not None
+        label, file, line = self.ground_owner
+        where = f"line {line}" if file == src.path else f"{file}:{line}"
+        self.note(
+            f"the world file already has a ground plane ({label}, {where}); this plane at z=0 is left out",
+            src,
+            el,
+        )
+
+    def ground_role(self, link: _Link, src: _Src, el: etree._Element) -> str:
+        """What a static horizontal plane at z=0 of `link` is: `ground` (the world's ground: its settings go
+        onto the ground geom, no second plane is added), `add` (the scenario has no ground: the plane is
+        added as it is) or `drop` (the file has a ground already: a notice, the plane is left out). The
+        first such link in the file is the ground."""
+        if self.ground_owner is None:
+            assert self.result is not None
+            self.ground_owner = (f"model {link.body.split('/')[0]!r}", src.path, link.el.sourceline)
+            self.ground_link = self.result.ground_model = link.body
+        elif self.ground_link != link.body:
+            self.duplicate_ground(src, el)
+            return "drop"
+        return "add" if self.ground_geom is None else "ground"
+
+    def take_ground(self, kw: dict[str, object], visual: bool, src: _Src, el: etree._Element) -> None:
+        """The world file's own ground plane is the ground: its surface (friction, collide bitmask) and its
+        colour go onto the ground geom, unless the scenario's `world.ground` sets them."""
+        assert self.ground_geom is not None
+        ground = self.ground_geom
+        default = Ground()
+        if visual:
+            if all(abs(a - b) < 1e-6 for a, b in zip(ground.rgba, default.rgba, strict=True)):
+                ground.rgba = list(kw["rgba"])  # type: ignore[call-overload]
+            return
+        friction = kw.get("friction")
+        if isinstance(friction, list):
+            mu = float(friction[0])
+            if abs(ground.friction[0] - default.friction) > 1e-9:
+                self.note(
+                    f"the ground plane's friction {mu:g} is not used: the scenario's "
+                    f"`world.ground.friction` ({ground.friction[0]:g}) is",
+                    src,
+                    el,
+                )
+            else:
+                # Gazebo takes the smaller mu of two surfaces, MuJoCo the larger unless one geom has
+                # priority. A slippery ground (mu under 1, the default of every surface in both) gets the
+                # top priority: its mu is what everything on it gets, as Gazebo's smaller-of-two would
+                # give anything grippier. A grippy one (Gazebo's ground_plane says mu 100) leaves every
+                # other surface its own friction, as the smaller-of-two does: 1 here, no priority, so
+                # geoms that state theirs (robot wheels, a caster's 0: priority 1) keep it.
+                ground.friction = [min(mu, 1.0), ground.friction[1], ground.friction[2]]
+                ground.priority = 2 if mu < 1.0 else 0
+        for k in ("contype", "conaffinity"):  # a collide bitmask
+            if k in kw:
+                setattr(ground, k, kw[k])
 
     def sun(self, pose: _Pose) -> None:
         direction = _unit(_rot(pose.q, (-0.5, 0.1, -0.9)))
@@ -1263,3 +1533,155 @@ class _Loader:
 
 def _bool(text: str | None) -> bool:
     return (text or "").strip().lower() in ("true", "1")
+
+
+def _malformed(msg: str, path: Path, line: int | None) -> SdfError:
+    return SdfError(
+        f"not well-formed XML: {msg}",
+        path,
+        line,
+        hint="check that every tag is closed and attribute values are quoted",
+    )
+
+
+_BEFORE_DECLARATION = re.compile(rb"^(?:\xef\xbb\xbf)?((?:\s|<!--.*?-->)+)(<\?xml\b[^>]*\?>)", re.S)
+
+
+def _xml_bytes(path: Path) -> bytes:
+    """The file's bytes; a comment (or blank lines) before `<?xml ...?>`, which XML forbids and Gazebo
+    accepts (gazebo-classic's cafe.world), is dropped, keeping every line number."""
+    data = path.read_bytes()
+    m = _BEFORE_DECLARATION.match(data)
+    if m:
+        declaration = m.group(2)
+        newlines = m.group(1).count(b"\n") + declaration.count(b"\n")
+        data = declaration.replace(b"\r", b" ").replace(b"\n", b" ") + b"\n" * newlines + data[m.end() :]
+    return data
+
+
+def _custom(el: etree._Element) -> bool:
+    """A custom element (`<gz:policies>`, `<drake:...>`: a namespace prefix), which SDF readers skip."""
+    return isinstance(el.tag, str) and (":" in el.tag or el.tag.startswith("{"))
+
+
+def _unreadable(path: Path) -> tuple[str, str] | None:
+    """Why the mesh file at `path` cannot be a mesh (what, hint), or None when it may be one."""
+    try:
+        with path.open("rb") as f:
+            head = f.read(64)
+    except OSError as e:
+        return f"cannot be read ({e.strerror or e})", "check the file's permissions"
+    if not head:
+        return "is empty", "the file has no content: fetch or export the mesh again"
+    if head.startswith(b"version https://git-lfs.github.com/spec/"):
+        return (
+            "is a Git LFS pointer, not the mesh",
+            "fetch the real file: `git lfs install && git lfs pull` in its repository",
+        )
+    return None
+
+
+# A static collision mesh whose convex hull exceeds its volume this many times (and by this much, m³) is
+# reported. Measured: a slab floor (aws warehouse GroundB) 1.0, ordinary rounded or slightly concave
+# shapes stay under 2; the same warehouse's four walls in one mesh (WallB) 38.
+_NONCONVEX_RATIO = 3.0
+_NONCONVEX_MIN_EXCESS = 1e-3
+
+
+def _hull_and_volume(path: Path, scale: tuple[float, ...]) -> tuple[float, float] | None:
+    """The volume of the convex hull MuJoCo makes of a mesh file, and the mesh's own (enclosed) volume;
+    None when MuJoCo cannot build it (the world's compile says why)."""
+    spec = mujoco.MjSpec()
+    spec.add_mesh(name="m", file=str(path), scale=list(scale))
+    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname="m")
+    try:
+        m = spec.compile()
+    except Exception:  # MuJoCo raises ValueError or its own errors; the world's compile reports them
+        return None
+    adr = int(m.mesh_graphadr[0])
+    if adr < 0:
+        return None
+    v = m.mesh_vert[m.mesh_vertadr[0] : m.mesh_vertadr[0] + m.mesh_vertnum[0]].astype(float)
+    faces = m.mesh_face[m.mesh_faceadr[0] : m.mesh_faceadr[0] + m.mesh_facenum[0]]
+    # mesh_graph: numvert, numface, vert_edgeadr[nv], vert_globalid[nv], edge_localid[nv + 3 nf],
+    # face_globalid[3 nf] (indexes into the mesh's vertices).
+    nv, nf = int(m.mesh_graph[adr]), int(m.mesh_graph[adr + 1])
+    start = adr + 2 + 3 * nv + 3 * nf
+    hull_faces = m.mesh_graph[start : start + 3 * nf].reshape(-1, 3)
+    return abs(_signed_volume(v, hull_faces)), abs(_signed_volume(v, faces))
+
+
+def _signed_volume(v: np.ndarray, faces: np.ndarray) -> float:
+    a, b, c = v[faces[:, 0]], v[faces[:, 1]], v[faces[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+_FUEL = re.compile(
+    r"^https?://fuel\.(?:gazebosim|ignitionrobotics)\.org/(?:1\.0/)?(?P<owner>[^/]+)/models/(?P<name>[^/]+)"
+    r"(?:/(?:\d+|tip))?/?$",
+    re.IGNORECASE,
+)
+# A file of a Fuel model (`.../models/<name>/<version>/files/meshes/a.dae`).
+_FUEL_FILE = re.compile(
+    r"^https?://fuel\.[^/]+/(?:1\.0/)?[^/]+/models/[^/]+/(?:\d+|tip)/files/(?P<rest>[^?#]+)$", re.IGNORECASE
+)
+# Fuel models that are the built-in ones (model://ground_plane, model://sun), by their names without
+# spaces, dashes and underscores, lower case.
+_FUEL_BUILTINS = {"groundplane": "ground_plane", "sun": "sun"}
+
+
+def _builtin(uri: str) -> str | None:
+    """`ground_plane` or `sun` when `uri` names a built-in model: `model://sun`, or Fuel's
+    `https://fuel.gazebosim.org/1.0/OpenRobotics/models/Ground Plane` (any case, any version)."""
+    bare = uri.strip().rstrip("/")
+    if bare in ("model://ground_plane", "model://sun"):
+        return bare[len("model://") :]
+    m = _FUEL.match(unquote(bare))
+    if m and m.group("owner").lower() == "openrobotics":
+        return _FUEL_BUILTINS.get(re.sub(r"[\s_-]+", "", m.group("name")).lower())
+    return None
+
+
+def _download_name(uri: str) -> str:
+    """The model folder name a downloaded model is expected under: Fuel's model name, else the last part
+    of the address."""
+    text = unquote(uri.strip().rstrip("/"))
+    m = _FUEL.match(text)
+    if m:
+        return m.group("name")
+    last = text.rsplit("/", 1)[-1]
+    for ext in (".zip", ".tar.gz", ".tgz", ".tar"):
+        last = last.removesuffix(ext)
+    return last
+
+
+def _together(errors: list[SdfError]) -> SdfError:
+    """One error listing several: one line per message and file (the lines of its repeats gathered), the
+    distinct hints after."""
+    if len(errors) == 1:
+        return errors[0]
+    lines: dict[tuple[str, str], list[int]] = {}
+    for e in errors:
+        lines.setdefault((str(e), str(e.file)), []).extend([e.line] if e.line is not None else [])
+    if len(lines) == 1:
+        (message, file), at = next(iter(lines.items()))
+        first = errors[0]
+        at_text = ", ".join(str(n) for n in at)
+        return SdfError(
+            f"{message} (lines {at_text})" if len(at) > 1 else message,
+            first.file,
+            first.line,
+            first.hint,
+            errors,
+        )
+    body = [f"{len(lines)} problems loading the world (all listed):"]
+    for (message, file), at in lines.items():
+        body.append(f"  {file}:{','.join(str(n) for n in at)}: {message}")
+    hints = list(dict.fromkeys(e.hint for e in errors if e.hint))
+    return SdfError(
+        "\n".join(body),
+        errors[0].file,
+        errors[0].line,
+        "\n            ".join(hints) if hints else None,
+        errors,
+    )

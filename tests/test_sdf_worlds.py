@@ -1,0 +1,666 @@
+"""Real Gazebo worlds as they come: what gazebo-classic, gz-sim, AWS and nav2 world files do that the first
+SDF reader tripped on. SDF text written in tmp_path, compiled to real MuJoCo models, stepped where it matters."""
+
+from __future__ import annotations
+
+import struct
+import textwrap
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from runner.compile.packages import PackageMap
+from runner.compile.sdf import SdfError, SdfWorld, load_sdf_world
+from runner.errors import Notices, ScenarioError
+from tests.helpers import plan_of
+
+PLANE = mujoco.mjtGeom.mjGEOM_PLANE
+
+
+def _spec(ground: bool = True) -> mujoco.MjSpec:
+    """A world spec as `_world_spec` makes it: a sun, and the scenario's default ground when asked."""
+    spec = mujoco.MjSpec()
+    spec.worldbody.add_light(
+        name="sun", pos=[0, 0, 10], dir=[0.2, 0.1, -1], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL
+    )
+    if ground:
+        spec.worldbody.add_geom(
+            name="ground",
+            type=PLANE,
+            size=[0, 0, 0.05],
+            rgba=[0.55, 0.57, 0.6, 1.0],
+            friction=[1.0, 0.005, 0.0001],
+        )
+    return spec
+
+
+def _write(folder: Path, name: str, text: str) -> Path:
+    path = folder / name
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(textwrap.dedent(text).lstrip(), encoding="utf-8")
+    return path
+
+
+def _load(
+    path: Path, spec: mujoco.MjSpec | None = None, packages: PackageMap | None = None
+) -> tuple[mujoco.MjSpec, SdfWorld, Notices]:
+    spec = spec if spec is not None else _spec()
+    notices = Notices()
+    result = load_sdf_world(spec, path, packages or PackageMap(roots=[path.parent]), notices)
+    return spec, result, notices
+
+
+def _forward(spec: mujoco.MjSpec) -> tuple[mujoco.MjModel, mujoco.MjData]:
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    return model, data
+
+
+def _step(model: mujoco.MjModel, data: mujoco.MjData, seconds: float) -> None:
+    for _ in range(round(seconds / model.opt.timestep)):
+        mujoco.mj_step(model, data)
+
+
+def _messages(notices: Notices) -> list[str]:
+    return [n.message for n in notices]
+
+
+def _box_triangles(lo: tuple[float, ...], hi: tuple[float, ...]) -> list[np.ndarray]:
+    """The 12 triangles of the box [lo, hi], counter-clockwise seen from outside."""
+    corners = [np.array([(lo, hi)[x][0], (lo, hi)[y][1], (lo, hi)[z][2]], float)
+               for x in (0, 1) for y in (0, 1) for z in (0, 1)]  # fmt: skip
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    tris = []
+    for a, b, c, d in quads:
+        tris += [
+            np.array([corners[a], corners[b], corners[c]]),
+            np.array([corners[a], corners[c], corners[d]]),
+        ]
+    return tris
+
+
+def _stl(path: Path, boxes: list[tuple[tuple[float, ...], tuple[float, ...]]]) -> Path:
+    """A binary STL holding the given axis-aligned boxes, in one mesh."""
+    tris = [t for lo, hi in boxes for t in _box_triangles(lo, hi)]
+    out = bytearray(b"\0" * 80) + struct.pack("<I", len(tris))
+    for p, q, r in tris:
+        n = np.cross(q - p, r - p)
+        n = n / np.linalg.norm(n)
+        out += struct.pack("<12fH", *n, *p, *q, *r, 0)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(bytes(out))
+    return path
+
+
+CUBE = [((-0.5, -0.5, -0.5), (0.5, 0.5, 0.5))]
+
+GROUND_PLANE = """
+<model name="ground_plane">
+  <static>true</static>
+  <link name="link">
+    <collision name="collision">
+      <geometry><plane><normal>0 0 1</normal><size>100 100</size></plane></geometry>
+      {surface}
+    </collision>
+    <visual name="visual">
+      <geometry><plane><normal>0 0 1</normal><size>100 100</size></plane></geometry>
+      <material><diffuse>0.2 0.5 0.2 1</diffuse></material>
+    </visual>
+  </link>
+</model>"""
+
+
+def _sliding_box() -> str:
+    return """
+    <model name="puck">
+      <pose>0 0 0.1 0 0 0</pose>
+      <link name="link">
+        <inertial><mass>1</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial>
+        <collision name="c"><geometry><box><size>0.4 0.4 0.2</size></box></geometry></collision>
+      </link>
+    </model>"""
+
+
+# ------------------------------------------------------------------------------------- XML quirks
+@pytest.mark.timeout(30)
+def test_a_comment_before_the_xml_declaration_is_accepted_and_lines_stay_right(tmp_path: Path) -> None:
+    path = _write(
+        tmp_path,
+        "cafe.world",
+        """
+        <!-- Usage notes are located in this file, look for "Usage"-->
+        <?xml version="1.0" ?>
+        <sdf version="1.5">
+          <world name="cafe">
+            <actor name="walker"/>
+            <model name="table">
+              <static>true</static>
+              <pose>0 0 0.5 0 0 0</pose>
+              <link name="l"><collision name="c"><geometry><box><size>1 1 1</size></box></geometry></collision>
+              </link>
+            </model>
+          </world>
+        </sdf>
+        """,
+    )
+    spec, result, notices = _load(path)
+    assert result.name == "cafe" and result.models == ["table"]
+    (actor,) = list(notices)
+    assert "<actor>" in actor.message and actor.location.line == 5  # the line in the file as written
+    model, data = _forward(spec)
+    np.testing.assert_allclose(data.geom_xpos[model.geom("table/l/c").id], [0, 0, 0.5])
+
+
+@pytest.mark.timeout(30)
+def test_the_gz_namespace_is_quiet_and_real_syntax_errors_are_still_errors(tmp_path: Path) -> None:
+    path = _write(
+        tmp_path,
+        "shapes.sdf",
+        """
+        <?xml version="1.0" ?>
+        <sdf version="1.11">
+          <world name="shapes">
+            <gz:policies><no_default_gui_plugins>true</no_default_gui_plugins></gz:policies>
+            <model name="box">
+              <static>true</static>
+              <link name="l">
+                <collision name="c">
+                  <geometry><box><size>1 1 1</size></box></geometry>
+                  <surface><bounce/><contact><ode/></contact></surface>
+                </collision>
+                <collision name="c2">
+                  <geometry><sphere><radius>0.2</radius></sphere></geometry>
+                  <surface><bounce><restitution_coefficient>0</restitution_coefficient></bounce></surface>
+                </collision>
+              </link>
+            </model>
+          </world>
+        </sdf>
+        """,
+    )
+    spec, _, notices = _load(path)
+    assert _messages(notices) == []
+    _forward(spec)
+
+    bouncy = _write(
+        tmp_path,
+        "bouncy.sdf",
+        """
+        <sdf version="1.7"><world name="w"><model name="ball"><static>true</static><link name="l">
+          <collision name="c"><geometry><sphere><radius>0.2</radius></sphere></geometry>
+            <surface><bounce><restitution_coefficient>0.8</restitution_coefficient></bounce></surface>
+          </collision>
+        </link></model></world></sdf>
+        """,
+    )
+    _, _, notices = _load(bouncy)
+    (notice,) = list(notices)
+    assert "restitution is not simulated" in notice.message and notice.location.line == 3
+
+    broken = _write(
+        tmp_path,
+        "broken.sdf",
+        """
+        <sdf version="1.11">
+          <world name="w">
+            <gz:policies/>
+            <model name="m"><static>true</static></mdl>
+          </world>
+        </sdf>
+        """,
+    )
+    with pytest.raises(SdfError, match="not well-formed") as info:
+        _load(broken)
+    assert info.value.line == 4
+
+
+# ------------------------------------------------------------------------------------------ shapes
+@pytest.mark.timeout(30)
+def test_a_cone_is_a_convex_mesh_centred_on_its_origin(tmp_path: Path) -> None:
+    cone = "<cone><radius>0.5</radius><length>1.0</length></cone>"
+    path = _write(
+        tmp_path,
+        "shapes.sdf",
+        f"""
+        <sdf version="1.11"><world name="w">
+          <model name="cone">
+            <pose>0 0 0.7 0 0 0</pose>
+            <link name="cone_link">
+              <inertial><mass>1</mass><inertia><ixx>0.05</ixx><iyy>0.05</iyy><izz>0.05</izz></inertia></inertial>
+              <collision name="c"><geometry>{cone}</geometry></collision>
+              <visual name="v"><geometry>{cone}</geometry></visual>
+            </link>
+          </model>
+          <model name="spike">
+            <static>true</static>
+            <pose>3 0 0.5 0 0 0</pose>
+            <link name="l"><collision name="c"><geometry>{cone}</geometry></collision></link>
+          </model>
+          <model name="pebble">
+            <pose>3.4 0 1.2 0 0 0</pose>
+            <link name="l">
+              <inertial><mass>0.1</mass><inertia><ixx>1e-4</ixx><iyy>1e-4</iyy><izz>1e-4</izz></inertia></inertial>
+              <collision name="c"><geometry><sphere><radius>0.05</radius></sphere></geometry></collision>
+            </link>
+          </model>
+        </world></sdf>
+        """,
+    )
+    spec, _, notices = _load(path)
+    assert _messages(notices) == []
+    assert len(spec.meshes) == 1  # one radius and length: one mesh for the three geoms
+    model, data = _forward(spec)
+    g = model.geom("cone/cone_link/c")
+    assert g.type[0] == mujoco.mjtGeom.mjGEOM_MESH
+    assert model.geom("cone/cone_link/v").dataid[0] == g.dataid[0]
+    mesh = g.dataid[0]
+    verts = model.mesh_vert[model.mesh_vertadr[mesh] : model.mesh_vertadr[mesh] + model.mesh_vertnum[mesh]]
+    world = data.geom_xpos[g.id] + verts @ data.geom_xmat[g.id].reshape(3, 3).T
+    cone_body = data.xpos[model.body("cone/cone_link").id]
+    # Base at -length/2, apex at +length/2 of the link frame, radius 0.5 (to the polygon's precision).
+    np.testing.assert_allclose(world[:, 2].min() - cone_body[2], -0.5, atol=1e-6)
+    np.testing.assert_allclose(world[:, 2].max() - cone_body[2], 0.5, atol=1e-6)
+    assert 0.49 < np.abs(world[:, 0] - cone_body[0]).max() <= 0.5 + 1e-6
+
+    _step(model, data, 1.5)
+    # The free cone stands on its base: its origin half a length up.
+    np.testing.assert_allclose(data.xpos[model.body("cone/cone_link").id], [0, 0, 0.5], atol=0.01)
+    # A pebble dropped where the static cone is 0.1 high (0.4 from its axis) hits the slope, not a
+    # cylinder's top at 1.0, and rolls off onto the ground.
+    pebble = data.xpos[model.body("pebble/l").id]
+    assert pebble[2] < 0.2 and pebble[0] > 3.4
+
+
+# ------------------------------------------------------------------------------------ paths, models
+@pytest.mark.timeout(30)
+def test_relative_mesh_uris_are_found_from_anywhere_and_misses_say_where_they_looked(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    pkg = tmp_path / "warehouse"  # the scenario's folder, as in aws-robomaker-small-warehouse-world
+    _stl(pkg / "models" / "wall" / "meshes" / "wall.stl", CUBE)
+    _write(
+        pkg / "models" / "wall",
+        "model.config",
+        "<model><name>wall</name><sdf version='1.6'>model.sdf</sdf></model>",
+    )
+    _write(
+        pkg / "models" / "wall",
+        "model.sdf",
+        """
+        <sdf version="1.6">
+          <model name="wall">
+            <static>true</static>
+            <link name="link">
+              <collision name="collision">
+                <geometry><mesh><uri>file://models/wall/meshes/wall.stl</uri></mesh></geometry>
+              </collision>
+              <visual name="visual">
+                <geometry><mesh><uri>meshes/wall.stl</uri><scale>2 2 2</scale></mesh></geometry>
+              </visual>
+            </link>
+          </model>
+        </sdf>
+        """,
+    )
+    world = _write(
+        pkg / "worlds",
+        "w.world",
+        """
+        <sdf version="1.6"><world name="w">
+          <include><uri>model://wall</uri><pose>0 0 0.5 0 0 0</pose></include>
+        </world></sdf>
+        """,
+    )
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    spec, _, notices = _load(world, packages=PackageMap(roots=[pkg]))
+    assert _messages(notices) == []
+    model, data = _forward(spec)
+    g = model.geom("wall/link/collision")
+    assert g.type[0] == mujoco.mjtGeom.mjGEOM_MESH
+    np.testing.assert_allclose(data.geom_xpos[g.id], [0, 0, 0.5])
+
+    missing = _write(
+        pkg / "models" / "wall",
+        "broken.sdf",
+        """
+        <sdf version="1.6"><model name="broken"><static>true</static><link name="link">
+          <collision name="c"><geometry><mesh><uri>file://models/wall/meshes/gone.stl</uri></mesh></geometry>
+          </collision>
+        </link></model></sdf>
+        """,
+    )
+    with pytest.raises(SdfError) as info:
+        _load(missing, packages=PackageMap(roots=[pkg]))
+    err = info.value
+    assert err.file == missing.resolve() and err.line == 2
+    for looked in (
+        pkg / "models" / "wall" / "models/wall/meshes/gone.stl",
+        pkg / "models/wall/meshes/gone.stl",
+    ):
+        assert str(looked) in str(err)
+    assert str(elsewhere) not in str(err)  # the current directory is not a place anything is looked up
+    assert "beside the SDF file" in (err.hint or "")
+
+
+@pytest.mark.timeout(30)
+def test_a_model_folder_with_only_model_sdf_is_found(tmp_path: Path) -> None:
+    _write(
+        tmp_path / "models" / "crate",
+        "model.sdf",
+        """
+        <sdf version="1.6"><model name="crate"><static>true</static><link name="l">
+          <collision name="c"><geometry><box><size>1 1 1</size></box></geometry></collision>
+        </link></model></sdf>
+        """,
+    )
+    world = _write(
+        tmp_path / "worlds",
+        "w.world",
+        """
+        <sdf version="1.6"><world name="w">
+          <include><uri>model://crate</uri><pose>1 2 0.5 0 0 0</pose></include>
+        </world></sdf>
+        """,
+    )
+    spec, result, _ = _load(world, packages=PackageMap(roots=[tmp_path]))
+    assert result.models == ["crate"]
+    model, data = _forward(spec)
+    np.testing.assert_allclose(data.xpos[model.body("crate/l").id], [1, 2, 0.5])
+
+
+@pytest.mark.timeout(30)
+def test_every_missing_model_and_collision_mesh_is_reported_at_once(tmp_path: Path) -> None:
+    includes = "\n".join(
+        f"  <include><uri>model://{name}</uri><name>{name}_{i}</name></include>"
+        for i, name in enumerate(["shelf", "bucket", "shelf", "lamp"])
+    )
+    world = _write(
+        tmp_path,
+        "warehouse.world",
+        f"""
+        <sdf version="1.6"><world name="w">
+        {includes}
+          <include><uri>models/nowhere/model.sdf</uri></include>
+          <model name="wall"><static>true</static><link name="l">
+            <collision name="c"><geometry><mesh><uri>meshes/wall.stl</uri></mesh></geometry></collision>
+          </link></model>
+        </world></sdf>
+        """,
+    )
+    with pytest.raises(SdfError) as info:
+        _load(world)
+    err = info.value
+    text = str(err)
+    assert "5 problems" in text  # the two shelves share a line of the message
+    assert ":2,4: model 'model://shelf' not found" in text
+    for uri in ("model://bucket", "model://lamp", "models/nowhere/model.sdf", "meshes/wall.stl"):
+        assert uri in text
+    lines = {(p.line, next(w for w in ("shelf", "bucket", "lamp", "nowhere", "wall") if w in str(p)))
+             for p in err.problems}  # fmt: skip
+    assert lines == {(2, "shelf"), (3, "bucket"), (4, "shelf"), (5, "lamp"), (6, "nowhere"), (8, "wall")}
+    assert err.file == world.resolve() and err.line == 2
+    assert "model.sdf" in (err.hint or "") and str(tmp_path) in (err.hint or "")
+
+    # Through the scenario: one error, every one of them, pointing back at the scenario's `world.sdf`.
+    scenario = _write(tmp_path, "s.yaml", "name: s\nduration: 1.0\nworld: {sdf: warehouse.world}\n")
+    with pytest.raises(ScenarioError) as full:
+        plan_of(scenario)
+    rendered = full.value.render()
+    for name in ("shelf", "bucket", "lamp", "nowhere", "wall.stl"):
+        assert name in rendered
+    assert f"{scenario}:3" in rendered
+
+
+@pytest.mark.timeout(30)
+def test_fuel_ground_plane_and_sun_are_the_builtins_and_other_fuel_models_can_be_supplied(
+    tmp_path: Path,
+) -> None:
+    fuel = "https://fuel.gazebosim.org/1.0/OpenRobotics/models"
+    world = _write(
+        tmp_path,
+        "tb3.world",
+        f"""
+        <sdf version="1.8"><world name="w">
+          <include><uri>{fuel}/Ground Plane</uri></include>
+          <include><uri>https://fuel.gazebosim.org/1.0/openrobotics/models/sun/2</uri></include>
+          <include><uri>{fuel}/ground%20plane/</uri></include>
+        </world></sdf>
+        """,
+    )
+    spec, result, notices = _load(world, _spec(ground=False))
+    assert result.ground
+    assert [g.name for g in spec.geoms if g.type == PLANE] == ["ground"]
+    assert [li.name for li in spec.lights] == ["sun"]
+    (dup,) = list(notices)  # the second ground plane, said once, not an error
+    assert "already has a ground plane" in dup.message and dup.location.line == 4
+    _forward(spec)
+
+    table = _write(
+        tmp_path / "scenario",
+        "w.world",
+        f"""
+        <sdf version="1.8"><world name="w">
+          <include><uri>{fuel}/Cafe table/3</uri><pose>2 0 0 0 0 0</pose></include>
+        </world></sdf>
+        """,
+    )
+    packages = PackageMap(roots=[tmp_path / "scenario"])
+    with pytest.raises(SdfError, match="not downloaded") as info:
+        _load(table, packages=packages)
+    hint = info.value.hint or ""
+    assert "gz fuel download" in hint and "'Cafe table'" in hint and "packages:" in hint
+    # Doing what the hint says: the downloaded folder, named as the hint says, under the scenario's folder.
+    _write(
+        tmp_path / "scenario" / "downloads" / "Cafe table",
+        "model.sdf",
+        """
+        <sdf version="1.6"><model name="cafe_table"><static>true</static><link name="l">
+          <collision name="c"><pose>0 0 0.4 0 0 0</pose><geometry><box><size>1 1 0.8</size></box></geometry>
+          </collision>
+          <visual name="v"><pose>0 0 0.85 0 0 0</pose><geometry><mesh>
+            <uri>https://fuel.gazebosim.org/1.0/OpenRobotics/models/Cafe%20table/3/files/meshes/top.stl</uri>
+          </mesh></geometry></visual>
+        </link></model></sdf>
+        """,
+    )
+    _stl(tmp_path / "scenario" / "downloads" / "Cafe table" / "meshes" / "top.stl", CUBE)
+    spec, result, notices = _load(table, packages=PackageMap(roots=[tmp_path / "scenario"]))
+    assert result.models == ["cafe_table"]
+    assert _messages(notices) == []  # the model's own Fuel file address is its folder's file
+    model, data = _forward(spec)
+    np.testing.assert_allclose(data.geom_xpos[model.geom("cafe_table/l/c").id], [2, 0, 0.4])
+    assert model.geom("cafe_table/l/v").type[0] == mujoco.mjtGeom.mjGEOM_MESH
+
+
+# ------------------------------------------------------------------------------------------ ground
+@pytest.mark.timeout(30)
+def test_the_worlds_own_ground_plane_is_the_ground_with_its_friction(tmp_path: Path) -> None:
+    slippery = "<surface><friction><ode><mu>0.1</mu><mu2>0.2</mu2></ode></friction></surface>"
+    path = _write(
+        tmp_path,
+        "ice.sdf",
+        f"""
+        <sdf version="1.7"><world name="w">
+          {GROUND_PLANE.format(surface=slippery)}
+          {_sliding_box()}
+        </world></sdf>
+        """,
+    )
+    spec, result, notices = _load(path)
+    assert _messages(notices) == []  # no "this plane at z=0 is left out": the file has one ground
+    assert result.ground_model == "ground_plane/link" and not result.ground
+    model, data = _forward(spec)
+    planes = [model.geom(i).name for i in range(model.ngeom) if model.geom_type[i] == PLANE]
+    assert planes == ["ground"]
+    ground = model.geom("ground")
+    assert ground.friction[0] == pytest.approx(0.1) and ground.priority[0] == 2
+    np.testing.assert_allclose(ground.rgba, [0.2, 0.5, 0.2, 1.0])  # the file's colour
+
+    # A box sliding at 2 m/s on mu 0.1 stops after v^2 / (2 mu g) = 2.04 m (0.2 m on the default mu 1).
+    puck = model.body("puck/link").id
+    _step(model, data, 0.3)
+    data.qvel[0] = 2.0
+    start = data.xpos[puck][0]
+    _step(model, data, 3.0)
+    assert data.xpos[puck][0] - start == pytest.approx(2.0**2 / (2 * 0.1 * 9.81), rel=0.1)
+
+
+@pytest.mark.timeout(30)
+def test_a_grippy_ground_plane_combines_as_gazebo_and_the_scenario_can_override(tmp_path: Path) -> None:
+    # nav2's sam_bot world: mu 100 / mu2 50, an empty <bounce/>, torsional friction.
+    grippy = (
+        "<surface><friction><ode><mu>100</mu><mu2>50</mu2></ode></friction><contact><ode/></contact>"
+        "<bounce/></surface>"
+    )
+    path = _write(
+        tmp_path,
+        "my_world.sdf",
+        f"""
+        <sdf version="1.7"><world name="w">
+          {GROUND_PLANE.format(surface=grippy)}
+          <model name="floor_2"><static>true</static><link name="l">
+            <collision name="c"><geometry><plane><normal>0 0 1</normal></plane></geometry></collision>
+          </link></model>
+        </world></sdf>
+        """,
+    )
+    spec, _, notices = _load(path)
+    # Gazebo takes the smaller mu of two surfaces: against mu 50 every surface keeps its own friction.
+    ground = spec.geom("ground")
+    assert ground.friction[0] == pytest.approx(1.0) and ground.priority == 0
+    (dup,) = list(notices)
+    lines = path.read_text().splitlines()
+    first = next(i for i, line in enumerate(lines, 1) if "<link" in line)  # the ground plane's link
+    second = next(i for i, line in enumerate(lines, 1) if "<plane><normal>0 0 1</normal></plane>" in line)
+    assert f"already has a ground plane (model 'ground_plane', line {first})" in dup.message
+    assert dup.location.line == second
+    _forward(spec)
+
+    # `world.ground.friction` set in the scenario wins over the file's, with a word.
+    spec = _spec()
+    spec.geom("ground").friction = [0.3, 0.005, 0.0001]
+    slippery = "<surface><friction><ode><mu>0.1</mu></ode></friction></surface>"
+    path = _write(tmp_path, "ice.sdf", f'<sdf version="1.7"><world name="w">{GROUND_PLANE.format(surface=slippery)}'
+                  "</world></sdf>")  # fmt: skip
+    spec, _, notices = _load(path, spec)
+    assert spec.geom("ground").friction[0] == pytest.approx(0.3)
+    assert any("`world.ground.friction` (0.3)" in m for m in _messages(notices))
+
+    # Through the scenario: the plan's model has one ground, the file's friction on it.
+    path = _write(tmp_path, "s.sdf", f'<sdf version="1.7"><world name="w">{GROUND_PLANE.format(surface=slippery)}'
+                  "</world></sdf>")  # fmt: skip
+    plan = plan_of(_write(tmp_path, "s.yaml", "name: s\nduration: 1.0\nworld: {sdf: s.sdf}\n"))
+    model = mujoco.MjModel.from_xml_string(plan.mjcf)
+    assert [model.geom(i).name for i in range(model.ngeom) if model.geom_type[i] == PLANE] == ["ground"]
+    assert model.geom("ground").friction[0] == pytest.approx(0.1)
+    assert not any("left out" in n for n in plan.notices)
+
+
+# ------------------------------------------------------------------------------------------ meshes
+@pytest.mark.timeout(30)
+def test_a_missing_visual_mesh_is_a_warning_a_broken_collision_mesh_an_error(tmp_path: Path) -> None:
+    path = _write(
+        tmp_path,
+        "cafe.sdf",
+        """
+        <sdf version="1.6"><model name="cafe"><static>true</static><link name="l">
+          <collision name="floor"><geometry><box><size>4 4 0.2</size></box></geometry></collision>
+          <visual name="look"><geometry><mesh><uri>model://cafe/meshes/cafe.dae</uri></mesh></geometry></visual>
+          <visual name="sign"><geometry><mesh><uri>meshes/sign.stl</uri></mesh></geometry></visual>
+        </link></model></sdf>
+        """,
+    )
+    spec, _, notices = _load(path)
+    assert [g.name for g in spec.geoms] == ["ground", "cafe/l/floor"]
+    by_line = {n.location.line: n for n in notices}
+    assert set(by_line) == {3, 4}
+    assert "model://cafe/meshes/cafe.dae" in by_line[3].message and "left out" in by_line[3].message
+    assert str(tmp_path / "meshes" / "sign.stl") in by_line[4].message
+    _forward(spec)
+
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "hexagon.dae").write_text(
+        "version https://git-lfs.github.com/spec/v1\noid sha256:16b1\nsize 3342\n"
+    )
+    (tmp_path / "meshes" / "empty.stl").write_bytes(b"")
+    lfs = _write(
+        tmp_path,
+        "tb3.sdf",
+        """
+        <sdf version="1.6"><model name="m"><static>true</static><link name="l">
+          <visual name="v"><geometry><mesh><uri>meshes/hexagon.dae</uri></mesh></geometry></visual>
+          <collision name="head"><geometry><mesh><uri>meshes/hexagon.dae</uri></mesh></geometry></collision>
+          <collision name="base"><geometry><mesh><uri>meshes/empty.stl</uri></mesh></geometry></collision>
+        </link></model></sdf>
+        """,
+    )
+    with pytest.raises(SdfError) as info:
+        _load(lfs)
+    assert [(p.line, "LFS" in str(p), "empty" in str(p)) for p in info.value.problems] == [
+        (3, True, False),
+        (4, False, True),
+    ]
+    assert "git lfs pull" in (info.value.hint or "")
+
+
+@pytest.mark.timeout(60)
+def test_a_static_collision_mesh_far_from_convex_is_reported(tmp_path: Path) -> None:
+    t, h = 0.1, 1.0  # a 4 x 4 m room: four walls 0.1 m thick, in one mesh
+    walls = [
+        ((-2, -2, 0), (2, -2 + t, h)),
+        ((-2, 2 - t, 0), (2, 2, h)),
+        ((-2, -2 + t, 0), (-2 + t, 2 - t, h)),
+        ((2 - t, -2 + t, 0), (2, 2 - t, h)),
+    ]
+    _stl(tmp_path / "meshes" / "room.stl", walls)
+    _stl(tmp_path / "meshes" / "slab.stl", [((-7, -10, -0.12), (7, 10, 0))])
+    _stl(tmp_path / "meshes" / "cube.stl", CUBE)
+    ball = """
+      <model name="{name}"><pose>{x} 0 0.3 0 0 0</pose><link name="l">
+        <inertial><mass>1</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial>
+        <collision name="c"><geometry><sphere><radius>0.2</radius></sphere></geometry></collision>
+      </link></model>"""
+    path = _write(
+        tmp_path,
+        "building.world",
+        f"""
+        <sdf version="1.6"><world name="w">
+          <model name="building"><static>true</static><link name="link">
+            <collision name="walls"><geometry><mesh><uri>meshes/room.stl</uri></mesh></geometry></collision>
+            <visual name="walls"><geometry><mesh><uri>meshes/room.stl</uri></mesh></geometry></visual>
+          </link></model>
+          <model name="floor"><static>true</static><pose>0 0 0 0 0 0</pose><link name="link">
+            <collision name="c"><geometry><mesh><uri>meshes/slab.stl</uri></mesh></geometry></collision>
+          </link></model>
+          <model name="crate"><static>true</static><pose>5 5 0.5 0 0 0</pose><link name="link">
+            <collision name="c"><geometry><mesh><uri>meshes/cube.stl</uri></mesh></geometry></collision>
+          </link></model>
+          <model name="loose_room"><pose>20 0 0 0 0 0</pose><link name="link">
+            <inertial><mass>10</mass><inertia><ixx>1</ixx><iyy>1</iyy><izz>1</izz></inertia></inertial>
+            <collision name="c"><geometry><mesh><uri>meshes/room.stl</uri><scale>1 1 0.5</scale></mesh></geometry>
+            </collision>
+          </link></model>
+          {ball.format(name="inside", x=0)}
+          {ball.format(name="outside", x=4)}
+        </world></sdf>
+        """,
+    )
+    spec, _, notices = _load(path)
+    (notice,) = list(notices)  # the walls only: not the slab, the cube or a moving mesh
+    assert notice.location.line == 3 and notice.location.file == path.resolve()
+    assert "meshes/room.stl" in notice.message and "building/link" in notice.message
+    ratio = (4 * 4 * h) / (4 * 4 * h - (4 - 2 * t) ** 2 * h)
+    assert f"{ratio:.0f} times" in notice.message
+    assert "primitive collision shapes" in (notice.hint or "") and "convex parts" in (notice.hint or "")
+
+    # What it is about: a robot inside the room is inside the hull and is shoved (here, into the floor),
+    # while the same one outside rests on the floor.
+    model, data = _forward(spec)
+    _step(model, data, 0.5)
+    assert data.xpos[model.body("outside/l").id][2] == pytest.approx(0.2, abs=0.01)
+    assert abs(data.xpos[model.body("inside/l").id][2] - 0.2) > 0.05
