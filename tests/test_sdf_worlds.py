@@ -4,7 +4,6 @@ SDF reader tripped on. SDF text written in tmp_path, compiled to real MuJoCo mod
 from __future__ import annotations
 
 import struct
-import textwrap
 from pathlib import Path
 
 import mujoco
@@ -15,6 +14,7 @@ from runner.compile.packages import PackageMap
 from runner.compile.sdf import SdfError, SdfWorld, load_sdf_world
 from runner.errors import Notices, ScenarioError
 from tests.helpers import plan_of
+from tests.test_sdf import _forward, _step, _write
 
 PLANE = mujoco.mjtGeom.mjGEOM_PLANE
 
@@ -36,32 +36,14 @@ def _spec(ground: bool = True) -> mujoco.MjSpec:
     return spec
 
 
-def _write(folder: Path, name: str, text: str) -> Path:
-    path = folder / name
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(textwrap.dedent(text).lstrip(), encoding="utf-8")
-    return path
-
-
 def _load(
     path: Path, spec: mujoco.MjSpec | None = None, packages: PackageMap | None = None
 ) -> tuple[mujoco.MjSpec, SdfWorld, Notices]:
+    """As test_sdf's, with this file's world spec (the scenario's default ground in it)."""
     spec = spec if spec is not None else _spec()
     notices = Notices()
     result = load_sdf_world(spec, path, packages or PackageMap(roots=[path.parent]), notices)
     return spec, result, notices
-
-
-def _forward(spec: mujoco.MjSpec) -> tuple[mujoco.MjModel, mujoco.MjData]:
-    model = spec.compile()
-    data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
-    return model, data
-
-
-def _step(model: mujoco.MjModel, data: mujoco.MjData, seconds: float) -> None:
-    for _ in range(round(seconds / model.opt.timestep)):
-        mujoco.mj_step(model, data)
 
 
 def _messages(notices: Notices) -> list[str]:
