@@ -16,7 +16,7 @@ from pydantic import ValidationError
 
 from runner import msgs
 from runner.checks import assertion_keys, check_names, truth_robots
-from runner.checks.judge import TRUTH_RATE, TRUTH_TOPIC
+from runner.checks.judge import TRUTH_RATE, TRUTH_TOPIC, contacts_key
 from runner.compile.gazebo import DescribedPlugin
 from runner.compile.packages import PackageMap
 from runner.compile.sdf import load_sdf_world
@@ -34,6 +34,7 @@ from runner.plan import (
     RunPlan,
     TimelinePlan,
     TopicPlan,
+    hidden_topic,
     topic_key,
 )
 from runner.plugin import BuildContext, PluginConfigError
@@ -149,12 +150,15 @@ def _check_record_patterns(plan: RunPlan, sc: Scenario, doc: Document, notices: 
         return
     keys = set()
     for part in plan.every_plan():
-        keys |= {t.key for t in part.topics()}
+        keys |= {t.key for t in part.topics()}  # plugins' (the judge's _truth too), timeline's, clock
+        # what the world publishes besides (runner.sim.scene, the contacts judge, the launcher's plan)
         keys |= {f"{part.name}/{k}" for k in ("scene", "tf", "tf_static", "_model", "_state", "_plan")}
-        keys |= {f"{part.name}/{r.namespace}/robot_description".replace("//", "/") for r in part.robots}
-        keys |= {f"{part.name}/_truth/x", f"{part.name}/_contacts"}
+        keys |= {topic_key(part.name, r.namespace, "robot_description") for r in part.robots}
+        keys.add(contacts_key(part.name))
     known = [zenoh.KeyExpr(k) for k in keys]
     nodes = " (or a node publishes it)" if plan.nodes else ""
+    rels = (k[len(plan.name) + 1 :] for k in keys)
+    sample = ", ".join(sorted(rel for rel in rels if not hidden_topic(rel))[:6])
     for field_name, written, full in (
         ("exclude", sc.record.exclude, rec.exclude),
         ("include", sc.record.include, rec.include),
@@ -163,13 +167,11 @@ def _check_record_patterns(plan: RunPlan, sc: Scenario, doc: Document, notices: 
             if any(zenoh.KeyExpr(expr).intersects(k) for k in known):
                 continue
             where = doc.locate(("record", field_name, i))
-            sample = sorted(k[len(plan.name) + 1 :] for k in keys if "/_" not in k)[:6]
             notices.add(
                 f"record.{field_name}[{i}] {text!r} matches none of the run's topics{nodes}",
                 where.file,
                 where.line,
-                hint="patterns are relative to the run, e.g. r1/camera/** or */camera/**; topics: "
-                + ", ".join(sample),
+                hint=f"patterns are relative to the run, e.g. r1/camera/** or */camera/**; topics: {sample}",
             )
 
 
