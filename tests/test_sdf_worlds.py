@@ -646,3 +646,31 @@ def test_a_static_collision_mesh_far_from_convex_is_reported(tmp_path: Path) -> 
     _step(model, data, 0.5)
     assert data.xpos[model.body("outside/l").id][2] == pytest.approx(0.2, abs=0.01)
     assert abs(data.xpos[model.body("inside/l").id][2] - 0.2) > 0.05
+
+
+@pytest.mark.timeout(30)
+def test_an_ascii_stl_in_a_world_is_converted_as_a_robots_is(tmp_path: Path) -> None:
+    facets = "".join(
+        f"facet normal 0 0 0\nouter loop\n{''.join(f'vertex {x} {y} {z}' + chr(10) for x, y, z in tri)}"
+        "endloop\nendfacet\n"
+        for tri in [
+            ((0, 0, 0), (1, 0, 0), (0, 1, 0)),
+            ((0, 0, 0), (0, 1, 0), (0, 0, 1)),
+            ((0, 0, 0), (0, 0, 1), (1, 0, 0)),
+            ((1, 0, 0), (0, 1, 0), (0, 0, 1)),
+        ]
+    )
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "tetra.stl").write_text(f"solid tetra\n{facets}endsolid tetra\n")
+    path = _write(
+        tmp_path,
+        "w.sdf",
+        """
+        <sdf version="1.6"><model name="m"><static>true</static><pose>3 0 0 0 0 0</pose><link name="l">
+          <collision name="c"><geometry><mesh><uri>meshes/tetra.stl</uri></mesh></geometry></collision>
+        </link></model></sdf>
+        """,
+    )
+    spec, _, _ = _load(path)
+    model, _ = _forward(spec)  # MuJoCo reads binary STL only: this compiles because it was converted
+    assert model.nmeshvert == 4

@@ -27,8 +27,6 @@ from pathlib import Path
 
 import numpy as np
 
-MUJOCO_MESH_FORMATS = {".stl", ".obj", ".msh"}
-
 # Bumped whenever the conversion changes what it writes (v2: COLLADA units, ASCII STL, OBJ for big meshes),
 # so that files converted by an older version are not reused.
 _RECIPE = "v2"
@@ -39,12 +37,16 @@ _FLAT = 1e-9  # thickness / size below which a mesh is flat
 
 
 class MeshError(Exception):
-    """A mesh file MuJoCo cannot use. `str()` is `mesh NAME: REASON`; `reason` and `hint` apart."""
+    """A mesh file MuJoCo cannot use. `str()` is `mesh NAME: REASON`; `reason` and `hint` apart;
+    `converting`: the file looked like a mesh, but its format could not be converted."""
 
-    def __init__(self, message: str, hint: str | None = None, reason: str | None = None):
+    def __init__(
+        self, message: str, hint: str | None = None, reason: str | None = None, converting: bool = False
+    ):
         super().__init__(message)
         self.hint = hint
         self.reason = reason if reason is not None else message
+        self.converting = converting
 
 
 @dataclass(frozen=True)
@@ -250,11 +252,13 @@ def _convert(path: Path, data: bytes) -> PreparedMesh:
     except MeshError:
         raise
     except Exception as e:
-        raise _error(
+        error = _error(
             path,
             f"cannot convert {what} to a format MuJoCo reads ({_why(e)})",
             hint="export it as binary STL or OBJ",
-        ) from None
+        )
+        error.converting = True
+        raise error from None
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
         raise _error(
             path,

@@ -46,7 +46,7 @@ import numpy as np
 from lxml import etree
 
 from runner.compile.materials import gazebo_material
-from runner.compile.meshes import MeshError, convert_mesh
+from runner.compile.meshes import MeshError, prepare_mesh
 from runner.compile.packages import URI_RE, PackageMap
 from runner.compile.urdf import COLLISION_GROUP
 from runner.errors import Notices, SourceError
@@ -153,7 +153,6 @@ _GREY = (0.7, 0.7, 0.7, 1.0)
 _GROUND_RGBA = (0.55, 0.57, 0.6, 1.0)
 
 _PLANE = mujoco.mjtGeom.mjGEOM_PLANE
-_MESH_FORMATS = {".stl", ".obj"}
 
 # Tags read without effect on a MuJoCo model; dropped without a notice.
 _QUIET = {
@@ -1192,30 +1191,27 @@ class _Loader:
             where = f"looked at {', '.join(str(p) for p in looked)}" if looked else hint
             fail(f"mesh {uri!r} not found ({where})", hint)
             return None
-        unreadable = _unreadable(path)
-        if unreadable:
-            fail(f"mesh {path} {unreadable[0]}", unreadable[1])
-            return None
-        if path.suffix.lower() not in _MESH_FORMATS:
-            try:
-                path = convert_mesh(path)
-            except MeshError as e:
-                alt = next(
-                    (
-                        path.with_suffix(x)
-                        for x in (".stl", ".STL", ".obj", ".OBJ")
-                        if path.with_suffix(x).is_file()
-                    ),
-                    None,
+        try:  # the same checks and conversions as a URDF's meshes (runner.compile.meshes)
+            path = prepare_mesh(path).file
+        except MeshError as e:
+            # a format that cannot be converted may have an STL or OBJ export beside it
+            alt = next(
+                (
+                    path.with_suffix(x)
+                    for x in (".stl", ".STL", ".obj", ".OBJ")
+                    if path.with_suffix(x).is_file()
+                ),
+                None,
+            )
+            if not e.converting or alt is None:
+                fail(
+                    f"mesh {uri!r}: {e.reason}",
+                    e.hint
+                    or "convert it to STL or OBJ (e.g. with Blender or trimesh) and point the <uri> at it",
                 )
-                if alt is None:
-                    fail(
-                        str(e),
-                        "convert it to STL or OBJ (e.g. with Blender or trimesh) and point the <uri> at it",
-                    )
-                    return None
-                self.note(f"{e}; using {alt.name} instead", src, uri_el)
-                path = alt
+                return None
+            self.note(f"{e}; using {alt.name} instead", src, uri_el)
+            path = alt
         key = (str(path.resolve()), tuple(scale))
         if convex_check and key not in self.convex_checked:
             self.convex_checked.add(key)
@@ -1562,23 +1558,6 @@ def _xml_bytes(path: Path) -> bytes:
 def _custom(el: etree._Element) -> bool:
     """A custom element (`<gz:policies>`, `<drake:...>`: a namespace prefix), which SDF readers skip."""
     return isinstance(el.tag, str) and (":" in el.tag or el.tag.startswith("{"))
-
-
-def _unreadable(path: Path) -> tuple[str, str] | None:
-    """Why the mesh file at `path` cannot be a mesh (what, hint), or None when it may be one."""
-    try:
-        with path.open("rb") as f:
-            head = f.read(64)
-    except OSError as e:
-        return f"cannot be read ({e.strerror or e})", "check the file's permissions"
-    if not head:
-        return "is empty", "the file has no content: fetch or export the mesh again"
-    if head.startswith(b"version https://git-lfs.github.com/spec/"):
-        return (
-            "is a Git LFS pointer, not the mesh",
-            "fetch the real file: `git lfs install && git lfs pull` in its repository",
-        )
-    return None
 
 
 # A static collision mesh whose convex hull exceeds its volume this many times (and by this much, m³) is
