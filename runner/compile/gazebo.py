@@ -473,10 +473,6 @@ class GazeboReader:
         if kind.lower() not in ("gaussian", "gaussian_quantized"):
             self.note(noise, f"noise type {kind!r} is treated as gaussian")
 
-        def num(tag: str) -> float:
-            text = noise.findtext(tag)
-            return float(text) if text and text.strip() else 0.0
-
         for child in noise:
             if not isinstance(child.tag, str) or child.tag in _NOISE_TAGS:
                 continue
@@ -484,7 +480,7 @@ class GazeboReader:
                 self.note(child, "noise <precision> is ignored (readings are not quantized)")
             elif child.tag != "precision" and not _zero(child.text):
                 self.note(child, f"noise <{child.tag}> is ignored")
-        return _NoiseSpec(num("stddev"), num("mean"), num("bias_mean"), num("bias_stddev"), noise)
+        return _NoiseSpec.of(noise)
 
     def _lidar(self, r: _Reader, el: Any, context: str) -> dict[str, Any]:
         ray = r.child("ray", "lidar")
@@ -588,11 +584,7 @@ class GazeboReader:
         if kind == "none":
             return None
 
-        def num(tag: str) -> float:
-            text = el.findtext(tag)
-            return float(text) if text and text.strip() else 0.0
-
-        return _NoiseSpec(num("stddev"), num("mean"), num("bias_mean"), num("bias_stddev"), el)
+        return _NoiseSpec.of(el)
 
     @staticmethod
     def _imu_noise(out: dict[str, Any], key: str, specs: list[_NoiseSpec | None]) -> None:
@@ -901,6 +893,16 @@ class _NoiseSpec:
     bias_mean: float = 0.0
     bias_stddev: float = 0.0
     el: Any = None
+
+    @classmethod
+    def of(cls, el: Any) -> _NoiseSpec:
+        """The numbers of a noise element (`<noise>`, or a classic `<rate>`/`<accel>` block); 0 if absent."""
+
+        def num(tag: str) -> float:
+            text = el.findtext(tag)
+            return float(text) if text and text.strip() else 0.0
+
+        return cls(num("stddev"), num("mean"), num("bias_mean"), num("bias_stddev"), el)
 
 
 def _sibling(topic: str, name: str) -> str:
