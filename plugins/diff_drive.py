@@ -20,7 +20,7 @@ import mujoco
 import numpy as np
 from pydantic import Field, PositiveFloat
 
-from plugins._common import BaseDriveParams, OdometryWriter, TransformWriter, drive_topics
+from plugins._common import BaseDriveParams, OdometryWriter, TransformWriter, drive_topics, tf_transforms
 from runner.geometry import quat_to_yaw
 from runner.plugin import BuildContext, Plugin, PluginConfigError, Topic
 
@@ -37,7 +37,13 @@ _ROUND = {
 class WheelDriveParams(BaseDriveParams):
     """Parameters shared by `diff_drive` and `skid_steer` (everything but the wheel joints)."""
 
-    rate: float = Field(50.0, gt=0, description="Control and odometry rate, sim Hz.")
+    rate: float = Field(50.0, gt=0, description="Odometry and TF publishing rate, sim Hz.")
+    control_rate: float = Field(
+        100.0,
+        gt=0,
+        description="How often the drive updates its wheel targets, sim Hz (at most every physics step), "
+        "whatever it publishes at: the wheel servos act at every physics step, as Gazebo's joint motors do.",
+    )
     wheel_separation: PositiveFloat | None = Field(
         None, description="Distance between the wheels, metres (default: measured from the model)."
     )
@@ -57,10 +63,24 @@ class WheelDriveParams(BaseDriveParams):
         "encoders", description="Integrate wheel encoders, or report the true pose."
     )
     yaw_rate_feedback: bool = Field(
-        True,
+        False,
         description="Close the loop on the body's yaw rate (as a gyro-stabilised drive does): when casters "
-        "drag or wheels scrub, the wheels turn faster until the body turns at the commanded rate. Off: the "
-        "wheel speeds alone follow the command, as in Gazebo's plugins.",
+        "drag or wheels scrub, the wheels turn faster until the body turns at the commanded rate. Off (the "
+        "default, as in Gazebo's plugins): the wheel speeds alone follow the command.",
+    )
+    publish_wheel_tf: bool = Field(
+        False,
+        description="Also publish each wheel's transform from its parent link on the TF topic "
+        "(gazebo_ros_diff_drive's publishWheelTF / publish_wheel_tf).",
+    )
+    pair_separations: list[PositiveFloat] | None = Field(
+        None,
+        description="Per wheel pair (left_joints[i], right_joints[i]): its separation, metres, as "
+        "gazebo_ros_diff_drive's repeated <wheel_separation> (default: `wheel_separation` for every pair).",
+    )
+    pair_radii: list[PositiveFloat] | None = Field(
+        None,
+        description="Per wheel pair: its wheel radius, metres (default: `wheel_radius` for every pair).",
     )
 
 
@@ -108,7 +128,23 @@ class WheelDrive(Plugin):
             act.set_to_velocity(kv=params.gain or 1.0)  # the automatic gain is set in setup()
             act.forcelimited = True
             act.forcerange = [-params.max_wheel_torque, params.max_wheel_torque]
-        return drive_topics(params)
+        pairs = max(len(left), len(right))
+        for key in ("pair_separations", "pair_radii"):
+            values = getattr(params, key)
+            if values is not None and len(values) != pairs:
+                raise PluginConfigError(
+                    f"{key} has {len(values)} value(s) for {pairs} wheel pair(s)",
+                    key,
+                    hint="one value per pair of left/right joints, in their order",
+                )
+        topics = drive_topics(params)
+        if params.publish_wheel_tf and not params.publish_tf:
+            topics.append(Topic(params.tf_topic, "tf2_msgs/msg/TFMessage", "pub", params.rate))
+        return topics
+
+    @classmethod
+    def control_rate_of(cls, params: Any) -> float | None:
+        return float(params.control_rate)
 
     def setup(self) -> None:
         p = self.params
@@ -131,19 +167,39 @@ class WheelDrive(Plugin):
                 kv = _auto_gain(m, r.body_ids, wheel, self.radius, len(wheel_bodies))
                 m.actuator_gainprm[a, 0] = kv
                 m.actuator_biasprm[a, 2] = -kv
+        # A velocity servo stiffer than the wheel's inertia allows (timestep x kv > inertia) upsets the
+        # wheel's contacts under the implicit integrators: MuJoCo computes contact forces without the
+        # servo's implicit damping, so a wheel scrubbing sideways loses its grip (a skid-steer robot turned at
+        # a quarter of its command). Armature (rotor inertia, as a geared motor has) of timestep x kv keeps
+        # the two consistent.
+        for a, dof in zip(self.act, self.vadr, strict=True):
+            m.dof_armature[dof] = max(
+                float(m.dof_armature[dof]), float(m.opt.timestep) * float(m.actuator_gainprm[a, 0])
+            )
         self.base_frame = p.base_frame or r.frame(r.root_link)
         self.odom_frame = r.frame(p.odom_frame)
         self.cmd = (0.0, 0.0)
         self.cmd_time = 0
-        # sign of each wheel's share of the turn: -1 for the left side, +1 for the right
-        turn_sign = [-1.0 if i < self.nleft else 1.0 for i in range(len(joints))]
+        # each wheel's share of the turn (-half its pair's separation on the left, + on the right) and the
+        # radius its speed is divided by
+        nright = len(joints) - self.nleft
+        pair = list(range(self.nleft)) + list(range(nright))
+        seps = p.pair_separations or [self.sep] * max(self.nleft, nright)
+        radii = p.pair_radii or [self.radius] * max(self.nleft, nright)
+        turn_sign = [
+            (-1.0 if i < self.nleft else 1.0) * seps[pair[i]] / 2.0 / radii[pair[i]]
+            for i in range(len(joints))
+        ]
+        self._inv_radius = [1.0 / radii[pair[i]] for i in range(len(joints))]
         self.ctrl = [0.0] * len(joints)
         # Integral of the wheel-speed error: a velocity servo alone lags under load (tyre scrub when
         # turning, slopes); Gazebo's diff drive holds the commanded wheel speed up to the torque limit.
         self.integral = [0.0] * len(joints)
         self.integral_max = (p.max_wheel_torque / m.actuator_gainprm[self.act, 0]).tolist()
-        self._wheels = list(zip(turn_sign, self.vadr.tolist(), self.act.tolist(), strict=True))
-        self.dt = 1.0 / p.rate
+        self._wheels = list(
+            zip(turn_sign, self._inv_radius, self.vadr.tolist(), self.act.tolist(), strict=True)
+        )
+        self.dt = max(1.0 / p.control_rate, float(m.opt.timestep))
         self.yaw_integral = 0.0
         self._vel = np.zeros(6)
         # encoder odometry state
@@ -157,9 +213,15 @@ class WheelDrive(Plugin):
         self.qpos, self.qvel, self.actuator_ctrl = d.qpos, d.qvel, d.ctrl  # views, looked up once
         self.ctx.subscribe(p.cmd_topic, "geometry_msgs/msg/Twist", self._on_cmd)
         odom_pub = self.ctx.publisher(p.odom_topic, "nav_msgs/msg/Odometry") if p.publish_odom else None
-        tf_pub = self.ctx.publisher(p.tf_topic, "tf2_msgs/msg/TFMessage") if p.publish_tf else None
+        wants_tf = p.publish_tf or p.publish_wheel_tf
+        tf_pub = self.ctx.publisher(p.tf_topic, "tf2_msgs/msg/TFMessage") if wants_tf else None
         self.odom_out = OdometryWriter(odom_pub, self.odom_frame, self.base_frame) if odom_pub else None
-        self.tf_out = TransformWriter(tf_pub, self.odom_frame, self.base_frame) if tf_pub else None
+        # with wheel transforms, one TFMessage a cycle carries them and odom -> base together
+        only_odom = tf_pub is not None and p.publish_tf and not p.publish_wheel_tf
+        self.tf_out = TransformWriter(tf_pub, self.odom_frame, self.base_frame) if only_odom else None
+        self.wheel_tf: WheelTransforms | None = None
+        if tf_pub is not None and p.publish_wheel_tf:
+            self.wheel_tf = WheelTransforms(tf_pub, m, d, r, wheel_bodies)
 
     def _side_means(self, values: np.ndarray) -> np.ndarray:
         return self._means @ values
@@ -176,14 +238,13 @@ class WheelDrive(Plugin):
             v, w = 0.0, 0.0
         if p.yaw_rate_feedback:
             w = self._yaw_feedback(w)
-        turn, ahead = w * self.sep / 2.0 / self.radius, v / self.radius
         step = p.max_wheel_acceleration * self.dt if p.max_wheel_acceleration > 0 else None
         gain = self.dt / _INTEGRAL_TIME_S
         qvel, out = self.qvel, self.actuator_ctrl
         ctrl, integral, limits = self.ctrl, self.integral, self.integral_max
         settled_all = True
-        for i, (sign, dof, act) in enumerate(self._wheels):
-            target = sign * turn + ahead
+        for i, (turn, inv_radius, dof, act) in enumerate(self._wheels):
+            target = turn * w + v * inv_radius
             c = ctrl[i]
             if step is None:
                 c = target
@@ -253,6 +314,37 @@ class WheelDrive(Plugin):
             self.odom_out.publish(now_ns, pos, quat, linear, angular)
         if self.tf_out:
             self.tf_out.publish(now_ns, pos, quat)
+        if self.wheel_tf:
+            odom_tf = (self.odom_frame, self.base_frame, pos, quat) if self.params.publish_tf else None
+            self.wheel_tf.publish(now_ns, odom_tf)
+
+
+class WheelTransforms:
+    """Each wheel link's pose in its parent link's frame, on TF: what gazebo_ros_diff_drive's
+    publishWheelTF sends (parent link -> wheel link, with the robot's namespace)."""
+
+    def __init__(self, pub: Any, m: mujoco.MjModel, d: mujoco.MjData, robot: Any, wheels: list[int]):
+        self.pub, self.d = pub, d
+        self.pairs = [(int(m.body_parentid[b]), b) for b in wheels]
+        self.frames = [
+            (
+                robot.frame(m.body(p).name.removeprefix(robot.prefix)),
+                robot.frame(m.body(c).name.removeprefix(robot.prefix)),
+            )
+            for p, c in self.pairs
+        ]
+        self._q = np.zeros(4)
+        self._qp = np.zeros(4)
+
+    def publish(self, now_ns: int, first: tuple[str, str, Sequence[float], Sequence[float]] | None) -> None:
+        d = self.d
+        entries = [first] if first is not None else []
+        for (parent, child), (pf, cf) in zip(self.pairs, self.frames, strict=True):
+            rel = d.xmat[parent].reshape(3, 3).T @ (d.xpos[child] - d.xpos[parent])
+            mujoco.mju_negQuat(self._qp, d.xquat[parent])
+            mujoco.mju_mulQuat(self._q, self._qp, d.xquat[child])
+            entries.append((pf, cf, rel.tolist(), self._q.tolist()))
+        self.pub.publish(tf_transforms(now_ns, entries), now_ns)
 
 
 class DiffDrive(WheelDrive):

@@ -3,17 +3,33 @@
 Like Gazebo's ray sensor: `samples` beams from `min_angle` to `max_angle` (inclusive), returns outside
 `[range_min, range_max]` are +inf (no return) or -inf (too close), gaussian noise, optional range
 resolution. The robot's own geoms and visual-only geoms are never hit.
+
+A 3D lidar (or any, with `publish_points`) also publishes a PointCloud2 in the sensor frame, in one of two
+layouts: `xyz` (x, y, z float32, one row per elevation) or `velodyne`, as velodyne_simulator's Gazebo plugin
+and the velodyne driver publish it: x, y, z, intensity (float32), ring (uint16, 0 = lowest beam), time
+(float32), 22 bytes a point, the rings of one azimuth after another; intensity and time are 0 (surfaces
+have no retro-reflectivity here, and a scan is one instant). `organize_cloud` keeps every beam (NaN where
+there is no return; `xyz` does by default) or only the returns (`velodyne` does by default).
+`publish_scan: false` leaves the LaserScan out (velodyne_simulator publishes only the cloud).
+
+`range_topic` publishes a sensor_msgs/Range as hector_gazebo_plugins' sonar does: the nearest return of
+all beams (`range_max` when none), with its own error (`range_offset`, a drifting bias `range_drift`, white
+noise `range_noise_stddev`, see plugins/_drift.py) added to returns short of `range_max`, clamped to
+`[range_min, range_max]`.
 """
 
 from __future__ import annotations
 
 import math
+import struct
+from typing import Literal
 
 import mujoco
 import numpy as np
 from pydantic import Field, PositiveFloat, PositiveInt, model_validator
 
 from plugins._common import MountPose, add_site, pick_link
+from plugins._drift import DriftingBias
 from runner import msgs
 from runner.plugin import BuildContext, Plugin, RatedParams, Topic
 
@@ -43,6 +59,31 @@ class LidarParams(RatedParams):
     points_topic: str | None = Field(
         None, description="PointCloud2 topic of a 3D lidar (default: <topic>/points)."
     )
+    publish_scan: bool = Field(True, description="Publish the LaserScan (the row closest to horizontal).")
+    publish_points: bool | None = Field(
+        None, description="Publish the PointCloud2 (default: when vertical_samples > 1)."
+    )
+    points_format: Literal["xyz", "velodyne"] = Field(
+        "xyz",
+        description="PointCloud2 fields: x y z (float32), or velodyne_simulator's x y z intensity "
+        "(float32) ring (uint16) time (float32).",
+    )
+    range_topic: str | None = Field(
+        None, description="Also publish a sensor_msgs/Range here: the nearest return of all beams."
+    )
+    radiation_type: Literal["ultrasound", "infrared"] = Field("ultrasound", description="Range's radiation.")
+    range_field_of_view: float = Field(0.0, ge=0, description="Range's field_of_view, rad.")
+    range_offset: float = Field(0.0, description="Constant error of the Range, metres.")
+    range_drift: float = Field(
+        0.0, ge=0, description="Scale of the Range's drifting error (starts at N(0, drift)), metres."
+    )
+    range_drift_frequency: float = Field(1 / 3600, ge=0, description="Frequency of that drift, Hz.")
+    range_noise_stddev: float = Field(0.0, ge=0, description="White noise on the Range, metres.")
+    organize_cloud: bool | None = Field(
+        None,
+        description="Keep every beam in the cloud, NaN where there is no return (true), or only the "
+        "returns, one row (false). Default: true for xyz, false for velodyne (as velodyne_simulator).",
+    )
 
     @model_validator(mode="after")
     def _angles(self) -> LidarParams:
@@ -52,7 +93,21 @@ class LidarParams(RatedParams):
             raise ValueError(f"range_max ({self.range_max}) must exceed range_min ({self.range_min})")
         if self.vertical_max_angle < self.vertical_min_angle:
             raise ValueError("vertical_max_angle is below vertical_min_angle")
+        if not self.publish_scan and not self.points and not self.range_topic:
+            raise ValueError(
+                "publish_scan is false and neither a PointCloud2 nor a Range is published: the lidar "
+                "publishes nothing"
+            )
         return self
+
+    @property
+    def points(self) -> bool:
+        """Whether the PointCloud2 is published."""
+        return self.vertical_samples > 1 if self.publish_points is None else self.publish_points
+
+    @property
+    def organized(self) -> bool:
+        return self.points_format == "xyz" if self.organize_cloud is None else self.organize_cloud
 
 
 class Lidar(Plugin):
@@ -63,10 +118,14 @@ class Lidar(Plugin):
     def build(cls, params: LidarParams, ctx: BuildContext, name: str) -> list[Topic]:
         link = pick_link(ctx, params.link, ("lidar", "laser", "scan"))
         add_site(ctx, link, name, params.pose)
-        topics = [Topic(params.topic, "sensor_msgs/msg/LaserScan", "pub", params.rate)]
-        if params.vertical_samples > 1:
+        topics = []
+        if params.publish_scan:
+            topics.append(Topic(params.topic, "sensor_msgs/msg/LaserScan", "pub", params.rate))
+        if params.points:
             points = params.points_topic or f"{params.topic}/points"
             topics.append(Topic(points, "sensor_msgs/msg/PointCloud2", "pub", params.rate))
+        if params.range_topic:
+            topics.append(Topic(params.range_topic, "sensor_msgs/msg/Range", "pub", params.rate))
         return topics
 
     def setup(self) -> None:
@@ -92,13 +151,8 @@ class Lidar(Plugin):
         self.scan_row = int(np.argmin(np.abs(self.elevations)))
         self.geomid = np.zeros(n * nv, dtype=np.int32)
         self.dist = np.zeros(n * nv, dtype=np.float64)
-        if nv > 1:
-            self.points_pub = ctx.publisher(
-                p.points_topic or f"{p.topic}/points", "sensor_msgs/msg/PointCloud2"
-            )
-            field = msgs.T["sensor_msgs/msg/PointField"]
-            self.fields = [field(name=c, offset=4 * i, datatype=7, count=1) for i, c in enumerate("xyz")]
-            self.PointCloud2 = msgs.T["sensor_msgs/msg/PointCloud2"]
+        if p.points:
+            self._setup_points()
         # Rays skip the robot's own geoms and visual-only geoms (URDF visuals are group 1, no contacts).
         skip = np.zeros(m.ngeom, dtype=bool)
         skip[ctx.robot.geom_ids] = True
@@ -114,7 +168,14 @@ class Lidar(Plugin):
         visible[self.own] = False
         self.may_recast = bool((skip & visible).any())
         self.vec = np.zeros((n * nv, 3))
-        self.pub = ctx.publisher(p.topic, "sensor_msgs/msg/LaserScan")
+        if p.publish_scan:
+            self._setup_scan()
+        if p.range_topic:
+            self._setup_range()
+
+    def _setup_scan(self) -> None:
+        p = self.params
+        self.pub = self.ctx.publisher(p.topic, "sensor_msgs/msg/LaserScan")
         template = msgs.T["sensor_msgs/msg/LaserScan"](
             header=msgs.header(0, self.frame_id),
             angle_min=p.min_angle,
@@ -129,6 +190,67 @@ class Lidar(Plugin):
         )
         self.layout = self.pub.layout(template, ["header.stamp"])
         self.out_ranges = self.layout.view("ranges")
+
+    def _setup_points(self) -> None:
+        p = self.params
+        self.points_pub = self.ctx.publisher(
+            p.points_topic or f"{p.topic}/points", "sensor_msgs/msg/PointCloud2"
+        )
+        field = msgs.T["sensor_msgs/msg/PointField"]
+        self.PointCloud2 = msgs.T["sensor_msgs/msg/PointCloud2"]
+        n, nv = p.samples, p.vertical_samples
+        if p.points_format == "xyz":
+            self.fields = [field(name=c, offset=4 * i, datatype=7, count=1) for i, c in enumerate("xyz")]
+            self.point_dtype = np.dtype({"names": list("xyz"), "formats": ["<f4"] * 3})
+            # one row per elevation, as the rays are cast
+            self.order = np.arange(n * nv)
+            self.cloud_shape = (nv, n)
+        else:
+            self.fields = [
+                field(name=name, offset=offset, datatype=datatype, count=1)
+                for name, offset, datatype in _VELODYNE_FIELDS
+            ]
+            self.point_dtype = _VELODYNE_POINT
+            # all rings of the first azimuth, then of the next... (the rays are cast row by row)
+            self.order = np.arange(n * nv).reshape(nv, n).T.ravel()
+            self.cloud_shape = (n, nv)
+        self.cloud = np.zeros(n * nv, dtype=self.point_dtype)
+        if p.points_format == "velodyne":
+            self.cloud["ring"] = np.tile(np.arange(nv, dtype=np.uint16), n)
+        self.local_ordered = self.local[:, self.order]
+
+    def _setup_range(self) -> None:
+        p = self.params
+        rng = self.ctx.rng
+        self.range_pub = self.ctx.publisher(p.range_topic, "sensor_msgs/msg/Range")
+        template = msgs.T["sensor_msgs/msg/Range"](
+            header=msgs.header(0, self.frame_id),
+            radiation_type=0 if p.radiation_type == "ultrasound" else 1,
+            field_of_view=p.range_field_of_view,
+            min_range=p.range_min,
+            max_range=p.range_max,
+            range=p.range_max,
+            variance=0.0,  # Jazzy's field: 0 is unknown, as the plugins publishing Range leave it
+        )
+        self.range_layout = self.range_pub.layout(template, ["header.stamp"])
+        self.at_range = self.range_layout.spans["range"].offset
+        start = [rng.normal(0.0, p.range_drift)] if p.range_drift else [0.0]
+        self.range_bias = DriftingBias(rng, start, p.range_drift, p.range_drift_frequency, 1.0 / p.rate)
+
+    def _publish_range(self, ranges: np.ndarray, now_ns: int) -> None:
+        """The nearest return; hector's error model applies to a return short of range_max (its drift
+        moves only then), and the result is clamped to the Range's limits."""
+        p = self.params
+        r = float(ranges.min()) if len(ranges) else math.inf
+        if r < p.range_max:
+            r += p.range_offset + float(self.range_bias.update()[0])
+            if p.range_noise_stddev:
+                r += float(self.ctx.rng.normal(0.0, p.range_noise_stddev))
+            r = min(max(r, p.range_min), p.range_max)
+        else:
+            r = p.range_max
+        struct.pack_into("<f", self.range_layout.buf, self.at_range, r)
+        self.range_pub.publish_cdr(self.range_layout.encode(now_ns), now_ns)
 
     def scan(self) -> np.ndarray:
         """Distances along each beam (inf where nothing is hit within range_max)."""
@@ -193,8 +315,12 @@ class Lidar(Plugin):
             np.round(every, out=every)
             every *= p.resolution
         n = p.samples
-        if p.vertical_samples > 1:
+        if p.points:
             self._publish_points(every, now_ns)
+        if p.range_topic:
+            self._publish_range(every, now_ns)
+        if not p.publish_scan:
+            return
         out = self.out_ranges  # float32 view into the message bytes
         out[:] = every[self.scan_row * n : (self.scan_row + 1) * n]
         out[out > p.range_max] = np.inf  # REP 117: beyond range +inf, too close -inf
@@ -202,21 +328,51 @@ class Lidar(Plugin):
         self.pub.publish_cdr(self.layout.encode(now_ns), now_ns)
 
     def _publish_points(self, ranges: np.ndarray, now_ns: int) -> None:
-        """A PointCloud2 (x, y, z float32, sensor frame, one row per elevation); NaN where no return."""
+        """The PointCloud2 in the sensor frame (`points_format`, `organize_cloud`: see the module doc)."""
         p = self.params
-        valid = np.isfinite(ranges) & (ranges >= p.range_min) & (ranges <= p.range_max)
-        r = np.where(valid, ranges, np.nan)
-        xyz = (self.local * r).T.astype(np.float32)  # (nv*n) x 3
-        n, nv = p.samples, p.vertical_samples
+        r = ranges[self.order]
+        valid = np.isfinite(r) & (r >= p.range_min) & (r <= p.range_max)
+        r = np.where(valid, r, np.nan)
+        xyz = (self.local_ordered * r).astype(np.float32)  # 3 x points
+        cloud = self.cloud
+        cloud["x"], cloud["y"], cloud["z"] = xyz
+        if p.points_format == "velodyne":
+            cloud["intensity"] = np.where(valid, np.float32(0.0), np.float32(np.nan))
+        if p.organized:
+            height, width = self.cloud_shape
+            data = cloud
+        else:
+            data = cloud[valid]
+            height, width = 1, len(data)
+        step = self.point_dtype.itemsize
         msg = self.PointCloud2(
             header=msgs.header(now_ns, self.frame_id),
-            height=nv,
-            width=n,
+            height=height,
+            width=width,
             fields=self.fields,
             is_bigendian=False,
-            point_step=12,
-            row_step=12 * n,
-            data=np.frombuffer(xyz.tobytes(), dtype=np.uint8),
-            is_dense=bool(valid.all()),
+            point_step=step,
+            row_step=step * width,
+            data=np.frombuffer(data.tobytes(), dtype=np.uint8),
+            is_dense=bool(valid.all()) or not p.organized,
         )
         self.points_pub.publish(msg, now_ns)
+
+
+# velodyne_simulator's point (as velodyne_pointcloud's): name, byte offset, PointField datatype
+_VELODYNE_FIELDS = (
+    ("x", 0, 7),
+    ("y", 4, 7),
+    ("z", 8, 7),
+    ("intensity", 12, 7),
+    ("ring", 16, 4),
+    ("time", 18, 7),
+)
+_VELODYNE_POINT = np.dtype(
+    {
+        "names": [f[0] for f in _VELODYNE_FIELDS],
+        "formats": ["<f4", "<f4", "<f4", "<f4", "<u2", "<f4"],
+        "offsets": [f[1] for f in _VELODYNE_FIELDS],
+        "itemsize": 22,
+    }
+)

@@ -19,6 +19,7 @@ from rich.console import Console
 from rich.table import Table
 
 from runner.errors import RunError, ScenarioError
+from runner.plan import RobotPlan
 
 app = typer.Typer(
     name="scenario",
@@ -95,6 +96,9 @@ def validate(
             ]
             robots.add_row(*row, *([part.name.rsplit("/", 1)[-1]] if plan.worlds else []))
     out.print(robots)
+    for part in parts:
+        for r in part.robots:
+            _print_parity(r)
     topics = Table("key", "type", "dir", "rate (sim Hz)", "from", title="Topics", title_justify="left")
     for part in parts:
         for t in part.topics():
@@ -141,6 +145,28 @@ def validate(
         )
     out.print(f"record: {plan.record.path if plan.record.enabled else 'off'}")
     _print_notices(plan.notices, verbose=True)
+
+
+def _shown_path(file: str) -> str:
+    """A path as the user would type it: relative to the current folder when it is below it."""
+    try:
+        return str(Path(file).relative_to(Path.cwd()))
+    except ValueError:
+        return file
+
+
+def _print_parity(robot: RobotPlan) -> None:
+    """The robot as in Gazebo: drives and wheels, sensors with topics and rates, self-collision, and what
+    was changed, dropped or ignored to load it, each with its file and line."""
+    if not robot.gazebo:
+        return
+    table = Table(
+        "", "", "where", title=f"{robot.name} as in Gazebo", title_justify="left", show_header=False, box=None
+    )
+    for line in robot.gazebo:
+        where = f"{_shown_path(line.file)}:{line.line}" if line.file and line.line else ""
+        table.add_row(line.kind, line.text, where)
+    out.print(table)
 
 
 def _print_notices(notices: list[str], verbose: bool) -> None:

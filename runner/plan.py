@@ -23,7 +23,20 @@ class PluginPlan(BaseModel):
     name: str
     params: dict[str, Any]
     rate: float | None
+    control_rate: float | None = None  # how often before_step runs, when not at `rate`
     topics: list[TopicPlan] = []
+    source_file: str | None = None  # where the description declares it (a Gazebo <plugin> or <sensor>)
+    source_line: int | None = None
+
+
+class ParityLine(BaseModel):
+    """One line of a robot's "as in Gazebo" summary: a drive, a sensor, self-collision, or what was changed,
+    dropped or ignored to load it, with where in the description it comes from."""
+
+    kind: str
+    text: str
+    file: str | None = None
+    line: int | None = None
 
 
 class RobotPlan(BaseModel):
@@ -37,6 +50,7 @@ class RobotPlan(BaseModel):
     joints: list[str]
     plugins: list[PluginPlan]
     urdf: str = ""  # the description as URDF (xacro expanded): published on <ns>/robot_description
+    gazebo: list[ParityLine] = []  # the robot as in Gazebo (scenario validate prints it)
 
 
 class TimelinePlan(BaseModel):

@@ -5,8 +5,9 @@ A plugin is a class with a `Params` pydantic model and fixed-name hooks:
 - `build(params, ctx)` (classmethod, compile time): add what the plugin needs to the robot's MuJoCo
   model (actuators, sites, sensors) and declare the topics it publishes and subscribes;
 - `setup()`, `before_step(now_ns)`, `after_step(now_ns)`, `close()` (run time, in the world process).
-  `before_step`/`after_step` are called at the plugin's `rate` (sim Hz; every physics step if it has
-  none). Hooks that a class does not override are never called.
+  `after_step` is called at the plugin's `rate` (sim Hz; every physics step if it has none),
+  `before_step` at its `control_rate_of` (by default the same rate). Hooks that a class does not override
+  are never called.
 
 Plugins never touch Zenoh: they publish and subscribe through `ctx.publisher(...)`/`ctx.subscribe(...)`.
 Built-ins are registered in the `scenario.plugins` entry-point group, as a third-party package would be.
@@ -177,6 +178,12 @@ class Plugin:
     def rate_of(cls, params: PluginParams) -> float | None:
         rate = getattr(params, "rate", None)
         return float(rate) if rate else None
+
+    @classmethod
+    def control_rate_of(cls, params: PluginParams) -> float | None:
+        """How often `before_step` runs (sim Hz; None: at `rate_of`). A plugin that both controls and
+        publishes (a drive) controls at a high rate whatever it publishes at, as Gazebo's do."""
+        return cls.rate_of(params)
 
     def setup(self) -> None:
         """Run time, once, before the first step."""

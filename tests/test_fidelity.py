@@ -220,7 +220,7 @@ robots:
   - name: r1
     description: "{skidbot}"
     pose: {{xyz: [0, 0, 0.065]}}
-    plugins: [{{type: skid_steer}}, {{type: ground_truth}}]
+    plugins: [{{type: skid_steer, params: {{yaw_rate_feedback: true}}}}, {{type: ground_truth}}]
 timeline:
 {timeline}
 """

@@ -67,12 +67,18 @@ def test_skid_steer_drives_four_wheels_straight(write_scenario):
 
 
 @pytest.mark.timeout(30)
-def test_skid_steer_turns_in_place(write_scenario):
-    truth, odom = _skid(write_scenario, "{angular: {z: 0.5}}", math.pi, 4.0)
+def test_skid_steer_turns_in_place_with_yaw_rate_feedback(write_scenario):
+    text = SKID.format(skidbot=SKIDBOT, cmd="{angular: {z: 0.5}}", stop=math.pi, duration=4.0).replace(
+        "{type: skid_steer}", "{type: skid_steer, params: {yaw_rate_feedback: true}}"
+    )
+    _, bus = simulate(write_scenario(text))
+    truth = messages(bus, "r1/ground_truth")[-1][1].pose.pose
+    odom = messages(bus, "r1/odom")[-1][1].pose.pose
     commanded = math.pi / 2
-    # A skid-steered body scrubs its wheels sideways and, open loop, turns at about 28 % of what the wheel
-    # speeds say on this robot (wheelbase 0.24 m, track 0.30 m, friction 1). The drive closes the loop on
-    # the body's yaw rate, so the robot turns as commanded; odometry comes from the world.
+    # A skid-steered body with isotropic friction scrubs its wheels sideways and, open loop (the default, as
+    # Gazebo's plugins drive), turns at about 30 % of what the wheel speeds say on this robot (wheelbase
+    # 0.24 m, track 0.30 m, friction 1). The opt-in yaw-rate feedback closes the loop on the body's yaw
+    # rate, so the robot turns as commanded; odometry comes from the world.
     yaw = _yaw(truth.orientation)
     assert abs(yaw - commanded) < 0.1 * commanded, yaw
     assert math.hypot(truth.position.x, truth.position.y) < 0.05, truth.position
@@ -82,8 +88,8 @@ def test_skid_steer_turns_in_place(write_scenario):
 @pytest.mark.timeout(30)
 def test_skid_steer_open_loop_turns_less(write_scenario):
     text = SKID.format(skidbot=SKIDBOT, cmd="{angular: {z: 0.5}}", stop=math.pi, duration=4.0).replace(
-        "{type: skid_steer}", "{type: skid_steer, params: {yaw_rate_feedback: false}}"
-    )
+        "{type: skid_steer}", "{type: skid_steer}"
+    )  # open loop is the default
     _, bus = simulate(write_scenario(text))
     yaw = _yaw(messages(bus, "r1/ground_truth")[-1][1].pose.pose.orientation)
     assert 0.1 * math.pi / 2 < yaw < 0.6 * math.pi / 2, yaw  # physics: the body lags the wheels

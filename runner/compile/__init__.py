@@ -19,8 +19,10 @@ from runner.checks import assertion_keys, check_names, truth_robots
 from runner.checks.judge import TRUTH_RATE, TRUTH_TOPIC, contacts_key
 from runner.compile.gazebo import DescribedPlugin
 from runner.compile.packages import PackageMap
+from runner.compile.parity import summarize
 from runner.compile.sdf import load_sdf_world
 from runner.compile.urdf import RobotModel, urdf_to_model
+from runner.compile.wheels import anisotropic_wheels, wheel_links
 from runner.compile.xacro_expand import expand
 from runner.errors import Location, Notices, Problem, ScenarioError, SourceError
 from runner.geometry import rpy_to_quat
@@ -116,6 +118,12 @@ def _check_start_overlaps(m: mujoco.MjModel, sc: Scenario, doc: Document, notice
         if c.dist > -(START_OVERLAP_GROUND_M if on_ground else START_OVERLAP_M):
             continue
         (r1, w1), (r2, w2) = owner(int(c.geom1)), owner(int(c.geom2))
+        if r1 is not None and r1 == r2:
+            # two links of one robot touch only where self-collision is on (<selfCollide>): say which
+            key = (r1, f"its own {w1!r} and {w2!r} (self-collision is on)")
+            if -c.dist > worst.get(key, (0.0, False))[0]:
+                worst[key] = (-float(c.dist), False)
+            continue
         for robot, other, other_robot, geom in ((r1, w2, r2, int(c.geom2)), (r2, w1, r1, int(c.geom1))):
             if robot is None or other_robot == robot:
                 continue
@@ -126,12 +134,15 @@ def _check_start_overlaps(m: mujoco.MjModel, sc: Scenario, doc: Document, notice
                 worst[key] = (-float(c.dist), mesh)
     for (robot, name), (depth, mesh) in sorted(worst.items()):
         where = doc.locate(("robots", robot, "pose"))
+        inside = name if name.startswith("its own ") else repr(name)
         notices.add(
-            f"robot {sc.robots[robot].name!r} starts {depth:.2f} m inside {name!r}: the first step shoves "
+            f"robot {sc.robots[robot].name!r} starts {depth:.2f} m inside {inside}: the first step shoves "
             "them apart",
             where.file,
             where.line,
-            hint="move the robot's pose"
+            hint="move the links apart in the description, or set <selfCollide> false for them"
+            if name.startswith("its own ")
+            else "move the robot's pose"
             + (
                 "; a mesh collides as its convex hull (walls made of one mesh are a solid block)"
                 if mesh
@@ -201,13 +212,17 @@ def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices
                 type="ground_truth", name="_truth", params={"topic": TRUTH_TOPIC, "rate": TRUTH_RATE}
             )
             robot = robot.model_copy(update={"plugins": [*robot.plugins, extra]})
+        before = len(notices)
         model = _robot_model(robot, i, doc, packages, notices, sc.world.physics.timestep)
         plugins = _build_plugins(sc, robot, i, model, doc)
         _add_transmissions(model, notices)
+        parity = summarize(model, plugins, notices.items[before:], f"{sc.name}/{robot.ns}/")
         pos = robot.pose.xyz
         frame = world.worldbody.add_frame(pos=list(pos), quat=list(rpy_to_quat(robot.pose.rpy)))
         prefix = f"{robot.ns}/"
+        wheels = wheel_links(plugins, model.spec)
         world.attach(model.spec, prefix=prefix, frame=frame)
+        anisotropic_wheels(world, prefix, wheels, model.gazebo, notices)
         # a robot's camera may have grown its framebuffer: the world's is the one cameras render into
         g, rg = world.visual.global_, model.spec.visual.global_
         g.offwidth, g.offheight = max(g.offwidth, rg.offwidth), max(g.offheight, rg.offheight)
@@ -223,6 +238,7 @@ def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices
                 joints=model.joints,
                 plugins=plugins,
                 urdf=model.urdf,
+                gazebo=parity,
             )
         )
 
@@ -574,6 +590,7 @@ def _robot_model(
                 packages,
                 fixed=robot.fixed,
                 namespace=robot.ns,
+                model=robot.name,
                 notices=notices,
                 sources=result.sources,
                 expanded=True,
@@ -596,6 +613,7 @@ def _robot_model(
                 packages,
                 fixed=robot.fixed,
                 namespace=robot.ns,
+                model=robot.name,
                 notices=notices,
                 timestep=timestep,
             )
@@ -696,6 +714,9 @@ def _build_plugins(sc: Scenario, robot: Robot, i: int, model: RobotModel, doc: D
                 name=entry.name,
                 params=params.model_dump(mode="json"),
                 rate=rate,
+                control_rate=cls.control_rate_of(params),
+                source_file=str(src.file) if src is not None and src.file else None,
+                source_line=src.line if src is not None else None,
                 topics=[
                     TopicPlan(
                         key=topic_key(sc.name, robot.ns, t.name),

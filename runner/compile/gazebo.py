@@ -23,6 +23,7 @@ from typing import Any
 
 from lxml import etree
 
+from runner.compile import thirdparty
 from runner.compile.locate import Locator
 from runner.compile.materials import gazebo_material
 from runner.errors import Notices, SourceError
@@ -39,13 +40,10 @@ _IGNORED_REASONS = {
     "publishWheelTF": "wheel TF comes from joint_states",
     "publish_wheel_tf": "wheel TF comes from joint_states",
     "hackBaseline": "stereo baseline (mono camera)",
-    "selfCollide": "MuJoCo excludes parent-child contacts",
-    "self_collide": "MuJoCo excludes parent-child contacts",
     "enable_metrics": "diagnostics",
     "gaussianNoise": "use the sensor's <noise>",
     "minDepth": "ODE contact parameter; MuJoCo contacts are soft (solref/solimp)",
     "maxVel": "ODE contact parameter; MuJoCo contacts are soft (solref/solimp)",
-    "fdir1": "anisotropic friction is not supported",
     "serviceName": "no ROS services",
     "maxContacts": "MuJoCo finds contacts itself",
     "provideFeedback": "no joint wrench feedback",
@@ -68,6 +66,9 @@ class DescribedPlugin:
     implicit: bool = False  # a sensor with neither a ROS plugin nor a <topic>: its topic is our default
 
 
+Where = tuple[Path | None, int | None]  # (file, line) of a tag in the user's files
+
+
 @dataclass
 class LinkProps:
     rgba: tuple[float, float, float, float] | None = None
@@ -75,6 +76,11 @@ class LinkProps:
     kp: float | None = None
     kd: float | None = None
     gravity_off: bool = False
+    mu1: float | None = None  # friction along fdir1 ...
+    mu2: float | None = None  # ... and across it: a drive's wheels keep the two apart (runner.compile.wheels)
+    fdir1: tuple[float, float, float] | None = None  # in the collision's frame
+    self_collide: bool | None = None  # <selfCollide> (or <self_collide>) of the link; None: the model's
+    self_collide_at: Where = (None, None)
 
 
 @dataclass
@@ -82,6 +88,9 @@ class GazeboInfo:
     plugins: list[DescribedPlugin] = field(default_factory=list)
     links: dict[str, LinkProps] = field(default_factory=dict)
     static: bool = False
+    self_collide: bool = False  # model-level <self_collide>: Gazebo's default is off
+    self_collide_at: Where = (None, None)
+    dropped: list[tuple[str, Where]] = field(default_factory=list)  # blocks and plugins left out, and why
 
 
 class _Reader:
@@ -94,13 +103,18 @@ class _Reader:
     def __init__(self, el: Any, attr_values: bool = False):
         self.el = el
         self.attr_values = attr_values
-        self.used: set[str] = set()
+        self.used: set[str] = set()  # tags read whole (every element of that name)
+        self.single: set[str] = set()  # tags read as one value: a repeated one is reported, not dropped
+        # elements read one by one, kept alive: lxml hands out the same proxy only while one is referenced
+        self._taken: list[Any] = []
 
     def child(self, *names: str) -> Any | None:
         for n in names:
             found = self.el.find(n)
             if found is not None:
-                self.used.add(n)
+                self.single.add(n)
+                if not any(found is t for t in self._taken):
+                    self._taken.append(found)
                 return found
         return None
 
@@ -138,7 +152,12 @@ class _Reader:
         self.used.update(names)
 
     def leftovers(self) -> list[Any]:
-        return [c for c in self.el if isinstance(c.tag, str) and c.tag not in self.used]
+        """Elements nothing read: unknown tags, and the second and later copies of a one-value tag."""
+        return [
+            c
+            for c in self.el
+            if isinstance(c.tag, str) and c.tag not in self.used and not any(c is t for t in self._taken)
+        ]
 
 
 def _floats(text: str | None, n: int) -> list[float] | None:
@@ -174,10 +193,12 @@ class GazeboReader:
         expanded: bool,
         namespace: str,
         notices: Notices,
+        model: str | None = None,
     ):
         self.root = root
         self.where = Locator(file, sources, expanded)
         self.namespace = namespace
+        self.model = model or namespace  # the model's name in Gazebo: the robot's name in the scenario
         self.notices = notices
         self.info = GazeboInfo()
         self._names: set[str] = set()
@@ -189,6 +210,13 @@ class GazeboReader:
 
     def ignored(self, reader: _Reader, context: str) -> None:
         for el in reader.leftovers():
+            if el.tag in reader.single:
+                self.note(
+                    el,
+                    f"a second <{el.tag}> in {context} is ignored: the plugin reads only the first",
+                    hint="remove the repeated tag, or check which one you meant",
+                )
+                continue
             reason = _IGNORED_REASONS.get(el.tag)
             self.note(el, f"<{el.tag}> in {context} is ignored" + (f" ({reason})" if reason else ""))
 
@@ -214,17 +242,79 @@ class GazeboReader:
 
     # ------------------------------------------------------------------------------------------ read
     def read(self) -> GazeboInfo:
+        self.link_names = {el.get("name") for el in self.root.findall("link")}
+        self.joint_names = {el.get("name") for el in self.root.findall("joint") if el.get("type") != "fixed"}
+        self.fixed_joints = {el.get("name") for el in self.root.findall("joint") if el.get("type") == "fixed"}
         for gz in self.root.findall("gazebo"):
             ref = gz.get("reference")
             try:
                 if ref:
+                    if ref not in self.link_names | self.joint_names | self.fixed_joints:
+                        self.drop(
+                            gz,
+                            f'<gazebo reference="{ref}"> names a link or joint the robot does not have',
+                            "Gazebo drops such a block too; xacro arguments may have left the link out",
+                        )
+                        continue
                     self._reference(gz, ref)
                 else:
                     self._model(gz)
             except (ValueError, OverflowError) as e:  # float("many"), int(float("inf")) in a tag's text
                 raise self._not_a_number(gz, e) from None
         self._drop_shadowed()
+        self._drop_missing_targets()
         return self.info
+
+    def drop(self, el: Any, message: str, hint: str | None = None) -> None:
+        """Leave a block or plugin out, as Gazebo does, with a warning at its line."""
+        where = self.where(el)
+        self.notices.add(f"{message}: it is left out", *where, hint)
+        self.info.dropped.append((message, where))
+
+    def _drop_missing_targets(self) -> None:
+        """A plugin naming a link or joint the expanded URDF lacks (an `enable_imu:=false` xacro argument
+        took it out) does not load in Gazebo, which goes on without it: so do we. A joint list (a joint
+        state publisher's) loses only the joints that are missing."""
+        keep: list[DescribedPlugin] = []
+
+        def named(joint: str) -> str:
+            fixed = " (fixed: Gazebo lumps it into its parent link)" if joint in self.fixed_joints else ""
+            return f"joint {joint!r}{fixed}"
+
+        for p in self.info.plugins:
+            missing: list[str] = []
+            for key, value in p.params.items():
+                if key == "link" and isinstance(value, str) and value not in self.link_names:
+                    missing.append(f"link {value!r}")
+                elif key in _JOINT_PARAMS and isinstance(value, str) and value not in self.joint_names:
+                    missing.append(named(value))
+                elif key in _JOINT_LIST_PARAMS and isinstance(value, list):
+                    gone = [j for j in value if j not in self.joint_names]
+                    if gone and key == "joints" and len(gone) < len(value):
+                        p.params[key] = [j for j in value if j in self.joint_names]
+                        msg = f"{p.type} plugin {p.name!r} names joint(s) the robot does not have: " + (
+                            ", ".join(named(j) for j in gone)
+                        )
+                        self.notices.add(f"{msg}: they are left out", p.file, p.line)
+                        self.info.dropped.append((msg, (p.file, p.line)))
+                    else:
+                        missing += [named(j) for j in gone]
+            if missing:
+                msg = (
+                    f"{p.type} plugin {p.name!r} names "
+                    + ", ".join(missing)
+                    + ", which the robot does not have"
+                )
+                self.notices.add(
+                    f"{msg}: it is left out",
+                    p.file,
+                    p.line,
+                    "Gazebo does not load such a plugin either; xacro arguments may have left the link out",
+                )
+                self.info.dropped.append((msg, (p.file, p.line)))
+                continue
+            keep.append(p)
+        self.info.plugins = keep
 
     def _not_a_number(self, gz: Any, e: Exception) -> SourceError:
         """A tag whose text should be a number and is not: the error at that tag's line."""
@@ -279,9 +369,14 @@ class GazeboReader:
             vm = visual.find("material")
             if vm is not None:
                 props.rgba = self._material(vm) or props.rgba
-        mu = [v for v in (r.float("mu1"), r.float("mu2"), r.float("mu")) if v is not None]
+        mu1, mu2 = r.float("mu1"), r.float("mu2")
+        mu = [v for v in (mu1, mu2, r.float("mu")) if v is not None]
         if mu:
             props.friction = min(mu)
+        props.mu1, props.mu2 = mu1, mu2
+        fdir = _floats(r.text("fdir1"), 3)
+        if fdir is not None and any(fdir):
+            props.fdir1 = (fdir[0], fdir[1], fdir[2])
         props.kp = r.float("kp")
         r.mark("kd")
         if r.float("kd") is not None:
@@ -292,6 +387,10 @@ class GazeboReader:
             )
         if r.bool("turnGravityOff"):
             props.gravity_off = True
+        self_collide = r.bool("selfCollide", "self_collide")
+        if self_collide is not None:
+            props.self_collide = self_collide
+            props.self_collide_at = self.where(r.child("selfCollide", "self_collide"))
         gravity = r.bool("gravity")
         if gravity is False:
             props.gravity_off = True
@@ -326,6 +425,10 @@ class GazeboReader:
         r = _Reader(gz, attr_values=True)
         if r.bool("static"):
             self.info.static = True
+        self_collide = r.bool("self_collide", "selfCollide")
+        if self_collide is not None:
+            self.info.self_collide = self_collide
+            self.info.self_collide_at = self.where(r.child("self_collide", "selfCollide"))
         for plugin in r.children("plugin"):
             self._plugin(plugin, None)
         for sensor in r.children("sensor"):
@@ -355,13 +458,18 @@ class GazeboReader:
             params["frame_id"] = ros.get("frame") or frame
             if ros.get("noise"):  # gazebo_ros_block_laser adds its <gaussianNoise> to the sensor's noise
                 params["noise_stddev"] = math.hypot(params.get("noise_stddev", 0.0), ros["noise"])
+            params.update(ros.get("params") or {})  # what a third-party plugin changes (velodyne)
             self.add(el, "lidar", name, params, implicit=not (ros or base_topic))
         elif kind == "camera":
             params = {**common, **self._camera(r, el, context)}
             ros = self._sensor_plugins(plugins, context, ("image_raw", "image"), name, kind)
-            image = ros.get("topic") or (_join(base_topic, "image") if base_topic else "camera/image_raw")
+            # gz-sensors: <topic> carries the image, CameraInfo goes to <camera_info_topic> or a sibling
+            image = ros.get("topic") or base_topic or "camera/image_raw"
             params["image_topic"] = image
-            params["info_topic"] = ros.get("info") or _sibling(image, "camera_info")
+            info_topic = _topic(el.findtext("camera/camera_info_topic"))
+            params["info_topic"] = (
+                ros.get("info") or (info_topic if not ros else None) or _sibling(image, "camera_info")
+            )
             params["frame_id"] = ros.get("frame") or frame
             self._plugin_rate(params, rate, ros)
             self.add(el, "camera", name, params, implicit=not (ros or base_topic))
@@ -422,6 +530,8 @@ class GazeboReader:
             params = {**common, "topic": ros.get("topic") or base_topic or "bumper"}
             params["frame_id"] = ros.get("frame") or frame
             self.add(el, "contact", name, params)
+        elif kind in thirdparty.SENSOR_KINDS:  # gps: runner/compile/thirdparty.py
+            thirdparty.sensor(self, r, el, common, plugins, name, kind, context, base_topic, frame)
         else:
             self.note(
                 el,
@@ -624,6 +734,9 @@ class GazeboReader:
             if base in _CAMERA_PLUGINS:
                 found.update(self._camera_plugin(r, filename, base, remap, sensor, kind, context))
                 rates = () if found["ros2"] else ("updateRate",)
+            elif base in thirdparty.SENSOR_PLUGINS:
+                extra, rates = thirdparty.sensor_plugin(self, r, base, remap, sensor, kind, context)
+                found.update(extra)
             else:
                 frame = r.text("frameName", "frame_name")
                 if frame:
@@ -859,6 +972,11 @@ class GazeboReader:
         self.ignored(r, context)
 
 
+# Plugin parameters that name joints of the robot (one, or a list).
+_JOINT_PARAMS = {"left_joint", "right_joint"}
+_JOINT_LIST_PARAMS = {"left_joints", "right_joints", "joints"}
+
+
 def _put(out: dict[str, Any], key: str, el: Any, path: str) -> None:
     """out[key] = the number at `path` under `el`, when there is one."""
     text = el.findtext(path)
@@ -1001,6 +1119,7 @@ _SENSOR_PLUGINS = _CAMERA_PLUGINS | {
     "gazebo_ros_imu",
     "gazebo_ros_bumper",
 }
+_SENSOR_PLUGINS |= thirdparty.SENSOR_PLUGINS  # velodyne_simulator: runner/compile/thirdparty.py
 # gz-sim systems that only switch on what our world always does (physics, sensors, broadcasting).
 _NOOP_PLUGINS = {
     "gz-sim-sensors-system",
@@ -1020,13 +1139,27 @@ def _odom_source(text: str | None) -> str | None:
 
 
 def _diff_drive_classic(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str, dict[str, Any]]:
-    diameter = r.float("wheelDiameter", "wheel_diameter")
+    """gazebo_ros_diff_drive, ROS 1 (`leftJoint`...) and ROS 2 (`left_joint`...). The ROS 2 plugin drives
+    `<num_wheel_pairs>` pairs: `left_joint`, `right_joint`, `wheel_separation` and `wheel_diameter` repeat,
+    one per pair (a pair without its own separation or diameter keeps the plugin's default, 0.34 m and
+    0.15 m); odometry comes from the first pair. Several pairs become our `skid_steer` with every wheel."""
+    lefts = [e.text.strip() for e in r.children("leftJoint", "left_joint") if e.text and e.text.strip()]
+    rights = [e.text.strip() for e in r.children("rightJoint", "right_joint") if e.text and e.text.strip()]
+    seps = [float(e.text) for e in r.children("wheelSeparation", "wheel_separation") if e.text]
+    diameters = [float(e.text) for e in r.children("wheelDiameter", "wheel_diameter") if e.text]
+    pairs_el = r.child("num_wheel_pairs")
+    pairs = int(float(pairs_el.text)) if pairs_el is not None and pairs_el.text else 1
+    if pairs_el is not None and pairs != max(len(lefts), len(rights), 1):
+        g.note(
+            pairs_el,
+            f"<num_wheel_pairs> is {pairs} but the plugin names {len(lefts)} left and {len(rights)} right "
+            "joint(s): every named wheel is driven",
+        )
+    diameter = diameters[0] if diameters else None
     torque = r.float("wheelTorque", "max_wheel_torque")
     accel = r.float("wheelAcceleration", "max_wheel_acceleration")
     params: dict[str, Any] = {
-        "left_joint": r.text("leftJoint", "left_joint"),
-        "right_joint": r.text("rightJoint", "right_joint"),
-        "wheel_separation": r.float("wheelSeparation", "wheel_separation"),
+        "wheel_separation": seps[0] if seps else None,
         "wheel_radius": diameter / 2 if diameter else None,
         "max_wheel_torque": torque if torque else None,
         # gazebo_ros_diff_drive limits the rim's linear acceleration (m/s²); ours is angular (rad/s²)
@@ -1045,27 +1178,50 @@ def _diff_drive_classic(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> t
     odom = r.bool("publishOdom", "publish_odom")
     if odom is not None:
         params["publish_odom"] = odom
+    wheel_tf = r.bool("publishWheelTF", "publish_wheel_tf")
+    if wheel_tf:
+        params["publish_wheel_tf"] = True
     if r.bool("publishWheelJointState", "publish_wheel_joint_state"):
         g.add(
             r.el,
             "joint_states",
             "wheel_joint_states",
-            {"joints": [params["left_joint"], params["right_joint"]], "rate": params["rate"]},
+            {"joints": lefts + rights, "rate": params["rate"]},
         )
-    r.mark("covariance_x", "covariance_y", "covariance_yaw", "publishOdomTF", "num_wheel_pairs")
+    r.mark("covariance_x", "covariance_y", "covariance_yaw", "publishOdomTF")
+    if len(lefts) > 1 or len(rights) > 1:
+        params["left_joints"], params["right_joints"] = lefts, rights
+        n = max(len(lefts), len(rights))
+        for values, tag, default in ((seps, "wheel_separation", 0.34), (diameters, "wheel_diameter", 0.15)):
+            if values and len(values) < n:
+                g.note(
+                    r.el,
+                    f"{n} wheel pairs but {len(values)} <{tag}>: gazebo_ros_diff_drive gives the pairs "
+                    f"without one its default, {default} m, and so do we",
+                    hint=f"repeat <{tag}> once per pair",
+                )
+                values += [default] * (n - len(values))
+        if seps or diameters:
+            params["pair_separations"] = seps or None
+            params["pair_radii"] = [d / 2 for d in diameters] or None
+        return "skid_steer", params
+    params["left_joint"] = lefts[0] if lefts else None
+    params["right_joint"] = rights[0] if rights else None
     return "diff_drive", params
 
 
 def _diff_drive_gz(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str, dict[str, Any]]:
     lefts = [e.text.strip() for e in r.children("left_joint") if e.text]
     rights = [e.text.strip() for e in r.children("right_joint") if e.text]
+    model = f"model/{g.model}"  # gz-sim's defaults: /model/<model>/cmd_vel, .../odometry, .../tf
     params: dict[str, Any] = {
         "wheel_separation": r.float("wheel_separation"),
         "wheel_radius": r.float("wheel_radius"),
+        # odom_publish_frequency is how often it publishes (default 50 Hz); it controls at every step
         "rate": r.float("odom_publish_frequency") or None,
-        "cmd_topic": _topic(r.text("topic")),
-        "odom_topic": _topic(r.text("odom_topic")),
-        "tf_topic": _topic(r.text("tf_topic")),
+        "cmd_topic": _topic(r.text("topic")) or f"{model}/cmd_vel",
+        "odom_topic": _topic(r.text("odom_topic")) or f"{model}/odometry",
+        "tf_topic": _topic(r.text("tf_topic")) or f"{model}/tf",
         "odom_frame": r.text("frame_id"),
         "base_frame": g.frame(r.text("child_frame_id")),
     }
@@ -1129,10 +1285,13 @@ def _joint_states(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[s
     joints: list[str] = []
     for el in r.children("jointName", "joint_name"):
         joints += [j.strip() for j in (el.text or "").split(",") if j.strip()]
+    topic = _topic(r.text("topic")) or remap.get("joint_states")
+    if topic is None and r.el.get("filename", "").startswith(("gz-sim", "ignition-gazebo", "libgz-sim")):
+        topic = f"world/default/model/{g.model}/joint_state"  # gz-sim's default (the world is "default")
     params: dict[str, Any] = {
         "joints": joints or None,
         "rate": r.float("updateRate", "update_rate") or None,
-        "topic": _topic(r.text("topic")) or remap.get("joint_states"),
+        "topic": topic,
     }
     return "joint_states", params
 
@@ -1178,7 +1337,7 @@ def _p3d(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str, dict[
 
 def _odometry_publisher(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str, dict[str, Any]]:
     params: dict[str, Any] = {
-        "topic": _topic(r.text("odom_topic")) or "odom",
+        "topic": _topic(r.text("odom_topic")) or f"model/{g.model}/odometry",
         "frame_id": g.frame(r.text("odom_frame") or "odom"),
         "rate": r.float("odom_publish_frequency") or None,
     }
@@ -1320,6 +1479,7 @@ _MODEL_PLUGINS = {
     "gz_ros2_control-system": _ros_control,
     "ign_ros2_control-system": _ros_control,
 }
+_MODEL_PLUGINS.update(thirdparty.MODEL_PLUGINS)  # hector_gazebo_plugins: runner/compile/thirdparty.py
 
 
 def read_gazebo(
@@ -1329,9 +1489,10 @@ def read_gazebo(
     sources: list[Path] | None = None,
     expanded: bool = False,
     namespace: str,
+    model: str | None = None,
     notices: Notices,
 ) -> GazeboInfo:
-    return GazeboReader(root, file, sources or [], expanded, namespace, notices).read()
+    return GazeboReader(root, file, sources or [], expanded, namespace, notices, model).read()
 
 
 def parse(text: str) -> Any:

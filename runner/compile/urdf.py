@@ -31,7 +31,7 @@ from runner.compile.gazebo import GazeboInfo, parse, read_gazebo
 from runner.compile.locate import Locator
 from runner.compile.meshes import MeshError, PreparedMesh, prepare_mesh
 from runner.compile.packages import PackageMap, resolve_uri
-from runner.errors import Notices, SourceError
+from runner.errors import Location, Notice, Notices, SourceError
 
 # URDF visuals are geom group 1 (MuJoCo's import); collisions go to group 3, which cameras do not draw
 # (MuJoCo renders groups 0-2 by default), as in MuJoCo Menagerie models.
@@ -58,6 +58,8 @@ class RobotModel:
     joints: list[str] = field(default_factory=list)
     gazebo: GazeboInfo = field(default_factory=GazeboInfo)
     transmissions: list[Transmission] = field(default_factory=list)
+    adjusted: list[Notice] = field(default_factory=list)  # what was changed or left out to load it, where
+    self_collision: list[str] = field(default_factory=list)  # links that collide with the robot's others
 
 
 _JOINT_TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
@@ -164,17 +166,6 @@ def _check_structure(root: Any, where: Any) -> str:
                 f"link {child!r} is the child of two joints ({children[child]!r} and {jname!r})", *where(j)
             )
         children[child] = jname
-        if jtype not in ("fixed", "floating", "planar") and j.find("child") is not None:
-            link_el = next(e for e in link_els if e.get("name") == child)
-            mass = link_el.find("inertial/mass")
-            value = _number(mass.get("value", "1") or "0", "mass", where, mass) if mass is not None else 1.0
-            if not value > 0:
-                raise DescriptionError(
-                    f"link {child!r} moves (joint {jname!r} is {jtype}) but has "
-                    + ("zero mass" if value == 0 else f"a negative mass ({value:g})"),
-                    *where(mass),
-                    hint="give it a positive <mass value=...> and an <inertia>",
-                )
     roots = [n for n in links if n not in children]
     if len(roots) != 1:
         raise DescriptionError(
@@ -192,6 +183,7 @@ def urdf_to_model(
     *,
     fixed: bool = False,
     namespace: str = "robot",
+    model: str | None = None,
     notices: Notices | None = None,
     sources: list[Path] | None = None,
     expanded: bool = False,
@@ -210,6 +202,8 @@ def urdf_to_model(
         raise DescriptionError(f"the top element is <{root.tag}>, expected <robot>", *where(root))
     root_link = _check_structure(root, where)
     _check_numbers(root, where)
+    adjusted: list[Notice] = []
+    _repair_inertias(root, where, notices, adjusted)
 
     shell: set[str] = set()  # mesh files without a volume (flat or tiny): MuJoCo weighs them as shells
     meshes = [m for m in root.iter("mesh") if m.getparent() is not None and m.getparent().tag == "geometry"]
@@ -222,6 +216,7 @@ def urdf_to_model(
         sources=sources or ([file] if file else []),
         expanded=expanded,
         namespace=namespace,
+        model=model or namespace,
         notices=notices,
     )
     transmissions = _transmissions(root, where, notices)
@@ -249,12 +244,15 @@ def urdf_to_model(
         if geom.contype or geom.conaffinity:
             geom.group = COLLISION_GROUP
     _apply_link_props(spec, gazebo, timestep)
+    self_collision = _self_collision(root, spec, gazebo)
     body = spec.body(root_link)
     if not (fixed or gazebo.static):
         body.add_freejoint(name="root")
     links = [b.name for b in spec.bodies if b.name and b.name != "world"]
     joints = [j.name for j in spec.joints if j.name and j.name != "root"]
-    return RobotModel(spec, root_link, urdf, links, joints, gazebo, transmissions)
+    for message, (src, line) in gazebo.dropped:
+        adjusted.append(Notice(message, Location(src, line)))
+    return RobotModel(spec, root_link, urdf, links, joints, gazebo, transmissions, adjusted, self_collision)
 
 
 def _mujoco_error(e: ValueError, root: Any, text: str, where: Any, file: Path | None) -> DescriptionError:
@@ -303,6 +301,155 @@ def _apply_link_props(spec: mujoco.MjSpec, gazebo: GazeboInfo, timestep: float) 
                 # per unit mass, not N/m: fed Gazebo's numbers, wheels lose traction.
                 mass = max(float(body.mass), 1e-3)
                 geom.solref = [max(2.0 * timestep, 2.0 * math.pi * math.sqrt(mass / props.kp)), 1.0]
+
+
+# Mass given to a moving link whose mass is zero, negative or next to nothing (MuJoCo refuses those).
+MIN_MASS = 1e-3
+_NEAR_ZERO_MASS = 1e-5
+# A principal moment this far below the largest (or not positive) is raised to a thousandth of it.
+_MIN_MOMENT_RATIO = 1e-3
+
+
+def _repair_inertias(root: Any, where: Any, notices: Notices, adjusted: list[Notice]) -> None:
+    """Masses and inertias Gazebo (ODE) takes and MuJoCo refuses, repaired as a careful user would, with
+    one warning per link saying what was changed:
+
+    - a moving link (a revolute, continuous or prismatic joint's child) with a zero, negative or near-zero
+      mass gets `MIN_MASS`;
+    - an inertia that is not positive definite (a zero or negative principal moment) has those moments
+      raised to a thousandth of the largest (a solid 10 cm sphere's when all are zero);
+    - principal moments that break the triangle inequality (A + B >= C: no rigid body has them, e.g.
+      ixx = iyy = 0.01, izz = 0.5) have the two smaller ones scaled up until A + B = C.
+
+    The orientation of the principal axes is kept: the repaired tensor is written back in the link's frame.
+    """
+    moving = {
+        j.find("child").get("link")
+        for j in root.findall("joint")
+        if j.get("type") in ("revolute", "continuous", "prismatic") and j.find("child") is not None
+    }
+    for link in root.findall("link"):
+        name = link.get("name")
+        inertial = link.find("inertial")
+        if inertial is None:
+            continue
+        changes: list[str] = []
+        mass_el = inertial.find("mass")
+        mass = (
+            _number(mass_el.get("value", "0") or "0", "mass", where, mass_el) if mass_el is not None else 0.0
+        )
+        if name in moving and mass < _NEAR_ZERO_MASS:
+            changes.append(f"mass {mass:g} kg -> {MIN_MASS:g} kg")
+            mass = MIN_MASS
+            if mass_el is None:
+                mass_el = etree.SubElement(inertial, "mass")
+            mass_el.set("value", repr(mass))
+        el = inertial.find("inertia")
+        if el is not None:
+            fixed = _repaired_inertia(el, mass, name in moving)
+            if fixed is not None:
+                tensor, before, after = fixed
+                for key, value in zip(("ixx", "iyy", "izz", "ixy", "ixz", "iyz"), tensor, strict=True):
+                    el.set(key, repr(value))
+                changes.append(f"principal moments {before} -> {after} kg·m²")
+        if not changes:
+            continue
+        at = where(el if el is not None else inertial)
+        message = f"link {name!r}: its inertia is not one MuJoCo accepts (Gazebo does): " + "; ".join(changes)
+        notices.add(
+            message,
+            *at,
+            hint="a rigid body needs a positive mass and principal moments with A + B >= C; fix the "
+            "<inertial> to silence this",
+        )
+        adjusted.append(Notice(message, Location(*at)))
+
+
+def _repaired_inertia(el: Any, mass: float, moving: bool) -> tuple[tuple[float, ...], str, str] | None:
+    """(ixx, iyy, izz, ixy, ixz, iyz) repaired, and the principal moments before and after; None if fine."""
+    import numpy as np
+
+    def num(key: str) -> float:
+        try:
+            return float(el.get(key, "0") or 0)
+        except ValueError:
+            return 0.0
+
+    ixx, iyy, izz, ixy, ixz, iyz = (num(k) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz"))
+    tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+    moments, axes = np.linalg.eigh(tensor)
+    new = moments.copy()
+    largest = float(moments.max())
+    if largest <= 0.0:
+        if not moving and mass <= 0.0:
+            return None  # a massless fixed link: MuJoCo asks nothing of it
+        new[:] = 0.4 * max(mass, MIN_MASS) * 0.05**2
+    else:
+        floor = largest * _MIN_MOMENT_RATIO
+        if moving or moments.min() < 0.0:
+            new = np.maximum(new, np.where(new <= largest * 1e-9, floor, new))
+    order = np.argsort(new)
+    a, b, c = (float(new[i]) for i in order)
+    if a + b < c * (1.0 - 1e-9):
+        scale = c / (a + b) * (1.0 + 1e-6) if a + b > 0 else None
+        a, b = (a * scale, b * scale) if scale else (c / 2.0 * (1.0 + 1e-6), c / 2.0 * (1.0 + 1e-6))
+        new[order[0]], new[order[1]] = a, b
+    if np.allclose(new, moments, rtol=0.0, atol=0.0):
+        return None
+    fixed = axes @ np.diag(new) @ axes.T
+    values = (fixed[0, 0], fixed[1, 1], fixed[2, 2], fixed[0, 1], fixed[0, 2], fixed[1, 2])
+
+    def shown(v: Any) -> str:
+        return "(" + ", ".join(f"{x:.4g}" for x in sorted(v)) + ")"
+
+    return tuple(float(v) for v in values), shown(moments), shown(new)
+
+
+def _self_collision(root: Any, spec: mujoco.MjSpec, gazebo: GazeboInfo) -> list[str]:
+    """Gazebo's rule: links of one model collide with each other only if one of the two has self_collide
+    (the link's `<selfCollide>`, else the model's `<self_collide>`, off by default), and never when a joint
+    connects them. Gazebo lumps links joined by fixed joints into one link: those never collide with each
+    other either, and a joint between two such groups connects all their links. MuJoCo only leaves out
+    parent-child pairs, so every other pair that Gazebo would not collide is excluded here. Returns the
+    links that self-collide."""
+    parent: dict[str, str] = {}
+    group = {el.get("name"): el.get("name") for el in root.findall("link")}
+
+    def find(x: str) -> str:
+        while group[x] != x:
+            group[x] = group[group[x]]
+            x = group[x]
+        return x
+
+    moving: list[tuple[str, str]] = []
+    for j in root.findall("joint"):
+        p, c = j.find("parent").get("link"), j.find("child").get("link")
+        parent[c] = p
+        if j.get("type") == "fixed":
+            group[find(c)] = find(p)
+        else:
+            moving.append((p, c))
+    jointed = {frozenset((find(p), find(c))) for p, c in moving}
+
+    def collides(name: str) -> bool:
+        props = gazebo.links.get(name)
+        if props is not None and props.self_collide is not None:
+            return props.self_collide
+        return gazebo.self_collide
+
+    bodies = [
+        b.name for b in spec.bodies if b.name in group and any(g.contype or g.conaffinity for g in b.geoms)
+    ]
+    on = [name for name in bodies if collides(name)]
+    for i, a in enumerate(bodies):
+        for b in bodies[i + 1 :]:
+            ga, gb = find(a), find(b)
+            if parent.get(a) == b or parent.get(b) == a:
+                continue  # MuJoCo leaves parent and child out by itself
+            if (collides(a) or collides(b)) and ga != gb and frozenset((ga, gb)) not in jointed:
+                continue
+            spec.add_exclude(bodyname1=a, bodyname2=b)
+    return on
 
 
 class _NoMesh(Exception):

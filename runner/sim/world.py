@@ -200,7 +200,8 @@ class World:
                     self.render_plugins[index] = plugin
                     continue
                 if overrides(plugin, "before_step"):
-                    self._before.append(_Hook(plugin.before_step, period))
+                    control = period if pp.control_rate is None else round(1e9 / pp.control_rate)
+                    self._before.append(_Hook(plugin.before_step, control))
                 if overrides(plugin, "after_step"):
                     self._after.append(_Hook(plugin.after_step, period, forward=plugin.needs_forward))
         if role == "world" and plan.foxglove.scene:
