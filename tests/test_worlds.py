@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from runner.record import read_summary
 from tests.conftest import SCENARIOS, read_mcap, run_cli, scenario_cmd
 from tests.test_hosts import _ancestor
 
@@ -97,6 +98,13 @@ def test_world_mistakes_point_at_the_users_lines(write_scenario) -> None:
 
 
 @pytest.mark.timeout(60)
+def _clocks_recorded(mcap: Path) -> bool:
+    if not mcap.exists():
+        return False
+    counts = {t["topic"]: t["count"] for t in read_summary(mcap)["topics"]}
+    return counts.get("pair/a/clock", 0) > 0 and counts.get("pair/b/clock", 0) > 0
+
+
 def test_a_world_that_dies_ends_the_run(write_scenario, tmp_path: Path) -> None:
     path = write_scenario(TWO.format(duration=600, rate="realtime"))
     mcap = tmp_path / "run.mcap"
@@ -116,7 +124,11 @@ def test_a_world_that_dies_ends_the_run(write_scenario, tmp_path: Path) -> None:
             out = subprocess.run(["pgrep", "-f", r"runner\.sim /"], capture_output=True, text=True)
             worlds = [int(p) for p in out.stdout.split() if _ancestor(int(p), proc.pid)]  # this run's
         assert len(worlds) == 2, "two world processes"
-        time.sleep(1.0)
+        # both worlds running and recorded (a loaded machine starts them slowly): the recorder hands a
+        # chunk to the OS at least every second, readable while the file is being written
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline and not _clocks_recorded(mcap):
+            time.sleep(0.2)
         killed = time.monotonic()
         os.kill(worlds[0], signal.SIGKILL)
         assert proc.stderr is not None
