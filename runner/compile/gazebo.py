@@ -37,8 +37,6 @@ _IGNORED_REASONS = {
     "alwaysOn": "sensors are always on",
     "rosDebugLevel": "ROS debug level",
     "legacyMode": "wheel order is taken from the joint names",
-    "publishWheelTF": "wheel TF comes from joint_states",
-    "publish_wheel_tf": "wheel TF comes from joint_states",
     "hackBaseline": "stereo baseline (mono camera)",
     "enable_metrics": "diagnostics",
     "gaussianNoise": "use the sensor's <noise>",
@@ -90,7 +88,7 @@ class GazeboInfo:
     static: bool = False
     self_collide: bool = False  # model-level <self_collide>: Gazebo's default is off
     self_collide_at: Where = (None, None)
-    dropped: list[tuple[str, Where]] = field(default_factory=list)  # blocks and plugins left out, and why
+    dropped: list[tuple[str, Where]] = field(default_factory=list)  # the warnings of what was left out
 
 
 class _Reader:
@@ -251,8 +249,9 @@ class GazeboReader:
                 if ref:
                     if ref not in self.link_names | self.joint_names | self.fixed_joints:
                         self.drop(
-                            gz,
-                            f'<gazebo reference="{ref}"> names a link or joint the robot does not have',
+                            self.where(gz),
+                            f'<gazebo reference="{ref}"> names a link or joint the robot does not have: '
+                            "it is left out",
                             "Gazebo drops such a block too; xacro arguments may have left the link out",
                         )
                         continue
@@ -265,10 +264,9 @@ class GazeboReader:
         self._drop_missing_targets()
         return self.info
 
-    def drop(self, el: Any, message: str, hint: str | None = None) -> None:
-        """Leave a block or plugin out, as Gazebo does, with a warning at its line."""
-        where = self.where(el)
-        self.notices.add(f"{message}: it is left out", *where, hint)
+    def drop(self, where: Where, message: str, hint: str | None = None) -> None:
+        """Leave a block, a plugin or part of one out, as Gazebo does, with a warning at its line."""
+        self.notices.add(message, *where, hint)
         self.info.dropped.append((message, where))
 
     def _drop_missing_targets(self) -> None:
@@ -292,26 +290,21 @@ class GazeboReader:
                     gone = [j for j in value if j not in self.joint_names]
                     if gone and key == "joints" and len(gone) < len(value):
                         p.params[key] = [j for j in value if j in self.joint_names]
-                        msg = f"{p.type} plugin {p.name!r} names joint(s) the robot does not have: " + (
-                            ", ".join(named(j) for j in gone)
+                        gone_names = ", ".join(named(j) for j in gone)
+                        self.drop(
+                            (p.file, p.line),
+                            f"{p.type} plugin {p.name!r} names joint(s) the robot does not have: "
+                            f"{gone_names}: they are left out",
                         )
-                        self.notices.add(f"{msg}: they are left out", p.file, p.line)
-                        self.info.dropped.append((msg, (p.file, p.line)))
                     else:
                         missing += [named(j) for j in gone]
             if missing:
-                msg = (
-                    f"{p.type} plugin {p.name!r} names "
-                    + ", ".join(missing)
-                    + ", which the robot does not have"
-                )
-                self.notices.add(
-                    f"{msg}: it is left out",
-                    p.file,
-                    p.line,
+                self.drop(
+                    (p.file, p.line),
+                    f"{p.type} plugin {p.name!r} names {', '.join(missing)}, which the robot does not have: "
+                    "it is left out",
                     "Gazebo does not load such a plugin either; xacro arguments may have left the link out",
                 )
-                self.info.dropped.append((msg, (p.file, p.line)))
                 continue
             keep.append(p)
         self.info.plugins = keep

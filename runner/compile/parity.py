@@ -8,8 +8,9 @@ with the file and line it comes from.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
+from runner.compile.wheels import wheel_joints
 from runner.errors import Notice
 from runner.plan import ParityLine, PluginPlan
 
@@ -36,10 +37,9 @@ def _topics(p: PluginPlan, direction: str, ns_prefix: str) -> list[str]:
     return out
 
 
-def _wheels(params: dict) -> str:  # type: ignore[type-arg]
-    left = params.get("left_joints") or [params.get("left_joint")]
-    right = params.get("right_joints") or [params.get("right_joint")]
-    return f"left {', '.join(str(j) for j in left)}; right {', '.join(str(j) for j in right)}"
+def _wheels(params: dict[str, Any]) -> str:
+    left, right = wheel_joints(params)
+    return f"left {', '.join(left)}; right {', '.join(right)}"
 
 
 def summarize(
@@ -92,13 +92,10 @@ def summarize(
         )
     else:
         out.append(_line("collide", "self-collision off: Gazebo's default (no <self_collide>/<selfCollide>)"))
-    shown = {n.message for n in model.adjusted}
-    for n in model.adjusted:
-        file = str(n.location.file) if n.location.file else None
-        kind = "changed" if "inertia" in n.message else "dropped"
-        out.append(_line(kind, n.message, (file, n.location.line)))
+    out += model.adjusted  # their warnings are among the robot's notices: not listed twice
+    shown = {line.text for line in model.adjusted}
     for n in robot_notices:
-        if any(n.message.startswith(s) for s in shown):
+        if n.message in shown:
             continue
         file = str(n.location.file) if n.location.file else None
         out.append(_line("ignored", n.message, (file, n.location.line)))

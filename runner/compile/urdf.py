@@ -31,7 +31,8 @@ from runner.compile.gazebo import GazeboInfo, parse, read_gazebo
 from runner.compile.locate import Locator
 from runner.compile.meshes import MeshError, PreparedMesh, prepare_mesh
 from runner.compile.packages import PackageMap, resolve_uri
-from runner.errors import Location, Notice, Notices, SourceError
+from runner.errors import Notices, SourceError
+from runner.plan import ParityLine
 
 # URDF visuals are geom group 1 (MuJoCo's import); collisions go to group 3, which cameras do not draw
 # (MuJoCo renders groups 0-2 by default), as in MuJoCo Menagerie models.
@@ -58,7 +59,7 @@ class RobotModel:
     joints: list[str] = field(default_factory=list)
     gazebo: GazeboInfo = field(default_factory=GazeboInfo)
     transmissions: list[Transmission] = field(default_factory=list)
-    adjusted: list[Notice] = field(default_factory=list)  # what was changed or left out to load it, where
+    adjusted: list[ParityLine] = field(default_factory=list)  # what was changed or left out to load it
     self_collision: list[str] = field(default_factory=list)  # links that collide with the robot's others
 
 
@@ -202,7 +203,7 @@ def urdf_to_model(
         raise DescriptionError(f"the top element is <{root.tag}>, expected <robot>", *where(root))
     root_link = _check_structure(root, where)
     _check_numbers(root, where)
-    adjusted: list[Notice] = []
+    adjusted: list[ParityLine] = []
     _repair_inertias(root, where, notices, adjusted)
 
     shell: set[str] = set()  # mesh files without a volume (flat or tiny): MuJoCo weighs them as shells
@@ -251,7 +252,7 @@ def urdf_to_model(
     links = [b.name for b in spec.bodies if b.name and b.name != "world"]
     joints = [j.name for j in spec.joints if j.name and j.name != "root"]
     for message, (src, line) in gazebo.dropped:
-        adjusted.append(Notice(message, Location(src, line)))
+        adjusted.append(ParityLine(kind="dropped", text=message, file=str(src) if src else None, line=line))
     return RobotModel(spec, root_link, urdf, links, joints, gazebo, transmissions, adjusted, self_collision)
 
 
@@ -310,7 +311,7 @@ _NEAR_ZERO_MASS = 1e-5
 _MIN_MOMENT_RATIO = 1e-3
 
 
-def _repair_inertias(root: Any, where: Any, notices: Notices, adjusted: list[Notice]) -> None:
+def _repair_inertias(root: Any, where: Any, notices: Notices, adjusted: list[ParityLine]) -> None:
     """Masses and inertias Gazebo (ODE) takes and MuJoCo refuses, repaired as a careful user would, with
     one warning per link saying what was changed:
 
@@ -362,7 +363,8 @@ def _repair_inertias(root: Any, where: Any, notices: Notices, adjusted: list[Not
             hint="a rigid body needs a positive mass and principal moments with A + B >= C; fix the "
             "<inertial> to silence this",
         )
-        adjusted.append(Notice(message, Location(*at)))
+        file, line = at
+        adjusted.append(ParityLine(kind="changed", text=message, file=str(file) if file else None, line=line))
 
 
 def _repaired_inertia(el: Any, mass: float, moving: bool) -> tuple[tuple[float, ...], str, str] | None:

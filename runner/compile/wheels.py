@@ -28,18 +28,22 @@ _DRIVES = ("diff_drive", "skid_steer")
 _MIN_MU = 0.01  # MuJoCo clamps a zero pair friction to 1e-5, and the pyramidal cone then diverges
 
 
+def wheel_joints(params: dict[str, Any]) -> tuple[list[str], list[str]]:
+    """The left and the right wheel joints of a diff_drive's or skid_steer's (compiled) params."""
+    left = params.get("left_joints") or [params.get("left_joint")]
+    right = params.get("right_joints") or [params.get("right_joint")]
+    return [j for j in left if j], [j for j in right if j]
+
+
 def wheel_links(plugins: list[Any], spec: mujoco.MjSpec) -> list[str]:
     """The links that a drive's wheel joints move."""
     out = []
     for p in plugins:
         if p.type not in _DRIVES:
             continue
-        params = p.params
-        joints = (params.get("left_joints") or [params.get("left_joint")]) + (
-            params.get("right_joints") or [params.get("right_joint")]
-        )
-        for j in joints:
-            joint = spec.joint(j) if j else None
+        left, right = wheel_joints(p.params)
+        for j in left + right:
+            joint = spec.joint(j)
             if joint is not None:
                 out.append(joint.parent.name)
     return out
