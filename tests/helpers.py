@@ -7,6 +7,7 @@ from typing import Any
 
 from runner import msgs
 from runner.compile import compile_plan
+from runner.errors import Notices
 from runner.loader import load_file
 from runner.plan import RunPlan
 from runner.sim.world import World
@@ -17,6 +18,14 @@ from runner.validate import validate_scenario
 def plan_of(path: Path) -> RunPlan:
     doc = load_file(path)
     return compile_plan(validate_scenario(doc), doc)
+
+
+def compile_with_notices(path: Path) -> tuple[RunPlan, str]:
+    """The plan of a scenario file and its warnings, rendered as `scenario validate` prints them."""
+    doc = load_file(path)
+    notices = Notices()
+    plan = compile_plan(validate_scenario(doc), doc, notices=notices)
+    return plan, "\n".join(n.render() for n in notices)
 
 
 def simulate(path: Path) -> tuple[World, MemoryBus]:

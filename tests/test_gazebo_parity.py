@@ -16,12 +16,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from runner.compile import compile_plan
-from runner.errors import Notices
 from runner.geometry import quat_to_yaw
-from runner.loader import load_file
-from runner.validate import validate_scenario
-from tests.helpers import messages, plan_of, simulate
+from tests.helpers import compile_with_notices, messages, plan_of, simulate
 
 # ------------------------------------------------------------------------------------------ the robots
 _INERTIA = '<inertia ixx="{i}" iyy="{i}" izz="{i}" ixy="0" ixz="0" iyz="0"/>'
@@ -142,13 +138,6 @@ def _write(
     return path
 
 
-def _compile(path: Path) -> tuple[Any, str]:
-    doc = load_file(path)
-    notices = Notices()
-    plan = compile_plan(validate_scenario(doc), doc, notices=notices)
-    return plan, "\n".join(n.render() for n in notices)
-
-
 def _truth(bus: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(t, xyz, yaw) of the robot's true pose, and its tilt, from the ground_truth plugin."""
     samples = messages(bus, "r1/ground_truth")
@@ -191,12 +180,14 @@ def test_links_of_one_robot_do_not_collide_unless_gazebo_says_so(tmp_path: Path)
     assert np.max(tilt) < 0.01
 
     on = diffbot(caster_extra="<selfCollide>true</selfCollide>")
-    plan, text = _compile(_write(tmp_path, on, 2.0))
+    plan, text = compile_with_notices(_write(tmp_path, on, 2.0))
     assert "robot 'r1' starts 0.04 m inside its own 'r1/" in text and "(self-collision is on)" in text, text
     collide = [line for line in plan.robots[0].gazebo if line.kind == "collide"]
     assert "self-collision on for caster" in collide[0].text and collide[0].line, collide
     assert ("r1/base_link", "r1/caster") in _touching(plan.mjcf)
-    assert ("r1/base_link", "r1/caster") not in _touching(_compile(_write(tmp_path, diffbot(), 2.0))[0].mjcf)
+    assert ("r1/base_link", "r1/caster") not in _touching(
+        compile_with_notices(_write(tmp_path, diffbot(), 2.0))[0].mjcf
+    )
 
 
 def _touching(mjcf: str) -> set[tuple[str, ...]]:
@@ -225,7 +216,7 @@ def test_model_self_collide_and_joined_links(tmp_path: Path):
   <link name="bumper"><collision><geometry><box size="0.05 0.3 0.05"/></geometry></collision></link>
   <joint name="bumper_joint" type="fixed"><parent link="base_link"/><child link="bumper"/><origin xyz="0.2 0 0"/></joint>
   <gazebo><self_collide>true</self_collide></gazebo>"""
-    plan, _ = _compile(_write(tmp_path, diffbot(extra=bumper), 1.0))
+    plan, _ = compile_with_notices(_write(tmp_path, diffbot(extra=bumper), 1.0))
     import mujoco
 
     m = mujoco.MjModel.from_xml_string(plan.mjcf)
@@ -247,7 +238,7 @@ def test_impossible_inertias_and_zero_masses_are_repaired_with_a_warning(tmp_pat
     loads them. We load them, repaired, with one warning per link naming it and what changed."""
     urdf = diffbot(inertia=(0.01, 0.01, 0.5), wheel_mass=0.0)
     path = _write(tmp_path, urdf, 2.0)
-    plan, text = _compile(path)
+    plan, text = compile_with_notices(path)
     urdf_file = tmp_path / "robot.urdf"
     assert f"{urdf_file}:5: link 'base_link': its inertia is not one MuJoCo accepts" in text, text
     assert "(0.01, 0.01, 0.5) -> (0.25, 0.25, 0.5)" in text
@@ -292,7 +283,7 @@ def test_blocks_naming_links_the_xacro_args_removed_are_dropped(tmp_path: Path, 
         "name: t\nduration: 1\nrobots:\n  - name: r1\n    description: {file: robot.urdf.xacro, "
         f"args: {{use_imu: {str(use_imu).lower()}}}}}\n"
     )
-    plan, text = _compile(tmp_path / "s.yaml")
+    plan, text = compile_with_notices(tmp_path / "s.yaml")
     types = [p.type for p in plan.robots[0].plugins]
     xacro = tmp_path / "robot.urdf.xacro"
     if use_imu:  # a fixed joint: Gazebo lumps it away, its joint state publisher finds no such joint either
@@ -331,7 +322,7 @@ ROS2_PAIRS = """
 
 
 def test_every_declared_wheel_is_driven(tmp_path: Path):
-    plan, text = _compile(_write(tmp_path, _four_wheels(ROS2_PAIRS), 1.0))
+    plan, text = compile_with_notices(_write(tmp_path, _four_wheels(ROS2_PAIRS), 1.0))
     drive = next(p for p in plan.robots[0].plugins if p.name == "drive")
     assert drive.type == "skid_steer"
     assert drive.params["left_joints"] == ["left_front_wheel_joint", "left_rear_wheel_joint"]
@@ -342,7 +333,7 @@ def test_every_declared_wheel_is_driven(tmp_path: Path):
     twice = ROS2_PAIRS.replace(
         "<num_wheel_pairs>2</num_wheel_pairs>", "<odometry_frame>a</odometry_frame>" * 2
     )
-    _, text = _compile(_write(tmp_path, _four_wheels(twice), 1.0))
+    _, text = compile_with_notices(_write(tmp_path, _four_wheels(twice), 1.0))
     assert "a second <odometry_frame> in <plugin filename='libgazebo_ros_diff_drive.so'> is ignored" in text
 
 
@@ -361,14 +352,14 @@ def test_a_drive_controls_at_a_high_rate_whatever_it_publishes_at(tmp_path: Path
 
 # ------------------------------------------------------------------------------------- 6. topic names
 def test_gazebo_default_topic_names(tmp_path: Path):
-    plan, _ = _compile(_write(tmp_path, diffbot(GZ_DRIVE), 1.0))
+    plan, _ = compile_with_notices(_write(tmp_path, diffbot(GZ_DRIVE), 1.0))
     keys = {t.key for p in plan.robots[0].plugins for t in p.topics}
     assert {"t/r1/model/r1/cmd_vel", "t/r1/model/r1/odometry", "t/r1/model/r1/tf"} <= keys, keys
     camera = """
   <link name="cam"/><joint name="cam_joint" type="fixed"><parent link="base_link"/><child link="cam"/></joint>
   <gazebo reference="cam"><sensor name="front" type="camera"><topic>front_camera</topic><update_rate>5</update_rate>
     <camera><image><width>64</width><height>48</height></image></camera></sensor></gazebo>"""
-    plan, _ = _compile(_write(tmp_path, diffbot(GZ_DRIVE, extra=camera), 1.0))
+    plan, _ = compile_with_notices(_write(tmp_path, diffbot(GZ_DRIVE, extra=camera), 1.0))
     cam = next(p for p in plan.robots[0].plugins if p.type == "camera")
     assert {t.key for t in cam.topics} == {"t/r1/front_camera", "t/r1/camera_info"}
 
@@ -423,7 +414,7 @@ def test_skid_steer_moves_as_commanded_with_gazebo_friction_directions(tmp_path:
     assert drift < 0.01 and tilt < 0.01, (drift, tilt)
     assert abs(straight - 1.0) < 0.1, straight
     assert abs(turned - 1.5) < 0.3, turned
-    plan, _ = _compile(tmp_path / "scenario.yaml")
+    plan, _ = compile_with_notices(tmp_path / "scenario.yaml")
     assert plan.mjcf.count("<pair") == 4
     # isotropic wheels (mu1 = mu2, as Gazebo then is): no pair, they scrub and turn much less
     _, _, _, iso = _drive_and_turn(tmp_path, _four_wheels(SKID_DRIVE))

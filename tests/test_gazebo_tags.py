@@ -17,13 +17,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from runner.compile import compile_plan
-from runner.errors import Notices
-from runner.loader import load_file
 from runner.plan import RunPlan
 from runner.transport import MemoryBus
-from runner.validate import validate_scenario
-from tests.helpers import messages, simulate
+from tests.helpers import compile_with_notices, messages, simulate
 
 IMAGE, INFO, POINTS = "sensor_msgs/msg/Image", "sensor_msgs/msg/CameraInfo", "sensor_msgs/msg/PointCloud2"
 
@@ -81,13 +77,6 @@ def _write(
     return path
 
 
-def _compile(path: Path) -> tuple[RunPlan, str]:
-    doc = load_file(path)
-    notices = Notices()
-    plan = compile_plan(validate_scenario(doc), doc, notices=notices)
-    return plan, "\n".join(n.render() for n in notices)
-
-
 def _camera_topics(plan: RunPlan) -> dict[str, str]:
     """Relative key -> type of what the robot's cameras publish."""
     cams = {t.key.removeprefix("g/bot/"): t.type for t in plan.topics() if t.type in (IMAGE, INFO, POINTS)}
@@ -126,7 +115,7 @@ ROS2_CAMERAS = (
 
 @pytest.mark.timeout(120)
 def test_ros2_camera_topics_are_named_after_the_camera_name(tmp_path: Path):
-    plan, notes = _compile(_write(tmp_path, ROS2_CAMERAS))
+    plan, notes = compile_with_notices(_write(tmp_path, ROS2_CAMERAS))
     assert _camera_topics(plan) == {
         "front_cam/image_raw": IMAGE,
         "front_cam/camera_info": INFO,
@@ -185,7 +174,7 @@ ROS1_CAMERAS = (
 
 @pytest.mark.timeout(120)
 def test_ros1_camera_and_openni_topics(tmp_path: Path):
-    plan, notes = _compile(_write(tmp_path, ROS1_CAMERAS))
+    plan, notes = compile_with_notices(_write(tmp_path, ROS1_CAMERAS))
     assert _camera_topics(plan) == {
         "left/image_rect": IMAGE,
         "left_info": INFO,
@@ -242,7 +231,7 @@ RATES = (
 
 @pytest.mark.timeout(120)
 def test_plugin_update_rate_throttles_the_sensor(tmp_path: Path):
-    plan, notes = _compile(_write(tmp_path, RATES, duration=1.0))
+    plan, notes = compile_with_notices(_write(tmp_path, RATES, duration=1.0))
     rates = {p.name: p.rate for p in plan.robots[0].plugins}
     assert rates == {"r200": 30, "slow": 10, "odd": 15, "ros2": 20}
     assert "<updateRate> is not read by 'libgazebo_ros_camera.so' (ROS 2)" in notes
@@ -331,7 +320,7 @@ CLASSIC_IMU = f"""
 @pytest.mark.timeout(120)
 def test_classic_imu_gaussian_noise(tmp_path: Path):
     path = _write(tmp_path, CLASSIC_IMU, duration=2.0, gravity="[0, 0, 0]")  # welded, no gravity: readings 0
-    plan, notes = _compile(path)
+    plan, notes = compile_with_notices(path)
     assert "<imu> is not a parameter of 'libgazebo_ros_imu.so': Gazebo ignores it too" in notes
     assert {p.name: p.rate for p in plan.robots[0].plugins} == {"imu_plugin": 200, "imu_sensor": 50}
     _, bus = simulate(path)
@@ -360,7 +349,7 @@ SLIPPERY = """
 @pytest.mark.timeout(120)
 def test_friction_in_value_attributes(tmp_path: Path):
     path = _write(tmp_path, SLIPPERY, duration=1.0, gravity="[2.0, 0, -9.81]")
-    plan, notes = _compile(path)
+    plan, notes = compile_with_notices(path)
     model = mujoco.MjModel.from_xml_string(plan.mjcf)
     base = model.body("bot/base_link").id
     geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] == base and model.geom_contype[g]]

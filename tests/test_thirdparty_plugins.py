@@ -11,12 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from plugins.gps import earth_radii
-from runner.compile import compile_plan
-from runner.errors import Notices
-from runner.loader import load_file
 from runner.plan import RunPlan
-from runner.validate import validate_scenario
-from tests.helpers import messages, simulate
+from tests.helpers import compile_with_notices, messages, simulate
 
 ROBOT = """<?xml version="1.0"?>
 <robot name="t">
@@ -177,13 +173,6 @@ def _write(
     return path
 
 
-def _compile(path: Path) -> tuple[RunPlan, str]:
-    doc = load_file(path)
-    notices = Notices()
-    plan = compile_plan(validate_scenario(doc), doc, notices=notices)
-    return plan, "\n".join(n.render() for n in notices)
-
-
 def _topics(plan: RunPlan) -> dict[str, str]:
     return {t.key.removeprefix("g/bot/"): t.type for t in plan.topics() if t.key.startswith("g/bot/")}
 
@@ -204,7 +193,7 @@ def _euler(q: object) -> tuple[float, float, float]:
 # ------------------------------------------------------------------------------------------ hector IMU
 def test_hector_imu_publishes_with_its_error_model(tmp_path: Path):
     path = _write(tmp_path, HECTOR_IMU, duration=3.0)
-    plan, notices = _compile(path)
+    plan, notices = compile_with_notices(path)
     assert "not supported" not in notices
     assert "<serviceName>" in notices  # reported at its line, not dropped silently
     topics = _topics(plan)
@@ -237,7 +226,7 @@ def test_hector_imu_publishes_with_its_error_model(tmp_path: Path):
 def test_hector_imu_drift_is_its_gauss_markov_process(tmp_path: Path):
     """rateDrift 0.5 rad/s at 20 Hz, read at 200 Hz: b' = b·exp(-20/200) + (1/200)·N(0, sqrt(40)·0.5)."""
     path = _write(tmp_path, DRIFTING_IMU, duration=6.0, seed=3)
-    plan, _ = _compile(path)
+    plan, _ = compile_with_notices(path)
     assert _topics(plan)["imu/bias"] == "sensor_msgs/msg/Imu"  # default topic `imu`, bias beside it
     _, bus = simulate(path)
     bias = np.array([_vec(m.angular_velocity) for _, m in messages(bus, "bot/imu/bias")])
@@ -278,7 +267,7 @@ def _cloud(msg: object) -> np.ndarray:
 
 def test_velodyne_ros1_publishes_only_its_point_cloud(tmp_path: Path):
     path = _write(tmp_path, VELODYNE_ROS1, duration=1.0, models=WALL)
-    plan, notices = _compile(path)
+    plan, notices = compile_with_notices(path)
     assert "not supported" not in notices
     topics = _topics(plan)
     assert topics == {"velodyne_points": "sensor_msgs/msg/PointCloud2"}  # no LaserScan
@@ -319,7 +308,7 @@ def test_velodyne_ros1_publishes_only_its_point_cloud(tmp_path: Path):
 
 def test_velodyne_ros2_organized_cloud_with_noise(tmp_path: Path):
     path = _write(tmp_path, VELODYNE_ROS2, duration=1.0, models=WALL)
-    plan, notices = _compile(path)
+    plan, notices = compile_with_notices(path)
     assert "not supported" not in notices
     assert "ROS namespace 'velodyne' is replaced" in notices
     assert _topics(plan) == {"velodyne_points": "sensor_msgs/msg/PointCloud2"}  # ~/out, remapped
@@ -380,7 +369,7 @@ def _sonar(name: str, yaw: float, noise: float) -> str:
 def test_hector_sonar_publishes_the_nearest_range(tmp_path: Path):
     extra = _sonar("sonar_front", 0.0, 0.01) + _sonar("sonar_back", math.pi, 0.01)
     path = _write(tmp_path, extra, duration=5.0, models=WALL)
-    plan, notices = _compile(path)
+    plan, notices = compile_with_notices(path)
     assert "not supported" not in notices
     assert _topics(plan) == {"sonar_front": "sensor_msgs/msg/Range", "sonar_back": "sensor_msgs/msg/Range"}
     _, bus = simulate(path)
@@ -402,7 +391,7 @@ def test_hector_gps_latitude_longitude_around_its_reference(tmp_path: Path):
     """100 m along x, 30 m along y: hector's defaults (heading 0) have x north and y west."""
     extra = HECTOR_GPS.replace("GPS_NOISE", "0 0 0").replace("REFERENCE", "")
     path = _write(tmp_path, extra, duration=1.0, xyz=(100.0, 30.0, 0.05))
-    plan, notices = _compile(path)
+    plan, notices = compile_with_notices(path)
     assert "not supported" not in notices
     topics = _topics(plan)
     assert topics["gps/fix"] == "sensor_msgs/msg/NavSatFix"
@@ -457,7 +446,7 @@ def test_hector_gps_heading_noise_and_velocity(tmp_path: Path):
 def test_gazebo_gps_sensor_with_the_ros2_plugin(tmp_path: Path):
     """Gazebo's reference (0°, 0°, 0 m), x east and y north; the robot 50 m east and 200 m north."""
     path = _write(tmp_path, GPS_SENSOR, duration=5.0, xyz=(50.0, 200.0, 0.05))
-    plan, notices = _compile(path)
+    plan, notices = compile_with_notices(path)
     assert "not supported" not in notices
     topics = _topics(plan)
     assert topics["gps/fix"] == "sensor_msgs/msg/NavSatFix"  # ~/out:=gps/fix
