@@ -40,7 +40,7 @@ def test_a_tightened_bound_fails_the_run_and_names_it(tmp_path: Path):
     failure = ET.parse(junit).getroot().find(".//testcase[@name='r1_drives_about_3_m']/failure")
     assert failure is not None
     message = failure.get("message", "")
-    assert "r1_drives_about_3_m" in message and "t=20.000 s" in message and "2.999 m" in message
+    assert "r1_drives_about_3_m" in message and "t=20.000 s" in message and "2.995 m" in message
 
 
 @pytest.mark.timeout(120)
