@@ -391,6 +391,29 @@ def test_diff_drive_moves_as_commanded(tmp_path: Path):
     assert abs(turned - 1.5) < 0.15, turned
 
 
+@pytest.mark.timeout(60)
+def test_declared_wheel_geometry_is_obeyed_as_gazebo_does_and_the_mismatch_is_said(tmp_path: Path):
+    """A description whose <wheel_separation> (0.40 m) is wider than its wheel joints (0.34 m), and whose
+    <wheel_diameter> (0.12 m) is larger than its wheels (0.10 m): Gazebo's drive computes wheel speeds from
+    the declared values, so the robot turns at 0.40 / 0.34 of the command and drives at 0.10 / 0.12. We do
+    the same, and validate says so with the factor, at the plugin's line."""
+    drive = CLASSIC_DRIVE.replace("<wheel_separation>0.34<", "<wheel_separation>0.40<").replace(
+        "<wheel_diameter>0.1<", "<wheel_diameter>0.12<"
+    )
+    urdf = diffbot(drive)
+    drift, tilt, straight, turned = _drive_and_turn(tmp_path, urdf)
+    assert abs(straight - 0.10 / 0.12) < 0.05, straight
+    assert abs(turned - 1.5 * 0.40 / 0.34 * 0.10 / 0.12) < 0.15, (straight, turned)
+    plan, notices = compile_with_notices(tmp_path / "scenario.yaml")
+    assert "wheel_separation 0.400 m, but its wheel joints are 0.340 m apart: it turns at 1.18x" in notices
+    assert "collision radius is 0.050 m: it drives at 0.83x" in notices, notices
+    lines = [ln for ln in plan.robots[0].gazebo if ln.kind == "geometry"]
+    assert len(lines) == 2 and all(ln.file and ln.file.endswith("robot.urdf") and ln.line for ln in lines)
+    # the description as written (declared = built): nothing said
+    _, clean = compile_with_notices(_write(tmp_path, diffbot(), 1.0))
+    assert "apart:" not in clean and "collision radius" not in clean, clean
+
+
 # --------------------------------------------------------------------------------------- 8. skid steer
 SKID_DRIVE = """
 <plugin name="skid" filename="libgazebo_ros_skid_steer_drive.so">

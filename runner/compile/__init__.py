@@ -22,7 +22,7 @@ from runner.compile.packages import PackageMap
 from runner.compile.parity import summarize
 from runner.compile.sdf import load_sdf_world
 from runner.compile.urdf import RobotModel, urdf_to_model
-from runner.compile.wheels import anisotropic_wheels, wheel_links
+from runner.compile.wheels import anisotropic_wheels, check_geometry, wheel_links
 from runner.compile.xacro_expand import expand
 from runner.errors import Location, Notices, Problem, ScenarioError, SourceError
 from runner.geometry import rpy_to_quat
@@ -247,6 +247,7 @@ def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices
     except ValueError as e:
         raise ScenarioError(_compile_problem(e, sc, doc, world)) from None
     _check_start_overlaps(compiled, sc, doc, notices)
+    check_geometry(compiled, robots, notices)
     # the sun's shadow map covers shadowclip x the model's extent around its centre; at its edge the floor
     # shows shadow acne (black speckles), in camera images and renders of a small world: cover 25 m at least
     extent = float(compiled.stat.extent)

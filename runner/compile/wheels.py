@@ -16,6 +16,7 @@ than the ground plane (boxes, meshes) the wheel keeps its isotropic cylinder con
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import mujoco
@@ -23,9 +24,11 @@ import numpy as np
 
 from runner.compile.gazebo import GazeboInfo
 from runner.errors import Notices
+from runner.plan import ParityLine, PluginPlan, RobotPlan
 
 _DRIVES = ("diff_drive", "skid_steer")
 _MIN_MU = 0.01  # MuJoCo clamps a zero pair friction to 1e-5, and the pyramidal cone then diverges
+_GEOMETRY_TOLERANCE = 0.05  # declared and built wheel geometry further apart than this get a warning
 
 
 def wheel_joints(params: dict[str, Any]) -> tuple[list[str], list[str]]:
@@ -98,3 +101,79 @@ def anisotropic_wheels(
             )
             count += 1
     return count
+
+
+def _round_radius(m: mujoco.MjModel, body: int) -> float | None:
+    """The largest radius of a wheel body's colliding cylinders/spheres/capsules, or None (a mesh wheel)."""
+    round_types = (
+        mujoco.mjtGeom.mjGEOM_CYLINDER,
+        mujoco.mjtGeom.mjGEOM_SPHERE,
+        mujoco.mjtGeom.mjGEOM_CAPSULE,
+    )
+    radii = [
+        float(m.geom_size[g][0])
+        for g in range(m.ngeom)
+        if int(m.geom_bodyid[g]) == body
+        and int(m.geom_type[g]) in round_types
+        and (m.geom_contype[g] or m.geom_conaffinity[g])
+    ]
+    return max(radii) if radii else None
+
+
+def check_geometry(m: mujoco.MjModel, robots: list[RobotPlan], notices: Notices) -> None:
+    """Warn where a drive's declared wheel separation or radius is not the robot's.
+
+    Gazebo's drives turn wheel speeds with the declared values whatever the links say, so a description
+    whose `<wheel_separation>` is wider than its wheel joints makes the robot turn faster than commanded,
+    in Gazebo as here. We keep that (parity) and say so, with the factor, at the plugin's line; the
+    robot's "as in Gazebo" summary gets the same line."""
+    d = mujoco.MjData(m)
+    mujoco.mj_kinematics(m, d)
+    for robot in robots:
+        for p in robot.plugins:
+            if p.type not in _DRIVES:
+                continue
+            file = Path(p.source_file) if p.source_file else None
+            for message, hint in _geometry_mismatches(m, d, robot.prefix, p):
+                notices.add(message, file, p.source_line, hint=hint)
+                robot.gazebo.append(
+                    ParityLine(kind="geometry", text=message, file=p.source_file, line=p.source_line)
+                )
+
+
+def _geometry_mismatches(
+    m: mujoco.MjModel, d: mujoco.MjData, prefix: str, p: PluginPlan
+) -> list[tuple[str, str]]:
+    """(message, hint) for each declared wheel value more than 5 % off the built robot's."""
+    left, right = wheel_joints(p.params)
+    ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, prefix + j) for j in left + right]
+    if not left or not right or min(ids) < 0:
+        return []
+    bodies = [int(m.jnt_bodyid[j]) for j in ids]
+    out = []
+    parity = "as in Gazebo (whose drive uses the declared value)"
+    declared = p.params.get("wheel_separation")
+    if declared and p.type == "diff_drive":
+        built = float(np.linalg.norm(d.xpos[bodies[0]] - d.xpos[bodies[1]]))
+        if built > 0 and abs(declared / built - 1) > _GEOMETRY_TOLERANCE:
+            out.append(
+                (
+                    f"{p.type} {p.name!r}: wheel_separation {declared:.3f} m, but its wheel joints are "
+                    f"{built:.3f} m apart: it turns at {declared / built:.2f}x the commanded rate, {parity}",
+                    f"if the joints are where the wheels are, set wheel_separation to {built:.3f}",
+                )
+            )
+    declared = p.params.get("wheel_radius")
+    radii = [r for r in (_round_radius(m, b) for b in bodies) if r]
+    if declared and radii and not p.params.get("pair_radii"):
+        built = float(np.mean(radii))
+        if abs(built / declared - 1) > _GEOMETRY_TOLERANCE:
+            out.append(
+                (
+                    f"{p.type} {p.name!r}: wheel radius {declared:.3f} m, but its wheels' collision radius "
+                    f"is {built:.3f} m: it drives at {built / declared:.2f}x the commanded speed, {parity}",
+                    f"if the collision is the wheel, set the wheel radius to {built:.3f} "
+                    f"(diameter {2 * built:.3f})",
+                )
+            )
+    return out
