@@ -7,7 +7,8 @@ each; a message is published every tick, with no states when the link touches no
 gazebo_ros_bumper does). Contacts between the robot's own bodies are left out unless `with_robot`.
 
 Per state: `collision1_name` is the link's geom and `collision2_name` the other one (the MuJoCo geom
-name, or the body's name for an unnamed geom, e.g. `r1/base_link` for a URDF collision); per contact
+name, `<ns>/<collision name>`: a URDF `<collision>` without a name is `<link>_collision` as Gazebo names
+it, e.g. `r1/base_link_collision`; the body's name for an unnamed geom of a world model); per contact
 point: `contact_positions`, `contact_normals` (unit, pointing from the other object into the link: the
 direction the link is pushed), `depths` (penetration, metres, >= 0) and `wrenches` (the contact force on
 the link and its torque about the link's origin); `total_wrench` is their sum.

@@ -64,7 +64,7 @@ def test_bumper_is_silent_before_the_wall_and_reports_it_while_pressing(write_sc
     for m in touching:
         assert m.header.frame_id == "r1/base_link"
         for s in m.states:  # wheel-ground contacts belong to other links: never here
-            assert (s.collision1_name, s.collision2_name) == ("r1/base_link", "wall")
+            assert (s.collision1_name, s.collision2_name) == ("r1/base_link_collision", "wall")
             n = len(s.depths)
             assert n >= 1 and len(s.wrenches) == len(s.contact_positions) == len(s.contact_normals) == n
             assert all(d >= 0 for d in s.depths)
@@ -85,7 +85,7 @@ def test_wheel_bumper_reports_the_ground_in_world_frame(write_scenario):
     assert rolling and all(m.header.frame_id == "world" for m in rolling)
     forces = []
     for m in rolling:
-        assert [(s.collision1_name, s.collision2_name) for s in m.states] == [("r1/left_wheel", "ground")]
+        assert [(s.collision1_name, s.collision2_name) for s in m.states] == [("r1/left_wheel_collision", "ground")]
         s = m.states[0]
         for normal, pos in zip(s.contact_normals, s.contact_positions, strict=True):
             assert (normal.x, normal.y, normal.z) == pytest.approx((0.0, 0.0, 1.0), abs=1e-6)

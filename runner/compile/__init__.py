@@ -247,7 +247,17 @@ def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices
     except ValueError as e:
         raise ScenarioError(_compile_problem(e, sc, doc, world)) from None
     _check_start_overlaps(compiled, sc, doc, notices)
-    check_geometry(compiled, robots, notices)
+    wheelless = check_geometry(compiled, robots, notices)
+    if wheelless:
+        raise ScenarioError(
+            Problem(
+                message,
+                doc.locate(("robots", i, "description")),
+                ("robots", i, "description"),
+                hint="give the wheel link a <collision> (a cylinder); with xacro, the `args:` that size it",
+            )
+            for i, message in wheelless
+        )
     # the sun's shadow map covers shadowclip x the model's extent around its centre; at its edge the floor
     # shows shadow acne (black speckles), in camera images and renders of a small world: cover 25 m at least
     extent = float(compiled.stat.extent)

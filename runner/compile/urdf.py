@@ -205,6 +205,7 @@ def urdf_to_model(
     _check_numbers(root, where)
     adjusted: list[ParityLine] = []
     _repair_inertias(root, where, notices, adjusted)
+    _drop_empty_shapes(root, where, notices, adjusted)
 
     shell: set[str] = set()  # mesh files without a volume (flat or tiny): MuJoCo weighs them as shells
     meshes = [m for m in root.iter("mesh") if m.getparent() is not None and m.getparent().tag == "geometry"]
@@ -231,6 +232,7 @@ def urdf_to_model(
     mj = etree.Element("mujoco")
     etree.SubElement(mj, "compiler", discardvisual="false", fusestatic="false", strippath="false")
     root.insert(0, mj)
+    _unique_shape_names(root)
     text = etree.tostring(root, encoding="unicode")
     try:
         spec = mujoco.MjSpec.from_string(text)
@@ -304,9 +306,84 @@ def _apply_link_props(spec: mujoco.MjSpec, gazebo: GazeboInfo, timestep: float) 
                 geom.solref = [max(2.0 * timestep, 2.0 * math.pi * math.sqrt(mass / props.kp)), 1.0]
 
 
+# The dimensions of each URDF shape (attribute, how many numbers)
+_SHAPE_SIZES = {
+    "box": ("size", 3),
+    "cylinder": ("radius", 1),
+    "sphere": ("radius", 1),
+    "capsule": ("radius", 1),
+}
+
+
+def _drop_empty_shapes(root: Any, where: Any, notices: Notices, adjusted: list[ParityLine]) -> None:
+    """A `<collision>` or `<visual>` whose shape has a zero dimension (`<box size="0 0 0">`, a sphere of
+    radius 0: placeholders some descriptions give sensors) loads in Gazebo, where it touches and shows
+    nothing; MuJoCo refuses it. It is left out, with a warning at its line."""
+    for link in root.findall("link"):
+        for el in [*link.findall("collision"), *link.findall("visual")]:
+            geometry = el.find("geometry")
+            shape = (
+                next((g for g in geometry if isinstance(g.tag, str)), None) if geometry is not None else None
+            )
+            if shape is None or shape.tag not in _SHAPE_SIZES:
+                continue
+            sizes = [shape.get(_SHAPE_SIZES[shape.tag][0], "")]
+            if shape.tag in ("cylinder", "capsule"):
+                sizes.append(shape.get("length", ""))
+            values = [float(v) for text in sizes for v in text.split() if _is_number(v)]
+            if not values or min(values) != 0.0:
+                continue
+            at = where(shape)
+            shown = " ".join(f'{k}="{v}"' for k, v in shape.attrib.items())
+            does = "touches" if el.tag == "collision" else "shows"
+            message = (
+                f"link {link.get('name')!r}: its <{el.tag}> is a <{shape.tag} {shown}>, of zero size: "
+                f"left out (Gazebo loads it, and it {does} nothing)"
+            )
+            notices.add(message, *at, hint=f"remove the <{el.tag}> or give it a size to silence this")
+            el.getparent().remove(el)
+            file, line = at
+            adjusted.append(
+                ParityLine(kind="dropped", text=message, file=str(file) if file else None, line=line)
+            )
+
+
+def _unique_shape_names(root: Any) -> None:
+    """Every `<visual>`/`<collision>` gets a unique name, as MuJoCo wants for its geoms: an unnamed one is
+    named as Gazebo's URDF reader does (`<link>_collision`, `<link>_collision_1`...), a name another link
+    already used (macros call them all "base_visual") gets its link's name before it. Left unnamed, MuJoCo's
+    URDF reader carries the link's visual name over to its unnamed collision and prints a warning for each.
+    """
+    taken = {el.get("name") for tag in ("collision", "visual") for el in root.iter(tag) if el.get("name")}
+    seen: set[str] = set()
+    for link in root.findall("link"):
+        lname = link.get("name")
+        for tag in ("collision", "visual"):
+            for k, el in enumerate(link.findall(tag)):
+                given = el.get("name")
+                name = given if given and given not in seen else None
+                if name is None:
+                    stem = f"{lname}/{given}" if given else f"{lname}_{tag}" + (f"_{k}" if k else "")
+                    name, n = stem, 1
+                    while name in seen or (name in taken and not given):
+                        name, n = f"{stem}_{n}", n + 1
+                    el.set("name", name)
+                seen.add(name)
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
 # Mass given to a moving link whose mass is zero, negative or next to nothing (MuJoCo refuses those).
 MIN_MASS = 1e-3
 _NEAR_ZERO_MASS = 1e-5
+# MJCF text keeps 6 significant digits: a repaired A + B exceeds C by more than their rounding
+_TEXT_ROUNDING = 2e-5
 # A principal moment this far below the largest (or not positive) is raised to a thousandth of it.
 _MIN_MOMENT_RATIO = 1e-3
 
@@ -349,10 +426,11 @@ def _repair_inertias(root: Any, where: Any, notices: Notices, adjusted: list[Par
         if el is not None:
             fixed = _repaired_inertia(el, mass, name in moving)
             if fixed is not None:
-                tensor, before, after = fixed
+                tensor, before, after, nudged_only = fixed
                 for key, value in zip(("ixx", "iyy", "izz", "ixy", "ixz", "iyz"), tensor, strict=True):
                     el.set(key, repr(value))
-                changes.append(f"principal moments {before} -> {after} kg·m²")
+                if not nudged_only:
+                    changes.append(f"principal moments {before} -> {after} kg·m²")
         if not changes:
             continue
         at = where(el if el is not None else inertial)
@@ -367,8 +445,9 @@ def _repair_inertias(root: Any, where: Any, notices: Notices, adjusted: list[Par
         adjusted.append(ParityLine(kind="changed", text=message, file=str(file) if file else None, line=line))
 
 
-def _repaired_inertia(el: Any, mass: float, moving: bool) -> tuple[tuple[float, ...], str, str] | None:
-    """(ixx, iyy, izz, ixy, ixz, iyz) repaired, and the principal moments before and after; None if fine."""
+def _repaired_inertia(el: Any, mass: float, moving: bool) -> tuple[tuple[float, ...], str, str, bool] | None:
+    """(ixx, iyy, izz, ixy, ixz, iyz) repaired, the principal moments before and after, and whether it was
+    only nudged by the MJCF text's rounding (not worth a warning); None if fine."""
     import numpy as np
 
     def num(key: str) -> float:
@@ -390,13 +469,19 @@ def _repaired_inertia(el: Any, mass: float, moving: bool) -> tuple[tuple[float, 
         floor = largest * _MIN_MOMENT_RATIO
         if moving or moments.min() < 0.0:
             new = np.maximum(new, np.where(new <= largest * 1e-9, floor, new))
+    raised = not np.array_equal(new, moments)
     order = np.argsort(new)
     a, b, c = (float(new[i]) for i in order)
-    if a + b < c * (1.0 - 1e-9):
-        scale = c / (a + b) * (1.0 + 1e-6) if a + b > 0 else None
-        a, b = (a * scale, b * scale) if scale else (c / 2.0 * (1.0 + 1e-6), c / 2.0 * (1.0 + 1e-6))
+    margin = 1.0 + _TEXT_ROUNDING
+    nudged_only = False
+    if a + b < c * margin:
+        # A + B = C exactly (a thin plate, or an xacro formula such as m/12 (y² + z²)) holds in floating
+        # point but not once the MJCF text keeps 6 digits: such a tensor is nudged by that rounding, silently
+        nudged_only = not raised and a + b >= c * (1.0 - 1e-9)
+        scale = c * margin / (a + b) if a + b > 0 else None
+        a, b = (a * scale, b * scale) if scale else (c / 2.0 * margin, c / 2.0 * margin)
         new[order[0]], new[order[1]] = a, b
-    if np.allclose(new, moments, rtol=0.0, atol=0.0):
+    if np.array_equal(new, moments):
         return None
     fixed = axes @ np.diag(new) @ axes.T
     values = (fixed[0, 0], fixed[1, 1], fixed[2, 2], fixed[0, 1], fixed[0, 2], fixed[1, 2])
@@ -404,7 +489,7 @@ def _repaired_inertia(el: Any, mass: float, moving: bool) -> tuple[tuple[float, 
     def shown(v: Any) -> str:
         return "(" + ", ".join(f"{x:.4g}" for x in sorted(v)) + ")"
 
-    return tuple(float(v) for v in values), shown(moments), shown(new)
+    return tuple(float(v) for v in values), shown(moments), shown(new), nudged_only
 
 
 def _self_collision(root: Any, spec: mujoco.MjSpec, gazebo: GazeboInfo) -> list[str]:

@@ -120,8 +120,10 @@ def _round_radius(m: mujoco.MjModel, body: int) -> float | None:
     return max(radii) if radii else None
 
 
-def check_geometry(m: mujoco.MjModel, robots: list[RobotPlan], notices: Notices) -> None:
-    """Warn where a drive's declared wheel separation or radius is not the robot's.
+def check_geometry(m: mujoco.MjModel, robots: list[RobotPlan], notices: Notices) -> list[tuple[int, str]]:
+    """Warn where a drive's declared wheel separation or radius is not the robot's, or its left wheels are
+    on the right; returns (robot index, message) for each drive wheel with nothing to roll on (no
+    collision shape: a zero-size one is left out), which no drive can move a robot with.
 
     Gazebo's drives turn wheel speeds with the declared values whatever the links say, so a description
     whose `<wheel_separation>` is wider than its wheel joints makes the robot turn faster than commanded,
@@ -129,29 +131,57 @@ def check_geometry(m: mujoco.MjModel, robots: list[RobotPlan], notices: Notices)
     robot's "as in Gazebo" summary gets the same line."""
     d = mujoco.MjData(m)
     mujoco.mj_kinematics(m, d)
-    for robot in robots:
+    fatal = []
+    for i, robot in enumerate(robots):
         for p in robot.plugins:
             if p.type not in _DRIVES:
                 continue
+            left, right = wheel_joints(p.params)
+            for j in left + right:
+                jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, robot.prefix + j)
+                if jid >= 0 and not _collides(m, int(m.jnt_bodyid[jid])):
+                    link = m.body(int(m.jnt_bodyid[jid])).name.removeprefix(robot.prefix)
+                    fatal.append((i, f"{p.type} {p.name!r}: its wheel {link!r} ({j}) has no collision shape"))
             file = Path(p.source_file) if p.source_file else None
-            for message, hint in _geometry_mismatches(m, d, robot.prefix, p):
+            for message, hint in _geometry_mismatches(m, d, robot.prefix + robot.root, robot.prefix, p):
                 notices.add(message, file, p.source_line, hint=hint)
                 robot.gazebo.append(
                     ParityLine(kind="geometry", text=message, file=p.source_file, line=p.source_line)
                 )
+    return fatal
+
+
+def _collides(m: mujoco.MjModel, body: int) -> bool:
+    return any(
+        int(m.geom_bodyid[g]) == body and (m.geom_contype[g] or m.geom_conaffinity[g]) for g in range(m.ngeom)
+    )
 
 
 def _geometry_mismatches(
-    m: mujoco.MjModel, d: mujoco.MjData, prefix: str, p: PluginPlan
+    m: mujoco.MjModel, d: mujoco.MjData, root: str, prefix: str, p: PluginPlan
 ) -> list[tuple[str, str]]:
-    """(message, hint) for each declared wheel value more than 5 % off the built robot's."""
+    """(message, hint) for left wheels on the robot's right, and for each declared wheel value more than
+    5 % off the built robot's."""
     left, right = wheel_joints(p.params)
     ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, prefix + j) for j in left + right]
-    if not left or not right or min(ids) < 0:
+    base = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, root)
+    if not left or not right or min(ids) < 0 or base < 0:
         return []
     bodies = [int(m.jnt_bodyid[j]) for j in ids]
     out = []
     parity = "as in Gazebo (whose drive uses the declared value)"
+    # the left wheels' centre seen from the right wheels', in the robot's frame (x ahead, y to the left)
+    across = d.xmat[base].reshape(3, 3).T @ (
+        np.mean(d.xpos[bodies[: len(left)]], axis=0) - np.mean(d.xpos[bodies[len(left) :]], axis=0)
+    )
+    if across[1] < 0 and abs(across[1]) > abs(across[0]):
+        out.append(
+            (
+                f"{p.type} {p.name!r}: its left wheels ({', '.join(left)}) are on the robot's right (y < 0 "
+                f"in {root.removeprefix(prefix)}): it turns the other way than commanded, as in Gazebo",
+                "swap the left and right joints in the plugin (ROS 1's old legacyMode swapped them)",
+            )
+        )
     declared = p.params.get("wheel_separation")
     if declared and p.type == "diff_drive":
         built = float(np.linalg.norm(d.xpos[bodies[0]] - d.xpos[bodies[1]]))
