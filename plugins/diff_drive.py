@@ -21,17 +21,11 @@ import numpy as np
 from pydantic import Field, PositiveFloat
 
 from plugins._common import BaseDriveParams, OdometryWriter, TransformWriter, drive_topics, tf_transforms
-from runner.geometry import quat_to_yaw
+from runner.geometry import quat_to_yaw, wheel_radius
 from runner.plugin import BuildContext, Plugin, PluginConfigError, Topic
 
 _INTEGRAL_TIME_S = 0.2
 _YAW_INTEGRAL_TIME_S = 0.05
-_ROUND = {
-    int(mujoco.mjtGeom.mjGEOM_CYLINDER),
-    int(mujoco.mjtGeom.mjGEOM_SPHERE),
-    int(mujoco.mjtGeom.mjGEOM_ELLIPSOID),
-    int(mujoco.mjtGeom.mjGEOM_CAPSULE),
-}
 
 
 class WheelDriveParams(BaseDriveParams):
@@ -357,18 +351,11 @@ class DiffDrive(WheelDrive):
 
 
 def _wheel_radius(m: mujoco.MjModel, body: int) -> float:
-    """Radius of the wheel's collision geometry (cylinder/sphere/ellipsoid), else its bounding radius."""
-    best = 0.0
-    for g in range(m.ngeom):
-        if int(m.geom_bodyid[g]) != body or (m.geom_contype[g] == 0 and m.geom_conaffinity[g] == 0):
-            continue
-        if int(m.geom_type[g]) in _ROUND:
-            best = max(best, float(m.geom_size[g][0]))
-        else:
-            best = max(best, float(m.geom_rbound[g]))
-    if best <= 0:
+    """Radius of the wheel's collision geometry (with the links fixed to it), see `wheel_radius`."""
+    radius = wheel_radius(m, body)
+    if not radius:
         raise ValueError("cannot find the wheel radius from the model; set `wheel_radius`")
-    return best
+    return radius
 
 
 def _auto_gain(

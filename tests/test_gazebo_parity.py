@@ -471,6 +471,27 @@ def test_left_wheels_on_the_right_turn_the_other_way_as_in_gazebo_and_are_said(t
     assert "swap the left and right joints" in text
 
 
+@pytest.mark.timeout(60)
+def test_a_wheel_joint_moving_a_hub_with_the_tyre_fixed_to_it(tmp_path: Path):
+    """The wheel joint moves a hub link with no collision (a zero-size placeholder), the tyre's cylinder is
+    on a link fixed to it: Gazebo lumps the two into one link. The drive finds the radius on the tyre."""
+    urdf = diffbot("")
+    for side in ("left", "right"):
+        urdf = urdf.replace(f'<link name="{side}_wheel">', f'<link name="{side}_tyre">').replace(
+            f'<joint name="{side}_wheel_joint" type="continuous">',
+            f'<link name="{side}_wheel"><collision><geometry><box size="0 0 0"/></geometry></collision>'
+            '<inertial><mass value="0.01"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/>'
+            f'</inertial></link><joint name="{side}_tyre_joint" type="fixed"><parent link="{side}_wheel"/>'
+            f'<child link="{side}_tyre"/></joint>\n  <joint name="{side}_wheel_joint" type="continuous">',
+        )
+    drive = ", {type: diff_drive, params: {left_joint: left_wheel_joint, right_joint: right_wheel_joint}}"
+    timeline = _cmd(0.5, "cmd_vel", lin=0.2) + _cmd(5.5, "cmd_vel")
+    path = _write(tmp_path, urdf, 6.0, timeline, plugins=drive)
+    _, bus = simulate(path)
+    t, pose, _ = _truth(bus)
+    assert abs(np.linalg.norm(_at(t, pose, 6.0)[:2] - _at(t, pose, 0.5)[:2]) - 1.0) < 0.05
+
+
 # --------------------------------------------------------------------------------------- 8. skid steer
 SKID_DRIVE = """
 <plugin name="skid" filename="libgazebo_ros_skid_steer_drive.so">

@@ -24,6 +24,7 @@ import numpy as np
 
 from runner.compile.gazebo import GazeboInfo
 from runner.errors import Notices
+from runner.geometry import colliding_geoms, wheel_radius
 from runner.plan import ParityLine, PluginPlan, RobotPlan
 
 _DRIVES = ("diff_drive", "skid_steer")
@@ -103,23 +104,6 @@ def anisotropic_wheels(
     return count
 
 
-def _round_radius(m: mujoco.MjModel, body: int) -> float | None:
-    """The largest radius of a wheel body's colliding cylinders/spheres/capsules, or None (a mesh wheel)."""
-    round_types = (
-        mujoco.mjtGeom.mjGEOM_CYLINDER,
-        mujoco.mjtGeom.mjGEOM_SPHERE,
-        mujoco.mjtGeom.mjGEOM_CAPSULE,
-    )
-    radii = [
-        float(m.geom_size[g][0])
-        for g in range(m.ngeom)
-        if int(m.geom_bodyid[g]) == body
-        and int(m.geom_type[g]) in round_types
-        and (m.geom_contype[g] or m.geom_conaffinity[g])
-    ]
-    return max(radii) if radii else None
-
-
 def check_geometry(m: mujoco.MjModel, robots: list[RobotPlan], notices: Notices) -> list[tuple[int, str]]:
     """Warn where a drive's declared wheel separation or radius is not the robot's, or its left wheels are
     on the right; returns (robot index, message) for each drive wheel with nothing to roll on (no
@@ -139,7 +123,7 @@ def check_geometry(m: mujoco.MjModel, robots: list[RobotPlan], notices: Notices)
             left, right = wheel_joints(p.params)
             for j in left + right:
                 jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, robot.prefix + j)
-                if jid >= 0 and not _collides(m, int(m.jnt_bodyid[jid])):
+                if jid >= 0 and not colliding_geoms(m, int(m.jnt_bodyid[jid])):
                     link = m.body(int(m.jnt_bodyid[jid])).name.removeprefix(robot.prefix)
                     fatal.append((i, f"{p.type} {p.name!r}: its wheel {link!r} ({j}) has no collision shape"))
             file = Path(p.source_file) if p.source_file else None
@@ -149,12 +133,6 @@ def check_geometry(m: mujoco.MjModel, robots: list[RobotPlan], notices: Notices)
                     ParityLine(kind="geometry", text=message, file=p.source_file, line=p.source_line)
                 )
     return fatal
-
-
-def _collides(m: mujoco.MjModel, body: int) -> bool:
-    return any(
-        int(m.geom_bodyid[g]) == body and (m.geom_contype[g] or m.geom_conaffinity[g]) for g in range(m.ngeom)
-    )
 
 
 def _geometry_mismatches(
@@ -194,7 +172,7 @@ def _geometry_mismatches(
                 )
             )
     declared = p.params.get("wheel_radius")
-    radii = [r for r in (_round_radius(m, b) for b in bodies) if r]
+    radii = [r for r in (wheel_radius(m, b, round_only=True) for b in bodies) if r]
     if declared and radii and not p.params.get("pair_radii"):
         built = float(np.mean(radii))
         if abs(built / declared - 1) > _GEOMETRY_TOLERANCE:
