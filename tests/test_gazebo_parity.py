@@ -407,6 +407,38 @@ def test_gazebo_default_topic_names(tmp_path: Path):
     assert {t.key for t in cam.topics} == {"t/r1/front_camera", "t/r1/camera_info"}
 
 
+def test_harmonic_sensors_publish_where_gz_sensors_does(tmp_path: Path):
+    """In a Gazebo Harmonic description (gz-sim systems), a sensor without <topic> publishes on gz-sensors'
+    scoped default (world, model, the link it is lumped into, sensor), and every lidar also publishes its
+    point cloud on <topic>/points, 2-D ones included. A classic description's lidar does neither."""
+    sensors = """
+  <link name="laser"/><joint name="laser_joint" type="fixed"><parent link="base_link"/><child link="laser"/>
+    <origin xyz="0.1 0 0.1"/></joint>
+  <link name="imu_link"/><joint name="imu_joint" type="fixed"><parent link="laser"/><child link="imu_link"/></joint>
+  <gazebo reference="laser">
+    <sensor name="front" type="gpu_lidar"><topic>scan</topic><update_rate>10</update_rate>
+      <lidar><scan><horizontal><samples>90</samples></horizontal></scan><range><min>0.1</min><max>5</max></range></lidar>
+    </sensor>
+    <sensor name="rear" type="gpu_lidar"><update_rate>10</update_rate>
+      <lidar><scan><horizontal><samples>90</samples></horizontal></scan><range><min>0.1</min><max>5</max></range></lidar>
+    </sensor>
+  </gazebo>
+  <gazebo reference="imu_link"><sensor name="imu" type="imu"><update_rate>50</update_rate></sensor></gazebo>"""
+    plan, _ = compile_with_notices(_write(tmp_path, diffbot(GZ_DRIVE, extra=sensors), 1.0))
+    topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in plan.robots[0].plugins}
+    scoped = "world/default/model/r1/link/base_link/sensor"  # laser and imu_link are lumped into base_link
+    assert topics["front"] == ["scan", "scan/points"], topics
+    assert topics["rear"] == [f"{scoped}/rear/scan", f"{scoped}/rear/scan/points"], topics
+    assert topics["imu"] == [f"{scoped}/imu/imu"], topics
+    _, bus = simulate(_write(tmp_path, diffbot(GZ_DRIVE, extra=sensors), 0.3))
+    clouds = messages(bus, "r1/scan/points")
+    assert clouds and clouds[-1][1].width * clouds[-1][1].height == 90
+    # the same sensors in a classic description (a gazebo_ros diff drive): no cloud, our short defaults
+    plan, _ = compile_with_notices(_write(tmp_path, diffbot(extra=sensors.replace("gpu_lidar", "ray")), 1.0))
+    topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in plan.robots[0].plugins}
+    assert topics["front"] == ["scan"] and topics["imu"] == ["imu"], topics
+
+
 def test_classic_publish_wheel_tf(tmp_path: Path):
     _, bus = simulate(_write(tmp_path, diffbot(), 0.5))
     tfs = messages(bus, "r1/tf")

@@ -241,6 +241,25 @@ class GazeboReader:
     # ------------------------------------------------------------------------------------------ read
     def read(self) -> GazeboInfo:
         self.link_names = {el.get("name") for el in self.root.findall("link")}
+        # a description for Gazebo Harmonic (gz-sim systems): its sensors publish as gz-sensors does
+        self.harmonic = any(
+            _plugin_base(el.get("filename") or "").startswith("gz-sim")
+            for gz in self.root.findall("gazebo")
+            for el in gz.iter("plugin")
+        )
+        # the Gazebo link each URDF link becomes: links joined by fixed joints are lumped into the upper one
+        upper = {
+            j.find("child").get("link"): j.find("parent").get("link")
+            for j in self.root.findall("joint")
+            if j.get("type") == "fixed" and j.find("child") is not None and j.find("parent") is not None
+        }
+        self.lumped_into: dict[str, str] = {}
+        for link in self.link_names:
+            top, seen = link, {link}
+            while top in upper and upper[top] not in seen:
+                top = upper[top]
+                seen.add(top)
+            self.lumped_into[link] = top
         self.joint_names = {el.get("name") for el in self.root.findall("joint") if el.get("type") != "fixed"}
         self.fixed_joints = {el.get("name") for el in self.root.findall("joint") if el.get("type") == "fixed"}
         for gz in self.root.findall("gazebo"):
@@ -452,12 +471,20 @@ class GazeboReader:
             if ros.get("noise"):  # gazebo_ros_block_laser adds its <gaussianNoise> to the sensor's noise
                 params["noise_stddev"] = math.hypot(params.get("noise_stddev", 0.0), ros["noise"])
             params.update(ros.get("params") or {})  # what a third-party plugin changes (velodyne)
-            self.add(el, "lidar", name, params, implicit=not (ros or base_topic))
+            if not ros and (self.harmonic or kind in ("lidar", "gpu_lidar")):
+                if not base_topic and self.harmonic:
+                    params["topic"] = self._gz_sensor_topic(link, name, "scan")
+                # gz-sensors: a lidar publishes its scan on <topic> and its point cloud on <topic>/points
+                params.setdefault("publish_points", True)
+                params["points_topic"] = _join(params["topic"], "points")
+            self.add(el, "lidar", name, params, implicit=not (ros or base_topic or self.harmonic))
         elif kind == "camera":
             params = {**common, **self._camera(r, el, context)}
             ros = self._sensor_plugins(plugins, context, ("image_raw", "image"), name, kind)
             # gz-sensors: <topic> carries the image, CameraInfo goes to <camera_info_topic> or a sibling
             image = ros.get("topic") or base_topic or "camera/image_raw"
+            if self.harmonic and not (ros or base_topic):
+                image = self._gz_sensor_topic(link, name, "image")
             params["image_topic"] = image
             info_topic = _topic(el.findtext("camera/camera_info_topic"))
             params["info_topic"] = (
@@ -465,7 +492,7 @@ class GazeboReader:
             )
             params["frame_id"] = ros.get("frame") or frame
             self._plugin_rate(params, rate, ros)
-            self.add(el, "camera", name, params, implicit=not (ros or base_topic))
+            self.add(el, "camera", name, params, implicit=not (ros or base_topic or self.harmonic))
         elif kind in ("depth", "depth_camera", "rgbd_camera", "rgbd"):
             params = {**common, **self._camera(r, el, context)}
             ros = self._sensor_plugins(plugins, context, ("image_raw", "image"), name, kind)
@@ -504,6 +531,8 @@ class GazeboReader:
             params = {**common, **self._imu(r, el, context)}
             ros = self._sensor_plugins(plugins, context, ("out", "imu"), name, kind)
             params["topic"] = ros.get("topic") or base_topic or "imu"
+            if self.harmonic and not (ros or base_topic):
+                params["topic"] = self._gz_sensor_topic(link, name, "imu")
             params["frame_id"] = ros.get("frame") or frame
             noise = ros.get("noise")
             if noise:
@@ -513,7 +542,7 @@ class GazeboReader:
                     params[key] = math.hypot(params.get(key, 0.0), noise)
                 params["orientation_stddev"] = 2.0 * noise  # a quaternion component of s is an angle of 2s
             self._plugin_rate(params, rate, ros)
-            self.add(el, "imu", name, params, implicit=not (ros or base_topic))
+            self.add(el, "imu", name, params, implicit=not (ros or base_topic or self.harmonic))
         elif kind == "contact":
             if link is None:
                 self.note(el, f"{context} outside a <gazebo reference=...> block has no link; ignored")
@@ -584,6 +613,12 @@ class GazeboReader:
             elif child.tag != "precision" and not _zero(child.text):
                 self.note(child, f"noise <{child.tag}> is ignored")
         return _NoiseSpec.of(noise)
+
+    def _gz_sensor_topic(self, link: str | None, sensor: str, leaf: str) -> str:
+        """gz-sensors' default topic of a sensor without `<topic>`: scoped by world, model, (lumped) link and
+        sensor name (the world is "default", as in our other gz-sim defaults)."""
+        gz_link = self.lumped_into.get(link or "", link or "base_link")
+        return f"world/default/model/{self.model}/link/{gz_link}/sensor/{sensor}/{leaf}"
 
     def _lidar(self, r: _Reader, el: Any, context: str) -> dict[str, Any]:
         ray = r.child("ray", "lidar")
