@@ -85,7 +85,9 @@ def test_wheel_bumper_reports_the_ground_in_world_frame(write_scenario):
     assert rolling and all(m.header.frame_id == "world" for m in rolling)
     forces = []
     for m in rolling:
-        assert [(s.collision1_name, s.collision2_name) for s in m.states] == [("r1/left_wheel_collision", "ground")]
+        assert [(s.collision1_name, s.collision2_name) for s in m.states] == [
+            ("r1/left_wheel_collision", "ground")
+        ]
         s = m.states[0]
         for normal, pos in zip(s.contact_normals, s.contact_positions, strict=True):
             assert (normal.x, normal.y, normal.z) == pytest.approx((0.0, 0.0, 1.0), abs=1e-6)
