@@ -180,7 +180,6 @@ _WHY = {
     "sensor": "sensors of world models are not simulated",
     "actor": "actors (animated people) are not simulated",
     "population": "populations are not expanded",
-    "state": "a saved world state is not applied; models start at their <pose>",
     "audio": "audio is not simulated",
     "audio_source": "audio is not simulated",
     "wind": "wind is not simulated",
@@ -228,6 +227,7 @@ class _Link:
     src: _Src
     static: bool
     model_world: _Pose  # pose of the model that holds the link (axes expressed in the model frame)
+    scale: tuple[float, float, float] = (1.0, 1.0, 1.0)  # the model's scale in the world's <state>
 
 
 @dataclass
@@ -240,6 +240,17 @@ class _Joint:
     el: etree._Element
     src: _Src
     model_world: _Pose
+
+
+@dataclass
+class _ModelState:
+    """A model in a world's `<state>` (Gazebo classic applies it when it loads the world; worlds saved
+    from the GUI keep their true poses there): world poses of the model and its links, its scale."""
+
+    pose: _Pose | None
+    scale: tuple[float, float, float] | None
+    links: dict[str, _Pose]  # scoped link key (`link`, `sub::link`) -> world pose
+    el: etree._Element
 
 
 @dataclass
@@ -287,6 +298,8 @@ class _Loader:
         self.ground_link: str | None = None
         self.missing: list[SdfError] = []  # files not found: reported together at the end
         self.result: SdfWorld | None = None
+        self.state: dict[str, _ModelState] = {}  # the world's <state>, by top-level model name
+        self.deleted: set[str] = set()  # models its <deletions> remove
 
     # ------------------------------------------------------------------------------------- notices
     def note(
@@ -435,7 +448,13 @@ class _Loader:
 
     def world(self, w: etree._Element, src: _Src, result: SdfWorld) -> None:
         result.name = w.get("name")
-        self.check(w, src, {"model", "include", "light", "physics", "gravity"})
+        self.check(w, src, {"model", "include", "light", "physics", "gravity", "state"})
+        states = w.findall("state")
+        for extra in states[1:]:
+            self.note("only the first <state> is applied", src, extra)
+        insertions: list[etree._Element] = []
+        if states:
+            insertions = self.read_state(states[0], src)
         physics = w.findall("physics")
         if physics:
             chosen = next((p for p in physics if _bool(p.get("default"))), physics[0])
@@ -453,6 +472,48 @@ class _Loader:
                 self.include(el, src, _IDENTITY, [], False, None, top=True)
             elif el.tag == "light":
                 self.light(el, src, self.spec.worldbody, _IDENTITY, "")
+        for el in insertions:
+            self.top_model(el, src, _IDENTITY, name=None, pose=None, static=None)
+        unused = [n for n in self.state if n not in result.models]
+        if unused:
+            self.note(
+                f"<state> names model(s) the world does not have: {', '.join(unused[:5])}"
+                + (" ..." if len(unused) > 5 else ""),
+                src,
+                self.state[unused[0]].el,
+            )
+
+    def read_state(self, st: etree._Element, src: _Src) -> list[etree._Element]:
+        """Reads a world's `<state>` (its models' and links' world poses, model scales, deletions) into
+        `self.state`; returns the models its `<insertions>` add. Times, velocities, accelerations, wrenches
+        and joint angles are not applied (the world starts at rest, as Gazebo's reset does)."""
+        for el in st:
+            if el.tag == "model" and el.get("name"):
+                self.state[el.get("name")] = self.model_state(el, src, "")
+            elif el.tag == "deletions":
+                self.deleted |= {(n.text or "").strip() for n in el.findall("name")}
+        ins = st.find("insertions")
+        return ins.findall("model") if ins is not None else []
+
+    def model_state(self, el: etree._Element, src: _Src, scope: str) -> _ModelState:
+        pose_el = el.find("pose")
+        scale_el = el.find("scale")
+        scale = self.floats(scale_el, src, 3) if scale_el is not None else None
+        out = _ModelState(
+            pose=self.pose(pose_el, src) if pose_el is not None else None,
+            scale=scale,  # type: ignore[arg-type]
+            links={},
+            el=el,
+        )
+        for ch in el:
+            name = ch.get("name")
+            if not name:
+                continue
+            if ch.tag == "link" and ch.find("pose") is not None:
+                out.links[scope + name] = self.pose(ch.find("pose"), src)
+            elif ch.tag == "model":  # a nested model's links, scoped as the model's links are
+                out.links.update(self.model_state(ch, src, f"{scope}{name}::").links)
+        return out
 
     def physics(self, p: etree._Element, src: _Src, result: SdfWorld) -> None:
         self.check(p, src, {"max_step_size", "real_time_factor", "gravity"})
@@ -559,6 +620,10 @@ class _Loader:
                 hint="model names must be unique in the world (and differ from robot namespaces); "
                 "give each <include> its own <name>",
             )
+        if model_name in self.deleted:
+            self.note(f"model {model_name!r} is removed by the world's <state> <deletions>", src, el)
+            return
+        state = self.state.get(model_name)
         if pose is None:
             local, rel, pel = self.pose_of(el, src)
             if rel not in (None, "world", "__model__"):
@@ -568,9 +633,41 @@ class _Loader:
                     pel,
                 )
             pose = local
+        if state is not None and state.pose is not None:
+            parent, pose = _IDENTITY, state.pose  # the saved pose is in the world frame
         collected = self.model(el, src, parent @ pose, [model_name], False, static, model_name)
+        if state is not None:
+            self.apply_state(state, collected, model_name, src)
         self.build(collected)
         self.result.models.append(model_name)
+
+    def apply_state(self, state: _ModelState, c: _Collected, model: str, src: _Src) -> None:
+        """Links where the world's <state> saved them (as Gazebo sets each link's world pose), and the
+        model's saved scale. A model with joints keeps its links where its joints hold them (its saved
+        joint angles are not applied), with a notice when the saved poses differ."""
+        moved = []
+        for link in c.links:
+            if state.scale is not None:
+                link.scale = state.scale
+            saved = state.links.get(link.key)
+            if saved is None:
+                continue
+            off = math.dist(saved.p, link.world.p) + 2 * math.acos(
+                min(1.0, abs(sum(a * b for a, b in zip(saved.q, link.world.q, strict=True))))
+            )
+            if off < 1e-6:
+                continue
+            if c.joints:
+                moved.append(link.key)
+            else:
+                link.world = saved
+        if moved:
+            self.note(
+                f"model {model!r} has joints: the poses <state> saved for its links ({', '.join(moved[:3])}) "
+                "are not applied; its links are placed from the model's saved pose",
+                src,
+                state.el,
+            )
 
     def model(
         self,
@@ -1088,28 +1185,34 @@ class _Loader:
         pose = local
         kw: dict[str, object] = {}
         G = mujoco.mjtGeom
+        # a model's saved scale (Gazebo scales each shape: box sizes and mesh axes one by one, a cylinder's
+        # radius by the larger of x and y and its length by z, a sphere's radius by the largest)
+        sx_, sy_, sz_ = link.scale
+        sr = max(sx_, sy_)
         if s.tag == "empty":
             return None
         if s.tag == "box":
             x, y, z = self.floats(self.need(s, "size", src), src, 3)
-            kw.update(type=G.mjGEOM_BOX, size=[x / 2, y / 2, z / 2])
+            kw.update(type=G.mjGEOM_BOX, size=[x * sx_ / 2, y * sy_ / 2, z * sz_ / 2])
         elif s.tag in ("cylinder", "capsule"):
-            r = self.child_float(s, "radius", src)
-            length = self.child_float(s, "length", src)
+            r = self.child_float(s, "radius", src) * sr
+            length = self.child_float(s, "length", src) * sz_
             kind = G.mjGEOM_CYLINDER if s.tag == "cylinder" else G.mjGEOM_CAPSULE
             kw.update(type=kind, size=[r, length / 2, 0])
         elif s.tag == "cone":
-            r = self.child_float(s, "radius", src)
-            length = self.child_float(s, "length", src)
+            r = self.child_float(s, "radius", src) * sr
+            length = self.child_float(s, "length", src) * sz_
             if r <= 0 or length <= 0:
                 raise self.error(
                     f"a <cone> needs a positive radius and length, found {r} and {length}", src, s
                 )
             kw.update(type=G.mjGEOM_MESH, meshname=self.cone_mesh(r, length))
         elif s.tag == "sphere":
-            kw.update(type=G.mjGEOM_SPHERE, size=[self.child_float(s, "radius", src), 0, 0])
+            radius = self.child_float(s, "radius", src) * max(link.scale)
+            kw.update(type=G.mjGEOM_SPHERE, size=[radius, 0, 0])
         elif s.tag == "ellipsoid":
-            kw.update(type=G.mjGEOM_ELLIPSOID, size=list(self.floats(self.need(s, "radii", src), src, 3)))
+            radii = self.floats(self.need(s, "radii", src), src, 3)
+            kw.update(type=G.mjGEOM_ELLIPSOID, size=[a * b for a, b in zip(radii, link.scale, strict=True)])
         elif s.tag == "plane":
             n_el = s.find("normal")
             normal = _unit(self.floats(n_el, src, 3)) if n_el is not None else (0.0, 0.0, 1.0)
@@ -1117,6 +1220,7 @@ class _Loader:
                 raise self.error("the <normal> of a plane is zero", src, n_el)
             size_el = s.find("size")
             sx, sy = self.floats(size_el, src, 2) if size_el is not None else (1.0, 1.0)
+            sx, sy = sx * sx_, sy * sy_
             pose = _Pose(local.p, _qmul(local.q, _quat_z_to(normal)))
             world = link.world @ pose
             up = _rot(world.q, (0.0, 0.0, 1.0))
@@ -1133,7 +1237,9 @@ class _Loader:
                     kw["_ground"] = role == "ground"
                 kw.update(type=_PLANE, size=[sx / 2, sy / 2, 0.05])
         elif s.tag == "mesh":
-            mesh = self.mesh(s, src, visual=visual, what=what, convex_check=link.static and not visual)
+            mesh = self.mesh(
+                s, src, visual=visual, what=what, convex_check=link.static and not visual, scaled=link.scale
+            )
             if mesh is None:
                 return None
             kw.update(type=G.mjGEOM_MESH, meshname=mesh)
@@ -1168,7 +1274,14 @@ class _Loader:
         return c
 
     def mesh(
-        self, s: etree._Element, src: _Src, *, visual: bool, what: str, convex_check: bool
+        self,
+        s: etree._Element,
+        src: _Src,
+        *,
+        visual: bool,
+        what: str,
+        convex_check: bool,
+        scaled: tuple[float, float, float] = (1.0, 1.0, 1.0),
     ) -> str | None:
         """The MuJoCo mesh of a <mesh> (None: left out). A visual's mesh that is missing or unreadable is
         a notice (the visual is left out, as Gazebo goes on); a collision's is an error, collected so that
@@ -1177,6 +1290,7 @@ class _Loader:
         uri = (uri_el.text or "").strip()
         scale_el = s.find("scale")
         scale = self.floats(scale_el, src, 3) if scale_el is not None else (1.0, 1.0, 1.0)
+        scale = tuple(a * b for a, b in zip(scale, scaled, strict=True))
         if s.find("submesh") is not None:
             self.note("<submesh> is not supported; the whole mesh is used", src, s.find("submesh"))
 
@@ -1186,10 +1300,31 @@ class _Loader:
             else:
                 self.missing.append(self.error(f"{message} ({what})", src, uri_el, hint=hint))
 
+        if any(abs(x) < 1e-12 for x in scale):
+            # Gazebo loads a mesh flattened to nothing and goes on; MuJoCo refuses it
+            self.note(
+                f"mesh {uri!r} is scaled by {' '.join(f'{x:g}' for x in scale)}: it has no volume and is "
+                f"left out ({what}), as it touches and shows nothing in Gazebo",
+                src,
+                scale_el if scale_el is not None else uri_el,
+                hint="give every axis a non-zero scale",
+            )
+            return None
         path, looked, hint = self.find_file(uri, src, "mesh")
         if path is None or not path.is_file():
             where = f"looked at {', '.join(str(p) for p in looked)}" if looked else hint
-            fail(f"mesh {uri!r} not found ({where})", hint)
+            near = _near_match(looked)
+            if near is not None:
+                hint = f"{near} differs only in letter case: file names are case-sensitive, fix the <uri>"
+            if visual:
+                fail(f"mesh {uri!r} not found ({where})", hint)
+            else:  # Gazebo logs an error and loads the model without this collision: so do we, warned
+                self.note(
+                    f"collision mesh {uri!r} not found ({where}); the collision is left out ({what})",
+                    src,
+                    uri_el,
+                    hint=hint,
+                )
             return None
         try:  # the same checks and conversions as a URDF's meshes (runner.compile.meshes)
             path = prepare_mesh(path).file
@@ -1543,16 +1678,46 @@ def _malformed(msg: str, path: Path, line: int | None) -> SdfError:
 _BEFORE_DECLARATION = re.compile(rb"^(?:\xef\xbb\xbf)?((?:\s|<!--.*?-->)+)(<\?xml\b[^>]*\?>)", re.S)
 
 
+_COMMENT = re.compile(rb"<!--(.*?)-->", re.DOTALL)
+
+
+def _blank_double_hyphens(comment: re.Match[bytes]) -> bytes:
+    inner = comment.group(1).replace(b"--", b"- ")
+    if inner.endswith(b"-"):  # `--->` ends a comment with `-`, which XML forbids too
+        inner = inner[:-1] + b" "
+    return b"<!--" + inner + b"-->"
+
+
 def _xml_bytes(path: Path) -> bytes:
     """The file's bytes; a comment (or blank lines) before `<?xml ...?>`, which XML forbids and Gazebo
-    accepts (gazebo-classic's cafe.world), is dropped, keeping every line number."""
+    accepts (gazebo-classic's cafe.world), is dropped, and `--` inside comments is blanked, keeping every
+    line number."""
     data = path.read_bytes()
+    if b"--" in data:
+        # `--` inside a comment: XML forbids it, TinyXML2 (libsdformat) accepts it (gz-sim's levels.sdf)
+        data = _COMMENT.sub(_blank_double_hyphens, data)
     m = _BEFORE_DECLARATION.match(data)
     if m:
         declaration = m.group(2)
         newlines = m.group(1).count(b"\n") + declaration.count(b"\n")
         data = declaration.replace(b"\r", b" ").replace(b"\n", b" ") + b"\n" * newlines + data[m.end() :]
     return data
+
+
+def _near_match(looked: list[Path]) -> Path | None:
+    """A file whose name differs only in letter case from one of the paths looked at (Gazebo, like the file
+    system, does not take it: a description written on a case-insensitive file system)."""
+    for path in looked:
+        try:
+            folder = path.parent
+            if not folder.is_dir():
+                continue
+            for candidate in folder.iterdir():
+                if candidate.name.lower() == path.name.lower() and candidate.name != path.name:
+                    return candidate
+        except OSError:
+            continue
+    return None
 
 
 def _custom(el: etree._Element) -> bool:
