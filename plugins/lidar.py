@@ -31,6 +31,7 @@ from pydantic import Field, PositiveFloat, PositiveInt, model_validator
 from plugins._common import MountPose, add_site, pick_link
 from plugins._drift import DriftingBias
 from runner import msgs
+from runner.compile.decompose import PIECES_GROUP, RAY_GROUP
 from runner.plugin import BuildContext, Plugin, RatedParams, Topic
 
 _EPS = 1e-4
@@ -156,11 +157,14 @@ class Lidar(Plugin):
         # Rays skip the robot's own geoms and visual-only geoms (URDF visuals are group 1, no contacts).
         skip = np.zeros(m.ngeom, dtype=bool)
         skip[ctx.robot.geom_ids] = True
-        skip |= (m.geom_contype == 0) & (m.geom_conaffinity == 0)
+        # ... but a world mesh split into convex pieces to collide is hit on its own faces (RAY_GROUP), never
+        # on its pieces (PIECES_GROUP, left out of the rays' groups)
+        skip |= (m.geom_contype == 0) & (m.geom_conaffinity == 0) & (m.geom_group != RAY_GROUP)
         self.skip = skip
         self.own = np.asarray(ctx.robot.geom_ids, dtype=np.int64)
         self.own_groups = m.geom_group[self.own].copy()
         self.geomgroup = np.array([1, 0, 1, 1, 1, 1], dtype=np.uint8)
+        self.geomgroup[PIECES_GROUP] = 0
         self.geom_group = m.geom_group  # a view, looked up once
         # Rays may stop on a geom they should pass (a visual-only geom outside the hidden group) only if
         # the world has one: otherwise the per-scan check for it is skipped.

@@ -18,6 +18,19 @@ SCENARIOS = REPO / "scenarios"
 DIFFBOT = SCENARIOS / "robots" / "diffbot.urdf.xacro"
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _own_cache(tmp_path_factory: pytest.TempPathFactory):
+    """The session's own cache folder (converted meshes, decomposed meshes), inherited by every process the
+    tests start: the user's cache is neither read nor written, and what a test finds there is its own."""
+    before = os.environ.get("XDG_CACHE_HOME")
+    os.environ["XDG_CACHE_HOME"] = str(tmp_path_factory.mktemp("cache"))
+    yield
+    if before is None:
+        os.environ.pop("XDG_CACHE_HOME", None)
+    else:
+        os.environ["XDG_CACHE_HOME"] = before
+
+
 @pytest.fixture
 def write_scenario(tmp_path: Path):
     """Write an inline scenario (dedented); `{diffbot}` is replaced by the project's robot file."""

@@ -3,6 +3,7 @@ SDF reader tripped on. SDF text written in tmp_path, compiled to real MuJoCo mod
 
 from __future__ import annotations
 
+import math
 import struct
 from pathlib import Path
 
@@ -594,16 +595,26 @@ def test_a_missing_visual_mesh_is_a_warning_a_broken_collision_mesh_an_error(tmp
     assert "git lfs pull" in (info.value.hint or "")
 
 
+# A 4 x 4 m room: four walls 0.1 m thick, 1 m high, and a 1 m doorway in the east wall; one mesh
+ROOM_T, ROOM_H = 0.1, 1.0
+ROOM = [
+    ((-2, -2, 0), (2, -2 + ROOM_T, ROOM_H)),
+    ((-2, 2 - ROOM_T, 0), (2, 2, ROOM_H)),
+    ((-2, -2 + ROOM_T, 0), (-2 + ROOM_T, 2 - ROOM_T, ROOM_H)),
+    ((2 - ROOM_T, -2 + ROOM_T, 0), (2, -0.5, ROOM_H)),
+    ((2 - ROOM_T, 0.5, 0), (2, 2 - ROOM_T, ROOM_H)),
+]
+
+
 @pytest.mark.timeout(60)
-def test_a_static_collision_mesh_far_from_convex_is_reported(tmp_path: Path) -> None:
-    t, h = 0.1, 1.0  # a 4 x 4 m room: four walls 0.1 m thick, in one mesh
-    walls = [
-        ((-2, -2, 0), (2, -2 + t, h)),
-        ((-2, 2 - t, 0), (2, 2, h)),
-        ((-2, -2 + t, 0), (-2 + t, 2 - t, h)),
-        ((2 - t, -2 + t, 0), (2, 2 - t, h)),
-    ]
-    _stl(tmp_path / "meshes" / "room.stl", walls)
+def test_a_static_collision_mesh_that_is_not_convex_collides_as_its_real_shape(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """MuJoCo collides a mesh as its convex hull: a room whose walls are one mesh would be a solid block
+    that shoves whatever is inside. Static meshes that are not convex collide as convex pieces instead,
+    said once with the count and time; the second load takes them from the cache."""
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    _stl(tmp_path / "meshes" / "room.stl", ROOM)
     _stl(tmp_path / "meshes" / "slab.stl", [((-7, -10, -0.12), (7, 10, 0))])
     _stl(tmp_path / "meshes" / "cube.stl", CUBE)
     ball = """
@@ -626,30 +637,39 @@ def test_a_static_collision_mesh_far_from_convex_is_reported(tmp_path: Path) -> 
           <model name="crate"><static>true</static><pose>5 5 0.5 0 0 0</pose><link name="link">
             <collision name="c"><geometry><mesh><uri>meshes/cube.stl</uri></mesh></geometry></collision>
           </link></model>
-          <model name="loose_room"><pose>20 0 0 0 0 0</pose><link name="link">
-            <inertial><mass>10</mass><inertia><ixx>1</ixx><iyy>1</iyy><izz>1</izz></inertia></inertial>
-            <collision name="c"><geometry><mesh><uri>meshes/room.stl</uri><scale>1 1 0.5</scale></mesh></geometry>
-            </collision>
-          </link></model>
           {ball.format(name="inside", x=0)}
           {ball.format(name="outside", x=4)}
         </world></sdf>
         """,
     )
     spec, _, notices = _load(path)
-    (notice,) = list(notices)  # the walls only: not the slab, the cube or a moving mesh
+    (notice,) = list(notices)  # the walls only: not the slab or the cube, which are convex
     assert notice.location.line == 3 and notice.location.file == path.resolve()
     assert "meshes/room.stl" in notice.message and "building/link" in notice.message
-    ratio = (4 * 4 * h) / (4 * 4 * h - (4 - 2 * t) ** 2 * h)
-    assert f"{ratio:.0f} times" in notice.message
-    assert "primitive collision shapes" in (notice.hint or "") and "convex parts" in (notice.hint or "")
-
-    # What it is about: a robot inside the room is inside the hull and is shoved (here, into the floor),
-    # while the same one outside rests on the floor.
+    assert (
+        "collides as" in notice.message
+        and "convex pieces" in notice.message
+        and "decomposed" in notice.message
+    )
+    # the ball inside the room rests on the floor as the one outside does
     model, data = _forward(spec)
     _step(model, data, 0.5)
-    assert data.xpos[model.body("outside/l").id][2] == pytest.approx(0.2, abs=0.01)
-    assert abs(data.xpos[model.body("inside/l").id][2] - 0.2) > 0.05
+    for name in ("inside", "outside"):
+        assert data.xpos[model.body(f"{name}/l").id][2] == pytest.approx(0.2, abs=0.01), name
+    # a ray (as a lidar casts it) from the room's centre meets the walls' own faces, and leaves by the door
+    geomgroup = np.array([1, 0, 1, 1, 1, 0], dtype=np.uint8)
+    gid = np.zeros(1, dtype=np.int32)
+    for direction, expected in (((0, 1, 0), 2 - ROOM_T), ((-1, 0, 0), 2 - ROOM_T), ((1, 0, 0), None)):
+        dist = mujoco.mj_ray(
+            model, data, np.array([0, 0, 0.5]), np.array(direction, float), geomgroup, 1, -1, gid
+        )
+        if expected is None:
+            assert dist < 0 or model.body(int(model.geom_bodyid[gid[0]])).name != "building/link"
+        else:
+            assert dist == pytest.approx(expected, abs=1e-6)
+    # the second load: from the cache
+    _, _, again = _load(path)
+    assert "from the cache" in next(iter(again)).message
 
 
 @pytest.mark.timeout(30)
@@ -796,3 +816,62 @@ def test_what_gazebo_loads_with_an_error_in_its_log_loads_here_with_a_located_wa
     assert "collision mesh 'meshes/wall.stl' not found" in by_line[6].message, by_line
     assert "Wall.STL differs only in letter case" in (by_line[6].hint or "")
     assert "scaled by 1 0 0: it has no volume and is left out" in by_line[7].message
+
+
+@pytest.mark.timeout(120)
+def test_a_robot_drives_out_of_a_one_mesh_room_by_its_door_and_its_lidar_sees_the_walls(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The room above as a world: the robot starts inside (not shoved out or into the floor), its lidar
+    reads the walls where they are (within 2 cm), and it drives out through the doorway."""
+    from tests.conftest import DIFFBOT
+    from tests.helpers import messages, simulate
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    _stl(tmp_path / "meshes" / "room.stl", ROOM)
+    _write(
+        tmp_path,
+        "room.world",
+        """
+        <sdf version="1.6"><world name="w">
+          <model name="building"><static>true</static><link name="link">
+            <collision name="walls"><geometry><mesh><uri>meshes/room.stl</uri></mesh></geometry></collision>
+            <visual name="walls"><geometry><mesh><uri>meshes/room.stl</uri></mesh></geometry></visual>
+          </link></model>
+        </world></sdf>
+        """,
+    )
+    scenario = _write(
+        tmp_path,
+        "s.yaml",
+        f"""
+        name: room
+        duration: 12
+        rate: max
+        world: {{sdf: room.world, ground: {{}}}}
+        robots:
+          - name: r1
+            description: {DIFFBOT}
+            pose: {{xyz: [0, 0, 0.06]}}
+            plugins:
+              - {{type: diff_drive}}
+              - {{type: lidar, params: {{link: lidar_link, samples: 360, rate: 10, range_max: 8}}}}
+              - {{type: ground_truth, params: {{rate: 10}}}}
+        timeline:
+          - {{t: 1.0, topic: r1/cmd_vel, type: geometry_msgs/msg/Twist, data: {{linear: {{x: 0.35}}}}}}
+        """,
+    )
+    _, bus = simulate(scenario)
+    scans = messages(bus, "r1/scan")
+    first = scans[0][1]  # at the start, at the room's centre: walls 1.9 m left, right and behind
+
+    def beam(scan, angle: float) -> float:
+        return float(scan.ranges[round((angle - scan.angle_min) / scan.angle_increment) % len(scan.ranges)])
+
+    for angle in (math.pi / 2, -math.pi / 2, math.pi):
+        assert beam(first, angle) == pytest.approx(2 - ROOM_T, abs=0.02), angle
+    assert beam(first, 0.0) > 2.5  # ahead: the doorway
+    truth = messages(bus, "r1/ground_truth")
+    start, end = truth[0][1].pose.pose.position, truth[-1][1].pose.pose.position
+    assert abs(start.z - end.z) < 0.02 and math.hypot(start.x, start.y) < 0.02  # it stood where it was put
+    assert end.x > 2.6 and abs(end.y) < 0.3, (end.x, end.y)  # and drove out through the door

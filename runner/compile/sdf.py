@@ -42,9 +42,9 @@ from typing import NamedTuple
 from urllib.parse import unquote
 
 import mujoco
-import numpy as np
 from lxml import etree
 
+from runner.compile.decompose import PIECES_GROUP, RAY_GROUP, decompose_file
 from runner.compile.materials import gazebo_material
 from runner.compile.meshes import MeshError, prepare_mesh
 from runner.compile.packages import URI_RE, PackageMap
@@ -287,7 +287,9 @@ class _Loader:
             "joint": {j.name for j in spec.joints if j.name},
         }
         self.meshes: dict[tuple[str, tuple[float, ...]], str] = {}
-        self.convex_checked: set[tuple[str, tuple[float, ...]]] = set()
+        # static collision meshes that are not convex: their convex pieces, by (file, scale)
+        self.decomposed: dict[tuple[str, tuple[float, ...]], list[str] | None] = {}
+        self.last_pieces: list[str] | None = None  # those of the mesh `mesh()` returned last
         # The world's ground so far: the scenario's (`world.ground`), a plane named `ground`; which part of
         # this file is the ground (label, file, line), once one is.
         planes = [g for g in spec.worldbody.geoms if g.type == _PLANE]
@@ -1083,6 +1085,15 @@ class _Loader:
         for kw in collisions + visuals:  # collisions first: they keep their plain name if a visual shares it
             if kw is not None:
                 kw["name"] = self.unique("geom", f"{link.body}/{kw['name']}")
+                pieces = kw.pop("_pieces", None)
+                if pieces:
+                    # the mesh itself stays for rays (its real faces), touching nothing; its convex pieces
+                    # collide, seen by no ray and no camera
+                    for k, mesh in enumerate(pieces):
+                        piece = {**kw, "meshname": mesh, "group": PIECES_GROUP}
+                        piece["name"] = self.unique("geom", f"{kw['name']}/piece{k}")
+                        body.add_geom(**piece)
+                    kw.update(contype=0, conaffinity=0, group=RAY_GROUP)
                 body.add_geom(**kw)
         for li in el.findall("light"):
             self.light(li, src, body, _IDENTITY, link.body + "/")
@@ -1149,9 +1160,12 @@ class _Loader:
         if g is None:
             raise self.error(f"a <{kind}> of link {link.body!r} has no <geometry>", src, el)
         what = f"{kind} {el.get('name') or kind!r} of {link.body!r}"
+        self.last_pieces = None
         kw = self.shape(g, src, link, local, visual, what)
         if kw is None:
             return None
+        if self.last_pieces and not visual:
+            kw["_pieces"] = self.last_pieces
         kw["name"] = el.get("name") or kind
         if visual:
             kw.update(contype=0, conaffinity=0, group=1, rgba=list(self.colour(el, src)))
@@ -1348,9 +1362,8 @@ class _Loader:
             self.note(f"{e}; using {alt.name} instead", src, uri_el)
             path = alt
         key = (str(path.resolve()), tuple(scale))
-        if convex_check and key not in self.convex_checked:
-            self.convex_checked.add(key)
-            self.check_convex(Path(key[0]), scale, uri, what, src, uri_el)
+        if convex_check:
+            self.last_pieces = self.pieces_of(Path(key[0]), scale, uri, what, src, uri_el)
         if key in self.meshes:
             return self.meshes[key]
         name = self.unique("mesh", f"sdf/{path.stem}")
@@ -1405,27 +1418,33 @@ class _Loader:
         )
         return None, looked, hint
 
-    def check_convex(
+    def pieces_of(
         self, path: Path, scale: tuple[float, ...], uri: str, what: str, src: _Src, at: etree._Element
-    ) -> None:
-        """A static collision mesh far from convex is a notice: MuJoCo collides with its convex hull, so
-        a building's four walls in one mesh are a solid block that swallows whatever is inside."""
-        stats = _hull_and_volume(path, scale)
-        if stats is None:
-            return
-        hull, volume = stats
-        if hull - volume < _NONCONVEX_MIN_EXCESS or hull < _NONCONVEX_RATIO * volume:
-            return
-        ratio = f"{hull / volume:.0f}" if volume > 0 else "many"
+    ) -> list[str] | None:
+        """The MuJoCo meshes of a static collision mesh's convex pieces, None when it is convex (MuJoCo
+        collides a mesh as its convex hull: a building's walls in one mesh would be a solid block). Said
+        once per mesh, with how many pieces and how long they took (`runner.compile.decompose`)."""
+        key = (str(path), tuple(scale))
+        if key in self.decomposed:
+            return self.decomposed[key]
+        found = decompose_file(path, scale)
+        if found is None or len(found.pieces) <= 1:
+            self.decomposed[key] = None
+            return None
+        names = []
+        for k, points in enumerate(found.pieces):
+            name = self.unique("mesh", f"sdf/{path.stem}/piece{k}")
+            self.spec.add_mesh(name=name, uservert=points.ravel().tolist())
+            names.append(name)
+        self.decomposed[key] = names
+        how = "from the cache" if found.cached else "decomposed"
         self.note(
-            f"collision mesh {uri!r} ({what}) is far from convex: MuJoCo collides with its convex hull, "
-            f"{ratio} times the mesh's volume ({hull:.3g} m³ against {volume:.3g} m³), so the space "
-            "it encloses is solid",
+            f"collision mesh {uri!r} ({what}) is not convex: it collides as {len(names)} convex pieces "
+            f"({found.triangles} triangles, {how} in {found.seconds:.2f} s); rays still hit its own faces",
             src,
             at,
-            hint="give the model primitive collision shapes (a <box> per wall), or split the mesh into "
-            "convex parts, one <collision> each",
         )
+        return names
 
     def colour(self, v: etree._Element, src: _Src) -> tuple[float, ...]:
         rgba: tuple[float, ...] = _GREY
@@ -1728,36 +1747,6 @@ def _custom(el: etree._Element) -> bool:
 # A static collision mesh whose convex hull exceeds its volume this many times (and by this much, m³) is
 # reported. Measured: a slab floor (aws warehouse GroundB) 1.0, ordinary rounded or slightly concave
 # shapes stay under 2; the same warehouse's four walls in one mesh (WallB) 38.
-_NONCONVEX_RATIO = 3.0
-_NONCONVEX_MIN_EXCESS = 1e-3
-
-
-def _hull_and_volume(path: Path, scale: tuple[float, ...]) -> tuple[float, float] | None:
-    """The volume of the convex hull MuJoCo makes of a mesh file, and the mesh's own (enclosed) volume;
-    None when MuJoCo cannot build it (the world's compile says why)."""
-    spec = mujoco.MjSpec()
-    spec.add_mesh(name="m", file=str(path), scale=list(scale))
-    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname="m")
-    try:
-        m = spec.compile()
-    except Exception:  # MuJoCo raises ValueError or its own errors; the world's compile reports them
-        return None
-    adr = int(m.mesh_graphadr[0])
-    if adr < 0:
-        return None
-    v = m.mesh_vert[m.mesh_vertadr[0] : m.mesh_vertadr[0] + m.mesh_vertnum[0]].astype(float)
-    faces = m.mesh_face[m.mesh_faceadr[0] : m.mesh_faceadr[0] + m.mesh_facenum[0]]
-    # mesh_graph: numvert, numface, vert_edgeadr[nv], vert_globalid[nv], edge_localid[nv + 3 nf],
-    # face_globalid[3 nf] (indexes into the mesh's vertices).
-    nv, nf = int(m.mesh_graph[adr]), int(m.mesh_graph[adr + 1])
-    start = adr + 2 + 3 * nv + 3 * nf
-    hull_faces = m.mesh_graph[start : start + 3 * nf].reshape(-1, 3)
-    return abs(_signed_volume(v, hull_faces)), abs(_signed_volume(v, faces))
-
-
-def _signed_volume(v: np.ndarray, faces: np.ndarray) -> float:
-    a, b, c = v[faces[:, 0]], v[faces[:, 1]], v[faces[:, 2]]
-    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
 
 
 _FUEL = re.compile(
