@@ -42,6 +42,7 @@ from typing import NamedTuple
 from urllib.parse import unquote
 
 import mujoco
+import numpy as np
 from lxml import etree
 
 from runner.compile.decompose import PIECES_GROUP, RAY_GROUP, decompose_file
@@ -1427,9 +1428,24 @@ class _Loader:
         key = (str(path), tuple(scale))
         if key in self.decomposed:
             return self.decomposed[key]
+        self.decomposed[key] = None
+        stats = _hull_and_volume(path, scale)
+        if stats is None:
+            return None
+        hull, volume = stats
+        if hull - volume < _NONCONVEX_MIN_EXCESS or hull < _NONCONVEX_RATIO * volume:
+            return None  # near enough to convex: its hull, as MuJoCo takes a mesh (cheap, and smooth)
         found = decompose_file(path, scale)
         if found is None or len(found.pieces) <= 1:
-            self.decomposed[key] = None
+            return None
+        if len(found.pieces) > _MAX_PIECES:
+            self.note(
+                f"collision mesh {uri!r} ({what}) is far from convex, and too curved to split "
+                f"({len(found.pieces)} pieces, more than {_MAX_PIECES}): it collides as its convex hull",
+                src,
+                at,
+                hint="give the model primitive collision shapes, or a simpler collision mesh",
+            )
             return None
         names = []
         for k, points in enumerate(found.pieces):
@@ -1747,6 +1763,41 @@ def _custom(el: etree._Element) -> bool:
 # A static collision mesh whose convex hull exceeds its volume this many times (and by this much, m³) is
 # reported. Measured: a slab floor (aws warehouse GroundB) 1.0, ordinary rounded or slightly concave
 # shapes stay under 2; the same warehouse's four walls in one mesh (WallB) 38.
+
+
+def _hull_and_volume(path: Path, scale: tuple[float, ...]) -> tuple[float, float] | None:
+    """The volume of the convex hull MuJoCo makes of a mesh file, and the mesh's own (enclosed) volume;
+    None when MuJoCo cannot build it (the world's compile says why)."""
+    spec = mujoco.MjSpec()
+    spec.add_mesh(name="m", file=str(path), scale=list(scale))
+    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname="m")
+    try:
+        m = spec.compile()
+    except Exception:  # MuJoCo raises ValueError or its own errors; the world's compile reports them
+        return None
+    adr = int(m.mesh_graphadr[0])
+    if adr < 0:
+        return None
+    v = m.mesh_vert[m.mesh_vertadr[0] : m.mesh_vertadr[0] + m.mesh_vertnum[0]].astype(float)
+    faces = m.mesh_face[m.mesh_faceadr[0] : m.mesh_faceadr[0] + m.mesh_facenum[0]]
+    # mesh_graph: numvert, numface, vert_edgeadr[nv], vert_globalid[nv], edge_localid[nv + 3 nf],
+    # face_globalid[3 nf] (indexes into the mesh's vertices).
+    nv, nf = int(m.mesh_graph[adr]), int(m.mesh_graph[adr + 1])
+    start = adr + 2 + 3 * nv + 3 * nf
+    hull_faces = m.mesh_graph[start : start + 3 * nf].reshape(-1, 3)
+    return abs(_signed_volume(v, hull_faces)), abs(_signed_volume(v, faces))
+
+
+def _signed_volume(v: np.ndarray, faces: np.ndarray) -> float:
+    a, b, c = v[faces[:, 0]], v[faces[:, 1]], v[faces[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+# A static collision mesh is split into convex pieces when its hull is this many times its volume (and
+# larger by this much), unless that takes more pieces than this (a curved, detailed mesh: its hull then)
+_NONCONVEX_RATIO = 3.0
+_NONCONVEX_MIN_EXCESS = 1e-3
+_MAX_PIECES = 5000
 
 
 _FUEL = re.compile(
