@@ -142,6 +142,27 @@ def test_collada_unit_is_applied_and_up_axis_left_alone_as_gazebo_does(tmp_path:
         assert np.allclose(world_extent(model, geom), [1.0, 0.5, 0.2], atol=1e-4)
 
 
+def test_collada_with_comments_inside_its_mesh_loads_whole_and_quietly(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """Exporters leave XML comments among a <mesh>'s children; pycollada then dropped the geometry and the
+    mesh came out "with no triangles". Gazebo's loader skips comments: so do we, with nothing printed (a
+    texture trimesh cannot load no longer prints its traceback either)."""
+    dae = (
+        box_dae((1, 0.5, 0.2))
+        .replace("<mesh>", "<mesh><!-- exported by a tool -->")
+        .replace("<vertices", "<!-- the vertices --><vertices")
+    )
+    dae = dae.replace("<library_geometries>", '<library_images><image id="bump"><init_from>missing.png'
+                      "</init_from></image></library_images><library_geometries>")  # fmt: skip
+    (tmp_path / "crate.dae").write_text(dae)
+    model, _ = compile_robot(tmp_path, ROBOT.format(visual=mesh("crate.dae"), collision=mesh("crate.dae")))
+    for geom in mesh_geoms(model).values():
+        assert np.allclose(world_extent(model, geom), [1.0, 0.5, 0.2], atol=1e-4)
+    err = capfd.readouterr().err
+    assert "Traceback" not in err and "unable to load" not in err, err
+
+
 def test_collada_unit_combines_with_the_urdf_scale(tmp_path: Path) -> None:
     (tmp_path / "mm.dae").write_text(box_dae((400, 200, 100), unit=0.001))
     urdf = ROBOT.format(visual='<mesh filename="mm.dae" scale="2 2 2"/>', collision=BOX)

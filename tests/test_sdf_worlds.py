@@ -875,3 +875,25 @@ def test_a_robot_drives_out_of_a_one_mesh_room_by_its_door_and_its_lidar_sees_th
     start, end = truth[0][1].pose.pose.position, truth[-1][1].pose.pose.position
     assert abs(start.z - end.z) < 0.02 and math.hypot(start.x, start.y) < 0.02  # it stood where it was put
     assert end.x > 2.6 and abs(end.y) < 0.3, (end.x, end.y)  # and drove out through the door
+
+
+@pytest.mark.timeout(30)
+def test_a_world_file_without_a_ground_plane_gets_none_unless_the_scenario_asks(tmp_path: Path) -> None:
+    """Gazebo adds no ground to a world that has none: a robot placed there falls. The scenario's default
+    ground is not added to such a world either (said, with how to add one), but `world.ground` still adds
+    it, and a world with its own ground plane keeps it."""
+    from tests.helpers import compile_with_notices
+
+    _write(tmp_path, "bare.world", '<sdf version="1.6"><world name="w"><model name="box"><static>true</static>'
+           '<pose>3 0 0.5 0 0 0</pose><link name="l"><collision name="c"><geometry><box><size>1 1 1</size></box>'
+           "</geometry></collision></link></model></world></sdf>\n")  # fmt: skip
+    _write(tmp_path, "floored.world", '<sdf version="1.6"><world name="w"><include><uri>model://ground_plane'
+           "</uri></include></world></sdf>\n")  # fmt: skip
+    for world, extra, ground in (("bare", "", False), ("bare", ", ground: {}", True), ("floored", "", True)):
+        path = _write(tmp_path, "s.yaml", f"name: s\nduration: 1\nworld: {{sdf: {world}.world{extra}}}\n")
+        plan, text = compile_with_notices(path)
+        model = mujoco.MjModel.from_xml_string(plan.mjcf)
+        planes = [g for g in range(model.ngeom) if model.geom_type[g] == PLANE]
+        assert len(planes) == (1 if ground else 0), (world, extra)
+        said = "the world file has no ground plane: none is added, as in Gazebo" in text
+        assert said == (world == "bare" and not ground), text

@@ -525,6 +525,17 @@ def _load_sdf(
                 Problem("while loading the world file", doc.locate(("world", "sdf")), ("world", "sdf")),
             ]
         ) from None
+    if sdf.name is not None and not sdf.has_ground and "ground" not in sc.world.model_fields_set:
+        ground = spec.geom("ground")
+        if ground is not None:
+            # Gazebo adds no ground a world file does not have (its robots would fall): neither do we
+            spec.delete(ground)
+            notices.add(
+                "the world file has no ground plane: none is added, as in Gazebo",
+                path,
+                None,
+                hint="set `world: {ground: {}}` in the scenario to add one",
+            )
     explicit = sc.world.physics.model_fields_set  # the scenario's own values win over the file's
     if sdf.timestep and "timestep" not in explicit:
         spec.option.timestep = sdf.timestep

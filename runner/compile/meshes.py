@@ -19,9 +19,14 @@ cannot collide with; what to do about that is the caller's choice (a visual or a
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import io
+import logging
 import math
 import os
+import re
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,7 +34,7 @@ import numpy as np
 
 # Bumped whenever the conversion changes what it writes (v2: COLLADA units, ASCII STL, OBJ for big meshes),
 # so that files converted by an older version are not reused.
-_RECIPE = "v2"
+_RECIPE = "v3"  # v3: COLLADA comments stripped before loading
 MAX_STL_TRIANGLES = 200_000  # MuJoCo's STL reader refuses more
 _LFS_POINTER = b"version https://git-lfs.github.com/spec/v1"
 _STL_RECORD = np.dtype([("normal", "<f4", (3,)), ("v", "<f4", (3, 3)), ("attr", "<u2")])
@@ -96,6 +101,33 @@ def prepare_mesh(path: Path) -> PreparedMesh:
         prepared = _convert(path, data)
     _MEMO[memo_key] = prepared
     return prepared
+
+
+_XML_COMMENT = re.compile(rb"<!--.*?-->", re.DOTALL)
+
+
+@contextlib.contextmanager
+def _trimesh_log() -> Iterator[list[str]]:
+    """trimesh's own log while it loads (it logs what it cannot load, with tracebacks, e.g. "unable to load
+    bumpmap", and goes on): kept off the user's terminal, its errors given back to explain an empty mesh."""
+    found: list[str] = []
+
+    class Keep(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            if record.levelno >= logging.ERROR or "unable to load" in record.getMessage().lower():
+                found.append(record.getMessage().splitlines()[0][:200])
+
+    log = logging.getLogger("trimesh")
+    handler, level, propagate = Keep(), log.level, log.propagate
+    log.addHandler(handler)
+    log.setLevel(logging.WARNING)
+    log.propagate = False
+    try:
+        yield found
+    finally:
+        log.removeHandler(handler)
+        log.setLevel(level)
+        log.propagate = propagate
 
 
 def _error(path: Path, reason: str, hint: str | None = None) -> MeshError:
@@ -244,7 +276,18 @@ def _convert(path: Path, data: bytes) -> PreparedMesh:
             return prepare_mesh(cached) if ext == ".stl" else _obj(cached, cached.read_bytes())
     what = "ASCII STL" if suffix == ".stl" else suffix or "this format"
     try:
-        loaded = trimesh.load(path, file_type=suffix.lstrip(".") or None, force="mesh")
+        with _trimesh_log() as logged:
+            if suffix == ".dae":
+                # an XML comment among a <mesh>'s children makes pycollada drop the whole geometry
+                # (trimesh logs it and goes on): comments are taken out first
+                loaded = trimesh.load(
+                    io.BytesIO(_XML_COMMENT.sub(b"", data)),
+                    file_type="dae",
+                    force="mesh",
+                    resolver=trimesh.resolvers.FilePathResolver(str(path)),
+                )
+            else:
+                loaded = trimesh.load(path, file_type=suffix.lstrip(".") or None, force="mesh")
         if suffix == ".dae":
             unit = _collada_unit(path)
             if unit != 1.0:
@@ -260,9 +303,10 @@ def _convert(path: Path, data: bytes) -> PreparedMesh:
         error.converting = True
         raise error from None
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
+        why = f" ({logged[0]})" if logged else ""
         raise _error(
             path,
-            "the mesh has no triangles (nothing to draw or collide with)",
+            f"the mesh has no triangles (nothing to draw or collide with){why}",
             hint="export the mesh again; lines and points are not meshes",
         )
     ext = ".stl" if len(loaded.faces) <= MAX_STL_TRIANGLES else ".obj"

@@ -85,6 +85,7 @@ class SdfWorld:
     free_bodies: list[str] = field(default_factory=list)  # bodies that were given a free joint
     ground: bool = False  # this file added the ground plane (geom `ground`)
     ground_model: str | None = None  # the file's own ground plane (its link) that became the ground geom
+    has_ground: bool = False  # the file has a ground plane (model://ground_plane or a plane at z=0)
 
 
 # ------------------------------------------------------------------------------------------- small maths
@@ -447,6 +448,7 @@ class _Loader:
                 elif el.tag == "light":
                     self.light(el, src, self.spec.worldbody, _IDENTITY, "")
         self.stack.pop()
+        result.has_ground = self.ground_owner is not None
         return result
 
     def world(self, w: etree._Element, src: _Src, result: SdfWorld) -> None:
