@@ -711,10 +711,15 @@ def render(
         raise _fail(RunError(f"{mcap}: file not found"))
     try:
         rec = replay.load(mcap, world)
+        notes: list[str] = []
         with _progress_bar("rendering") as bar:
-            n = replay.write(rec, output, camera=camera, width=w, height=h, fps=fps, progress=bar)
+            n = replay.write(
+                rec, output, camera=camera, width=w, height=h, fps=fps, progress=bar, notes=notes
+            )
     except RunError as e:
         raise _fail(e) from None
+    for note in notes:
+        err.print(f"note: {note}", markup=False, style="yellow")
     out.print(f"{output}: {n} frames, {rec.times[-1] / 1e9:.1f} s sim, camera {camera}", markup=False)
 
 

@@ -92,37 +92,57 @@ def _robots(m: mujoco.MjModel, names: set[str] | None = None) -> list[tuple[str,
     return out
 
 
-def _framing(m: mujoco.MjModel, d: mujoco.MjData, rec: Recording) -> tuple[np.ndarray, float]:
+# What the overview frames: everything within this many metres of what moves (robots and the bodies that
+# move), or within this many times what moves spans, whichever is larger; farther geoms are left out.
+_FRAME_REACH_M = 100.0
+_FRAME_REACH_SPANS = 20.0
+
+
+def _framing(m: mujoco.MjModel, d: mujoco.MjData, rec: Recording) -> tuple[np.ndarray, float, list[str]]:
     """Centre and size of what is worth seeing: every geom but the (infinite) ground planes, at the start,
-    and where the bodies go over the run."""
-    points = []
+    and where the bodies go over the run; and the models left out because they lie far beyond all that
+    moves (a world model posed hundreds of kilometres away would shrink the rest to nothing)."""
     mujoco.mj_kinematics(m, d)
     corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
-    for g in range(m.ngeom):
-        if int(m.geom_type[g]) != int(mujoco.mjtGeom.mjGEOM_PLANE):
-            center, half = m.geom_aabb[g][:3], m.geom_aabb[g][3:]
-            rot = d.geom_xmat[g].reshape(3, 3)
-            points += list(d.geom_xpos[g] + (center + corners * half) @ rot.T)
+
+    def box(g: int) -> list[np.ndarray]:
+        center, half = m.geom_aabb[g][:3], m.geom_aabb[g][3:]
+        return list(d.geom_xpos[g] + (center + corners * half) @ d.geom_xmat[g].reshape(3, 3).T)
+
+    solid = [g for g in range(m.ngeom) if int(m.geom_type[g]) != int(mujoco.mjtGeom.mjGEOM_PLANE)]
     # geoms of bodies that can move (their root body has joints), seen whole wherever they go: a box
     # pushed to the edge stays in the picture
-    moving = [
-        g
-        for g in range(m.ngeom)
-        if int(m.body_jntnum[int(m.body_rootid[int(m.geom_bodyid[g])])]) > 0
-        and int(m.geom_type[g]) != int(mujoco.mjtGeom.mjGEOM_PLANE)
-    ]
+    moving = [g for g in solid if int(m.body_jntnum[int(m.body_rootid[int(m.geom_bodyid[g])])]) > 0]
+    still = {g: box(g) for g in solid if g not in moving}
+    travelled: list[np.ndarray] = []
     for state in [*rec.states[:: max(1, len(rec.states) // 50)], rec.states[-1]]:
         d.qpos[:] = state[: m.nq]
         mujoco.mj_kinematics(m, d)
-        points += list(d.xpos[1:])
+        travelled += [d.xpos[b].copy() for b in range(1, m.nbody) if m.body_jntnum[int(m.body_rootid[b])] > 0]
         for g in moving:
-            center, half = m.geom_aabb[g][:3], m.geom_aabb[g][3:]
-            points += list(d.geom_xpos[g] + (center + corners * half) @ d.geom_xmat[g].reshape(3, 3).T)
+            travelled += box(g)
+    left_out: list[str] = []
+    points = list(travelled)
+    if travelled:
+        ref = np.array(travelled)
+        lo, hi = ref.min(axis=0), ref.max(axis=0)
+        centre, reach = (lo + hi) / 2, max(_FRAME_REACH_M, _FRAME_REACH_SPANS * float(np.max(hi - lo)))
+        for g, pts in still.items():
+            if np.linalg.norm(d.geom_xpos[g] - centre) > reach:
+                root = int(m.body_rootid[int(m.geom_bodyid[g])])
+                # a scenario's world model is a geom of the world body; an SDF model, bodies `<model>/...`
+                name = (m.body(root).name if root else m.geom(g).name or "a world geom").split("/")[0]
+                if name not in left_out:
+                    left_out.append(name)
+                continue
+            points += pts
+    else:
+        points = [p for pts in still.values() for p in pts]
     if not points:
-        return np.array(m.stat.center), 2.0 * float(m.stat.extent)
+        return np.array(m.stat.center), 2.0 * float(m.stat.extent), left_out
     pts = np.array(points)
     lo, hi = pts.min(axis=0), pts.max(axis=0)
-    return (lo + hi) / 2, float(max(hi[0] - lo[0], hi[1] - lo[1], 1.0))
+    return (lo + hi) / 2, float(max(hi[0] - lo[0], hi[1] - lo[1], 1.0)), left_out
 
 
 def frames(
@@ -133,8 +153,10 @@ def frames(
     height: int = 480,
     fps: float = 15.0,
     last_only: bool = False,
+    notes: list[str] | None = None,
 ) -> Iterator[np.ndarray]:
-    """RGB frames of the recording, one every 1/fps sim seconds (or only the last, paths complete)."""
+    """RGB frames of the recording, one every 1/fps sim seconds (or only the last, paths complete);
+    `notes` receives what the viewer should know (models left out of the overview)."""
     m = mujoco.MjModel.from_xml_string(rec.mjcf)
     d = mujoco.MjData(m)
     m.vis.global_.offwidth = max(int(m.vis.global_.offwidth), width)
@@ -142,7 +164,17 @@ def frames(
     robots = _robots(m, rec.robots)
     cam = mujoco.MjvCamera()
     if camera == "overview":
-        center, span = _framing(m, d, rec)
+        center, span, left_out = _framing(m, d, rec)
+        if left_out:
+            # MuJoCo scales its clipping planes and lights with the model's extent: the far model's would
+            # put the near plane kilometres away
+            m.stat.extent, m.stat.center = max(span, 1.0), center
+        if left_out and notes is not None:
+            notes.append(
+                f"the overview leaves out {', '.join(left_out[:5])}{' ...' if len(left_out) > 5 else ''}: "
+                f"farther than {_FRAME_REACH_M:g} m (or {_FRAME_REACH_SPANS:g} times their spread) from "
+                "the robots and all that moves"
+            )
         # the shadow map must cover what is framed, or its edge speckles the floor (shadow acne)
         extent = max(float(m.stat.extent), 1e-6)
         m.vis.map.shadowclip = max(float(m.vis.map.shadowclip), max(25.0, 3.0 * span) / extent)
@@ -211,14 +243,17 @@ def write(
     height: int = 480,
     fps: float = 15.0,
     progress: Callable[[int, int], None] | None = None,
+    notes: list[str] | None = None,
 ) -> int:
-    """Render `rec` into `out` (.mp4, .gif, .png); returns the number of frames."""
+    """Render `rec` into `out` (.mp4, .gif, .png); returns the number of frames (`notes`: see `frames`)."""
     suffix = out.suffix.lower()
     if suffix not in (".mp4", ".gif", ".png"):
         raise RunError(f"{out}: write .mp4, .gif or .png")
     total = 1 if suffix == ".png" else len(range(0, rec.times[-1] + 1, round(1e9 / fps)))
     out.parent.mkdir(parents=True, exist_ok=True)
-    images = frames(rec, camera=camera, width=width, height=height, fps=fps, last_only=suffix == ".png")
+    images = frames(
+        rec, camera=camera, width=width, height=height, fps=fps, last_only=suffix == ".png", notes=notes
+    )
     count = 0
     if suffix == ".mp4":
         import imageio_ffmpeg

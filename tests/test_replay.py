@@ -137,3 +137,30 @@ def test_a_small_worlds_floor_has_no_shadow_speckles(write_scenario, tmp_path: P
     neighbours = np.minimum.reduce([a[:-2, 1:-1], a[2:, 1:-1], a[1:-1, :-2], a[1:-1, 2:]])
     speckles = int((neighbours - c > 25).sum())  # a pixel much darker than all four of its neighbours
     assert speckles < 50, speckles  # (was 1385)
+
+
+@pytest.mark.timeout(120)
+def test_a_model_far_away_is_left_out_of_the_overview_and_said(tmp_path: Path) -> None:
+    """A world model posed 343 km away (a stray pose in a public world) framed with the rest would shrink
+    the robots to nothing: the overview frames what is near the robots, and says what it left out."""
+    from PIL import Image
+
+    from tests.conftest import DIFFBOT
+
+    scenario = tmp_path / "far.yaml"
+    scenario.write_text(
+        "name: far\nduration: 1\nworld:\n  models:\n"
+        "    - {name: stray, shape: box, size: [1, 1, 1], pose: {xyz: [343000, 0, 0.5]}}\n"
+        "    - {name: crate, shape: box, size: [0.5, 0.5, 0.5], pose: {xyz: [2, 0, 0.25]}}\n"
+        f"robots:\n  - {{name: r1, description: '{DIFFBOT}', pose: {{xyz: [0, 0, 0.06]}}}}\n"
+    )
+    mcap = tmp_path / "far.mcap"
+    r = run_cli("run", str(scenario), "--no-judge", "-q", "--record", str(mcap), timeout=100)
+    assert r.returncode == 0, r.stderr
+    png = tmp_path / "far.png"
+    r = run_cli("render", str(mcap), "-o", str(png), timeout=100)
+    assert r.returncode == 0, r.stderr
+    assert "the overview leaves out stray" in r.stderr, r.stderr
+    with Image.open(png) as img:
+        red, _ = _robot_pixels(np.asarray(img.convert("RGB")))
+    assert red > 100, red  # the robot is seen, not a dot in a grey field
