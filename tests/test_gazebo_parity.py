@@ -524,6 +524,62 @@ def test_a_wheel_joint_moving_a_hub_with_the_tyre_fixed_to_it(tmp_path: Path):
     assert abs(np.linalg.norm(_at(t, pose, 6.0)[:2] - _at(t, pose, 0.5)[:2]) - 1.0) < 0.05
 
 
+ROS2_CONTROL = """
+  <gazebo>
+    <plugin filename="libgz_ros2_control-system.so" name="gz_ros2_control::GazeboSimROS2ControlPlugin">
+      <parameters>{yaml}</parameters>
+    </plugin>
+  </gazebo>"""
+
+CONTROLLERS = """
+/**:
+  controller_manager:
+    ros__parameters:
+      update_rate: 100
+      joint_state_broadcaster: {type: joint_state_broadcaster/JointStateBroadcaster}
+      base_controller: {type: diff_drive_controller/DiffDriveController}
+      gripper_controller: {type: position_controllers/GripperActionController}
+  base_controller:
+    ros__parameters:
+      left_wheel_names: [left_wheel_joint]
+      right_wheel_names: [right_wheel_joint]
+      wheel_separation: 0.34
+      wheel_radius: 0.05
+      publish_rate: 25.0
+      use_stamped_vel: false
+      cmd_vel_timeout: 0.5
+"""
+
+
+@pytest.mark.timeout(60)
+def test_a_ros2_control_diff_drive_runs_from_its_controllers_file(tmp_path: Path):
+    """gz_ros2_control names its controllers file in <parameters>: its DiffDriveController runs as in
+    Gazebo (`<name>/cmd_vel_unstamped` in, `<name>/odom` out, stopping 0.5 s after the last command) and
+    its joint state broadcaster publishes `joint_states`; a controller we do not run is said."""
+    (tmp_path / "control.yaml").write_text(CONTROLLERS)
+    urdf = diffbot(ROS2_CONTROL.format(yaml=tmp_path / "control.yaml"))
+    timeline = "".join(
+        _cmd(round(0.5 + 0.2 * k, 1), "base_controller/cmd_vel_unstamped", lin=0.2) for k in range(26)
+    )
+    path = _write(tmp_path, urdf, 7.0, timeline)
+    plan, text = compile_with_notices(path)
+    topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in plan.robots[0].plugins}
+    assert topics["base_controller"] == ["base_controller/cmd_vel_unstamped", "base_controller/odom", "tf"]
+    assert topics["joint_state_broadcaster"] == ["joint_states"]
+    assert (
+        "ros2_control controller 'gripper_controller' (position_controllers/GripperActionController) is not run"
+        in text
+    )
+    _, bus = simulate(path)
+    t, pose, _ = _truth(bus)
+    # commands from 0.5 s to 5.5 s, then none: it stops 0.5 s later (cmd_vel_timeout), having gone ~1.1 m
+    moved = float(np.linalg.norm(_at(t, pose, 7.0)[:2] - _at(t, pose, 0.5)[:2]))
+    assert abs(moved - 1.1) < 0.06, moved
+    assert float(np.linalg.norm(_at(t, pose, 7.0)[:2] - _at(t, pose, 6.3)[:2])) < 0.01  # stopped
+    odom = messages(bus, "r1/base_controller/odom")
+    assert 6.5 * 25 <= len(odom) <= 7.0 * 25 + 1
+
+
 # --------------------------------------------------------------------------------------- 8. skid steer
 SKID_DRIVE = """
 <plugin name="skid" filename="libgazebo_ros_skid_steer_drive.so">

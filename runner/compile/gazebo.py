@@ -1382,14 +1382,130 @@ def _odometry_publisher(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> t
 
 
 def _ros_control(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> None:
+    """gazebo_ros_control (ROS 1): its controllers come from parameters a launch file loads, which the
+    description does not name. gz_ros2_control / gazebo_ros2_control (ROS 2): `<parameters>` names the
+    controllers file, whose diff drive and joint state broadcaster are run as Gazebo runs them."""
+    r.mark(*[c.tag for c in r.el if isinstance(c.tag, str)])
+    files = [e for e in r.children("parameters") if (e.text or "").strip().endswith((".yaml", ".yml"))]
+    ran = sum(_ros2_controllers(g, r.el, e) for e in files)
+    if ran:
+        return None
     g.note(
         r.el,
-        f"{r.el.get('filename')!r}: ros_control controllers are not run; transmissions became MuJoCo "
-        "actuators",
-        hint="command joints with a `joint_controller` plugin in the scenario",
+        f"{r.el.get('filename')!r}: ros_control controllers are not run"
+        + (" (no diff drive or joint state broadcaster in its <parameters>)" if files else "")
+        + "; transmissions became MuJoCo actuators",
+        hint="command joints with a `joint_controller` plugin in the scenario, or give the robot a "
+        "`diff_drive` plugin with the controller's wheels and topics",
     )
-    r.mark(*[c.tag for c in r.el if isinstance(c.tag, str)])
     return None
+
+
+def _ros_parameters(doc: Any, path: tuple[str, ...] = ()) -> dict[str, dict[str, Any]]:
+    """Node name -> its `ros__parameters` in a ROS 2 parameters file (under `/**`, namespaces, or plain)."""
+    out: dict[str, dict[str, Any]] = {}
+    if not isinstance(doc, dict):
+        return out
+    for key, value in doc.items():
+        if key == "ros__parameters" and isinstance(value, dict) and path:
+            out[path[-1].strip("/").split("/")[-1]] = value
+        elif isinstance(value, dict):
+            out.update(_ros_parameters(value, (*path, str(key))))
+    return out
+
+
+def _param(params: dict[str, Any], dotted: str) -> Any:
+    """A parameter written `a.b.c: v` or nested (`a: {b: {c: v}}`)."""
+    if dotted in params:
+        return params[dotted]
+    node: Any = params
+    for part in dotted.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return None
+        node = node[part]
+    return node
+
+
+def _ros2_controllers(g: GazeboReader, plugin: Any, el: Any) -> int:
+    """The diff drive controllers and joint state broadcasters of a ros2_control parameters file, as our
+    drive and joint state plugins; returns how many. Other controllers are said, with their type."""
+    import yaml
+
+    where = el
+    path = Path((el.text or "").strip())
+    if not path.is_absolute():
+        base = g.where(el)[0]
+        path = (base.parent if base else Path.cwd()) / path
+    try:
+        doc = yaml.safe_load(path.read_text())
+    except (OSError, yaml.YAMLError) as e:
+        g.note(
+            where, f"ros2_control parameters {str(path)!r} cannot be read ({e}); its controllers are not run"
+        )
+        return 0
+    nodes = _ros_parameters(doc)
+    manager = nodes.get("controller_manager", {})
+    update_rate = manager.get("update_rate")
+    count = 0
+    for name, spec in manager.items():
+        if not isinstance(spec, dict) or "type" not in spec:
+            continue
+        kind, params = str(spec["type"]), nodes.get(name, {})
+        if kind.endswith("DiffDriveController"):
+            g.add(plugin, *_ros2_diff_drive(g, name, params, update_rate, where))
+            count += 1
+        elif kind.endswith(("JointStateBroadcaster", "JointStateController")):
+            joints = params.get("joints") or None
+            g.add(
+                plugin, "joint_states", name, {"topic": "joint_states", "joints": joints, "rate": update_rate}
+            )
+            count += 1
+        else:
+            g.note(where, f"ros2_control controller {name!r} ({kind}) is not run")
+    return count
+
+
+def _ros2_diff_drive(
+    g: GazeboReader, name: str, p: dict[str, Any], update_rate: Any, where: Any
+) -> tuple[str, str, dict[str, Any]]:
+    """diff_drive_controller/DiffDriveController as it runs in ROS 2 (Humble to Jazzy): `<name>/cmd_vel`
+    (TwistStamped) or, with `use_stamped_vel: false`, `<name>/cmd_vel_unstamped` (Twist); odometry on
+    `<name>/odom`, the odom -> base transform on `/tf` when `enable_odom_tf`."""
+    lefts = [str(j) for j in (_param(p, "left_wheel_names") or [])]
+    rights = [str(j) for j in (_param(p, "right_wheel_names") or [])]
+    sep, radius = _param(p, "wheel_separation"), _param(p, "wheel_radius")
+    sep = float(sep) * float(_param(p, "wheel_separation_multiplier") or 1.0) if sep else None
+    radius = float(radius) * float(_param(p, "left_wheel_radius_multiplier") or 1.0) if radius else None
+    stamped = _param(p, "use_stamped_vel")
+    if stamped is not False:
+        g.note(
+            where,
+            f"ros2_control diff drive {name!r} takes geometry_msgs/TwistStamped on {name}/cmd_vel; here it "
+            "takes geometry_msgs/Twist there",
+            hint="set use_stamped_vel: false in the controllers file to have it as Gazebo then has it "
+            f"({name}/cmd_vel_unstamped, Twist)",
+        )
+    params: dict[str, Any] = {
+        "wheel_separation": sep,
+        "wheel_radius": radius,
+        "rate": float(_param(p, "publish_rate") or 50.0),
+        "cmd_topic": f"{name}/cmd_vel" if stamped is not False else f"{name}/cmd_vel_unstamped",
+        "odom_topic": f"{name}/odom",
+        "tf_topic": "tf",
+        "publish_tf": _param(p, "enable_odom_tf") is not False,
+        "odom_frame": _param(p, "odom_frame_id") or "odom",
+        "base_frame": g.frame(_param(p, "base_frame_id") or "base_link"),
+        "cmd_timeout": float(_param(p, "cmd_vel_timeout") or 0.5),
+    }
+    accel = _param(p, "linear.x.max_acceleration")
+    if accel and radius and _param(p, "linear.x.has_acceleration_limits"):
+        params["max_wheel_acceleration"] = float(accel) / radius
+    if len(lefts) > 1 or len(rights) > 1:
+        params["left_joints"], params["right_joints"] = lefts, rights
+        return "skid_steer", name, params
+    params["left_joint"] = lefts[0] if lefts else None
+    params["right_joint"] = rights[0] if rights else None
+    return "diff_drive", name, params
 
 
 # The parameters the real Gazebo plugins read (classic ROS 1 and ROS 2 spellings, gz-sim systems): anything
