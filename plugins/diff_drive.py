@@ -44,6 +44,15 @@ class WheelDriveParams(BaseDriveParams):
     wheel_radius: PositiveFloat | None = Field(
         None, description="Wheel radius, metres (default: from the wheel's collision geometry)."
     )
+    wheel_separation_multiplier: PositiveFloat = Field(
+        1.0,
+        description="Factor on the wheel separation, given or measured (diff_drive_controller's "
+        "wheel_separation_multiplier): the wheels are driven as for a robot this much wider, as for skid "
+        "steers that turn less than their geometry says.",
+    )
+    wheel_radius_multiplier: PositiveFloat = Field(
+        1.0, description="Factor on the wheel radius, given or measured (diff_drive_controller's)."
+    )
     max_wheel_torque: PositiveFloat = Field(20.0, description="Torque limit of each wheel, N·m.")
     max_wheel_acceleration: float = Field(
         0.0, ge=0, description="Wheel acceleration limit, rad/s² (0: none)."
@@ -153,8 +162,12 @@ class WheelDrive(Plugin):
         wheel_bodies = [int(m.jnt_bodyid[j]) for j in joints]
         left_centre = np.mean([d.xpos[b] for b in wheel_bodies[: self.nleft]], axis=0)
         right_centre = np.mean([d.xpos[b] for b in wheel_bodies[self.nleft :]], axis=0)
-        self.sep = p.wheel_separation or float(np.linalg.norm(left_centre - right_centre))
-        self.radius = p.wheel_radius or float(np.mean([_wheel_radius(m, b) for b in wheel_bodies]))
+        self.sep = p.wheel_separation_multiplier * (
+            p.wheel_separation or float(np.linalg.norm(left_centre - right_centre))
+        )
+        self.radius = p.wheel_radius_multiplier * (
+            p.wheel_radius or float(np.mean([_wheel_radius(m, b) for b in wheel_bodies]))
+        )
         self.base = r.root_body
         if p.gain is None:
             for a, wheel in zip(self.act, wheel_bodies, strict=True):

@@ -209,6 +209,12 @@ class Robot(Strict):
     plugins_from_description: bool = Field(
         True, description="Use the plugins and sensors declared in the description's <gazebo> tags."
     )
+    controllers: list[str] = Field(
+        default_factory=list,
+        description="ros_control / ros2_control controllers files (the YAML a launch file loads for "
+        "gazebo_ros_control), relative to the scenario: their diff drive and joint state controllers run "
+        "as in Gazebo (`<controller>/cmd_vel`, `<controller>/odom`, `joint_states`).",
+    )
 
     @property
     def ns(self) -> str:

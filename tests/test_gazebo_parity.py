@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from runner.errors import ScenarioError
 from runner.geometry import quat_to_yaw
 from tests.helpers import compile_with_notices, messages, plan_of, simulate
 
@@ -567,7 +568,7 @@ def test_a_ros2_control_diff_drive_runs_from_its_controllers_file(tmp_path: Path
     assert topics["base_controller"] == ["base_controller/cmd_vel_unstamped", "base_controller/odom", "tf"]
     assert topics["joint_state_broadcaster"] == ["joint_states"]
     assert (
-        "ros2_control controller 'gripper_controller' (position_controllers/GripperActionController) is not run"
+        "ros_control controller 'gripper_controller' (position_controllers/GripperActionController) is not run"
         in text
     )
     _, bus = simulate(path)
@@ -578,6 +579,55 @@ def test_a_ros2_control_diff_drive_runs_from_its_controllers_file(tmp_path: Path
     assert float(np.linalg.norm(_at(t, pose, 7.0)[:2] - _at(t, pose, 6.3)[:2])) < 0.01  # stopped
     odom = messages(bus, "r1/base_controller/odom")
     assert 6.5 * 25 <= len(odom) <= 7.0 * 25 + 1
+
+
+ROS1_CONTROL = """
+  <gazebo><plugin name="gazebo_ros_control" filename="libgazebo_ros_control.so"/></gazebo>"""
+
+ROS1_CONTROLLERS = """
+joint_publisher:
+  type: "joint_state_controller/JointStateController"
+  publish_rate: 20
+velocity_controller:
+  type: "diff_drive_controller/DiffDriveController"
+  left_wheel: ['left_wheel_joint']
+  right_wheel: right_wheel_joint
+  publish_rate: 25
+  cmd_vel_timeout: 0.25
+  enable_odom_tf: false
+  wheel_separation_multiplier: 1.5
+"""
+
+
+@pytest.mark.timeout(60)
+def test_ros1_gazebo_ros_control_runs_the_controllers_file_the_scenario_names(tmp_path: Path):
+    """A ROS 1 robot's diff_drive_controller comes from a YAML file its launch file loads: the scenario
+    names it (`controllers:`) and it runs as in Gazebo: `<name>/cmd_vel`, `<name>/odom`, no TF when
+    `enable_odom_tf: false`, separation measured from the URDF times its multiplier (1.5: the wheels are
+    driven for a wider robot, which turns at 1.5 times the command where wheels do not scrub), stopping `cmd_vel_timeout` after the last command. A file that is not there is
+    an error at its line."""
+    (tmp_path / "control.yaml").write_text(ROS1_CONTROLLERS)
+    urdf = diffbot(ROS1_CONTROL)
+    timeline = "".join(
+        _cmd(round(0.5 + 0.1 * k, 1), "velocity_controller/cmd_vel", ang=0.5) for k in range(30)
+    )
+    path = _write(tmp_path, urdf, 4.0, timeline)
+    text = path.read_text().replace("    plugins: [", "    controllers: [control.yaml]\n    plugins: [")
+    path.write_text(text)
+    plan, said = compile_with_notices(path)
+    assert "controllers are not run" not in said, said
+    topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in plan.robots[0].plugins}
+    assert topics["velocity_controller"] == ["velocity_controller/cmd_vel", "velocity_controller/odom"]
+    assert topics["joint_publisher"] == ["joint_states"]
+    _, bus = simulate(path)
+    t, pose, _ = _truth(bus)
+    turned = float(_at(t, pose, 4.0)[3] - _at(t, pose, 0.5)[3])
+    # 0.5 rad/s for 3.0 s (+ the 0.25 s timeout), at 1.5 times the command: ~2.44 rad
+    assert abs(turned - 0.5 * 3.25 * 1.5) < 0.15, turned
+    path.write_text(text.replace("[control.yaml]", "[nowhere.yaml]"))
+    with pytest.raises(ScenarioError) as err:
+        plan_of(path)
+    assert "controllers file not found" in str(err.value) and "robots[0].controllers[0]" in str(err.value)
 
 
 # --------------------------------------------------------------------------------------- 8. skid steer

@@ -602,6 +602,21 @@ def _robot_model(
                 found=str(path),
             )
         )
+    controllers = []
+    for k, name in enumerate(robot.controllers):
+        where: PathKey = ("robots", i, "controllers", k)
+        found = doc.base_dir / name
+        if not found.is_file():
+            raise ScenarioError(
+                Problem(
+                    "controllers file not found",
+                    doc.locate(where),
+                    where,
+                    expected="a ros_control YAML file (relative to the scenario's folder)",
+                    found=str(found),
+                )
+            )
+        controllers.append(found)
     try:
         if path.suffix == ".xacro" or _looks_like_xacro(path):
             args = {k: _xacro_str(v) for k, v in robot.desc.args.items()}
@@ -617,6 +632,7 @@ def _robot_model(
                 sources=result.sources,
                 expanded=True,
                 timestep=timestep,
+                controllers=controllers,
             )
         else:
             if robot.desc.args:
@@ -638,6 +654,7 @@ def _robot_model(
                 model=robot.name,
                 notices=notices,
                 timestep=timestep,
+                controllers=controllers,
             )
     except SourceError as e:
         where = Location(e.file, e.line) if e.file else doc.locate(file_path)

@@ -197,6 +197,7 @@ class GazeboReader:
         self.where = Locator(file, sources, expanded)
         self.namespace = namespace
         self.model = model or namespace  # the model's name in Gazebo: the robot's name in the scenario
+        self.controller_files: list[Path] = []
         self.notices = notices
         self.info = GazeboInfo()
         self._names: set[str] = set()
@@ -279,9 +280,58 @@ class GazeboReader:
                     self._model(gz)
             except (ValueError, OverflowError) as e:  # float("many"), int(float("inf")) in a tag's text
                 raise self._not_a_number(gz, e) from None
+        for path in self.controller_files:  # the scenario's `controllers:` (what a launch file would load)
+            self.controllers(path, (path, None))
         self._drop_shadowed()
         self._drop_missing_targets()
         return self.info
+
+    def controllers(self, path: Path, where: Where) -> int:
+        """Run the diff drive and joint state controllers of a ros_control / ros2_control controllers file
+        (as `<parameters>` names it, or the scenario's `controllers:`); returns how many. Other controllers
+        are said, with their type."""
+        import yaml
+
+        try:
+            doc = yaml.safe_load(path.read_text())
+        except OSError as e:
+            raise SourceError(
+                f"controllers file {str(path)!r} cannot be read: {e.strerror or e}", path
+            ) from None
+        except yaml.YAMLError as e:
+            mark = getattr(e, "problem_mark", None)
+            raise SourceError(
+                f"controllers file {str(path)!r} is not valid YAML: {getattr(e, 'problem', e)}",
+                path,
+                mark.line + 1 if mark else None,
+            ) from None
+        entries, update_rate = _controller_entries(doc)
+        ros1 = not _ros_parameters(doc)
+        count = 0
+        for name, kind, params in entries:
+            if kind.endswith("DiffDriveController"):
+                type_name, drive = _diff_drive_controller(self, name, params, ros1, where)
+                self.info.plugins.append(
+                    DescribedPlugin(
+                        type_name,
+                        self.unique(name),
+                        {k: v for k, v in drive.items() if v is not None},
+                        *where,
+                    )
+                )
+            elif kind.endswith(("JointStateBroadcaster", "JointStateController")):
+                rate = params.get("publish_rate") if ros1 else update_rate
+                js = {"topic": "joint_states", "joints": params.get("joints") or None, "rate": rate}
+                self.info.plugins.append(
+                    DescribedPlugin(
+                        "joint_states", self.unique(name), {k: v for k, v in js.items() if v}, *where
+                    )
+                )
+            else:
+                self.notices.add(f"ros_control controller {name!r} ({kind}) is not run", *where)
+                continue
+            count += 1
+        return count
 
     def drop(self, where: Where, message: str, hint: str | None = None) -> None:
         """Leave a block, a plugin or part of one out, as Gazebo does, with a warning at its line."""
@@ -1388,7 +1438,7 @@ def _ros_control(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> None:
     r.mark(*[c.tag for c in r.el if isinstance(c.tag, str)])
     files = [e for e in r.children("parameters") if (e.text or "").strip().endswith((".yaml", ".yml"))]
     ran = sum(_ros2_controllers(g, r.el, e) for e in files)
-    if ran:
+    if ran or g.controller_files:  # the scenario's `controllers:` are run (read at the end)
         return None
     g.note(
         r.el,
@@ -1427,69 +1477,82 @@ def _param(params: dict[str, Any], dotted: str) -> Any:
 
 
 def _ros2_controllers(g: GazeboReader, plugin: Any, el: Any) -> int:
-    """The diff drive controllers and joint state broadcasters of a ros2_control parameters file, as our
-    drive and joint state plugins; returns how many. Other controllers are said, with their type."""
-    import yaml
-
-    where = el
+    """The controllers of the ros2_control parameters file a `<parameters>` names; returns how many run."""
     path = Path((el.text or "").strip())
     if not path.is_absolute():
         base = g.where(el)[0]
         path = (base.parent if base else Path.cwd()) / path
     try:
-        doc = yaml.safe_load(path.read_text())
-    except (OSError, yaml.YAMLError) as e:
-        g.note(
-            where, f"ros2_control parameters {str(path)!r} cannot be read ({e}); its controllers are not run"
-        )
+        return g.controllers(path, g.where(plugin))
+    except SourceError as e:
+        g.note(el, f"{e}; its controllers are not run")
         return 0
+
+
+def _controller_entries(doc: Any) -> tuple[list[tuple[str, str, dict[str, Any]]], Any]:
+    """(name, type, parameters) of each controller in a controllers file, and the update rate: ROS 2's
+    (`controller_manager: ros__parameters: <name>: {type}` and `<name>: ros__parameters: {...}`, under
+    `/**` or namespaces) or ROS 1's (`<name>: {type: ..., ...}`, at the top or under namespaces)."""
     nodes = _ros_parameters(doc)
-    manager = nodes.get("controller_manager", {})
-    update_rate = manager.get("update_rate")
-    count = 0
-    for name, spec in manager.items():
-        if not isinstance(spec, dict) or "type" not in spec:
-            continue
-        kind, params = str(spec["type"]), nodes.get(name, {})
-        if kind.endswith("DiffDriveController"):
-            g.add(plugin, *_ros2_diff_drive(g, name, params, update_rate, where))
-            count += 1
-        elif kind.endswith(("JointStateBroadcaster", "JointStateController")):
-            joints = params.get("joints") or None
-            g.add(
-                plugin, "joint_states", name, {"topic": "joint_states", "joints": joints, "rate": update_rate}
-            )
-            count += 1
-        else:
-            g.note(where, f"ros2_control controller {name!r} ({kind}) is not run")
-    return count
+    if nodes:
+        manager = nodes.get("controller_manager", {})
+        found = [
+            (name, str(spec["type"]), nodes.get(name, {}))
+            for name, spec in manager.items()
+            if isinstance(spec, dict) and "type" in spec
+        ]
+        return found, manager.get("update_rate")
+    found = []
+
+    def walk(node: Any) -> None:
+        if not isinstance(node, dict):
+            return
+        for key, value in node.items():
+            if isinstance(value, dict) and isinstance(value.get("type"), str):
+                found.append((str(key), value["type"], value))
+            elif isinstance(value, dict):
+                walk(value)
+
+    walk(doc)
+    return found, None
 
 
-def _ros2_diff_drive(
-    g: GazeboReader, name: str, p: dict[str, Any], update_rate: Any, where: Any
-) -> tuple[str, str, dict[str, Any]]:
-    """diff_drive_controller/DiffDriveController as it runs in ROS 2 (Humble to Jazzy): `<name>/cmd_vel`
-    (TwistStamped) or, with `use_stamped_vel: false`, `<name>/cmd_vel_unstamped` (Twist); odometry on
-    `<name>/odom`, the odom -> base transform on `/tf` when `enable_odom_tf`."""
-    lefts = [str(j) for j in (_param(p, "left_wheel_names") or [])]
-    rights = [str(j) for j in (_param(p, "right_wheel_names") or [])]
+def _diff_drive_controller(
+    g: GazeboReader, name: str, p: dict[str, Any], ros1: bool, where: Where
+) -> tuple[str, dict[str, Any]]:
+    """diff_drive_controller/DiffDriveController as it runs in Gazebo. ROS 1: `left_wheel`/`right_wheel`
+    (a joint or a list), `<name>/cmd_vel` (Twist); separation and radius from the URDF unless given. ROS 2
+    (Humble to Jazzy): `left_wheel_names`/`right_wheel_names`, `<name>/cmd_vel` (TwistStamped) or, with
+    `use_stamped_vel: false`, `<name>/cmd_vel_unstamped` (Twist). Both: `<name>/odom` at `publish_rate`,
+    `/tf` when `enable_odom_tf`, stopping `cmd_vel_timeout` (0.5 s) after the last command, multipliers."""
+
+    def names(*keys: str) -> list[str]:
+        for key in keys:
+            value = _param(p, key)
+            if value:
+                return [str(v) for v in value] if isinstance(value, list) else [str(value)]
+        return []
+
+    lefts, rights = names("left_wheel_names", "left_wheel"), names("right_wheel_names", "right_wheel")
     sep, radius = _param(p, "wheel_separation"), _param(p, "wheel_radius")
-    sep = float(sep) * float(_param(p, "wheel_separation_multiplier") or 1.0) if sep else None
-    radius = float(radius) * float(_param(p, "left_wheel_radius_multiplier") or 1.0) if radius else None
-    stamped = _param(p, "use_stamped_vel")
-    if stamped is not False:
-        g.note(
-            where,
+    stamped = False if ros1 else _param(p, "use_stamped_vel") is not False
+    if stamped:
+        g.notices.add(
             f"ros2_control diff drive {name!r} takes geometry_msgs/TwistStamped on {name}/cmd_vel; here it "
             "takes geometry_msgs/Twist there",
+            *where,
             hint="set use_stamped_vel: false in the controllers file to have it as Gazebo then has it "
             f"({name}/cmd_vel_unstamped, Twist)",
         )
     params: dict[str, Any] = {
-        "wheel_separation": sep,
-        "wheel_radius": radius,
+        "wheel_separation": float(sep) if sep else None,
+        "wheel_radius": float(radius) if radius else None,
+        "wheel_separation_multiplier": float(_param(p, "wheel_separation_multiplier") or 1.0),
+        "wheel_radius_multiplier": float(
+            _param(p, "wheel_radius_multiplier") or _param(p, "left_wheel_radius_multiplier") or 1.0
+        ),
         "rate": float(_param(p, "publish_rate") or 50.0),
-        "cmd_topic": f"{name}/cmd_vel" if stamped is not False else f"{name}/cmd_vel_unstamped",
+        "cmd_topic": f"{name}/cmd_vel_unstamped" if not ros1 and not stamped else f"{name}/cmd_vel",
         "odom_topic": f"{name}/odom",
         "tf_topic": "tf",
         "publish_tf": _param(p, "enable_odom_tf") is not False,
@@ -1499,13 +1562,13 @@ def _ros2_diff_drive(
     }
     accel = _param(p, "linear.x.max_acceleration")
     if accel and radius and _param(p, "linear.x.has_acceleration_limits"):
-        params["max_wheel_acceleration"] = float(accel) / radius
+        params["max_wheel_acceleration"] = float(accel) / float(radius)
     if len(lefts) > 1 or len(rights) > 1:
         params["left_joints"], params["right_joints"] = lefts, rights
-        return "skid_steer", name, params
+        return "skid_steer", params
     params["left_joint"] = lefts[0] if lefts else None
     params["right_joint"] = rights[0] if rights else None
-    return "diff_drive", name, params
+    return "diff_drive", params
 
 
 # The parameters the real Gazebo plugins read (classic ROS 1 and ROS 2 spellings, gz-sim systems): anything
@@ -1635,8 +1698,11 @@ def read_gazebo(
     namespace: str,
     model: str | None = None,
     notices: Notices,
+    controllers: list[Path] | None = None,
 ) -> GazeboInfo:
-    return GazeboReader(root, file, sources or [], expanded, namespace, notices, model).read()
+    reader = GazeboReader(root, file, sources or [], expanded, namespace, notices, model)
+    reader.controller_files = list(controllers or [])
+    return reader.read()
 
 
 def parse(text: str) -> Any:

@@ -189,6 +189,7 @@ def urdf_to_model(
     sources: list[Path] | None = None,
     expanded: bool = False,
     timestep: float = 0.002,
+    controllers: list[Path] | None = None,
 ) -> RobotModel:
     notices = notices if notices is not None else Notices()
     base_dir = file.parent if file else Path.cwd()
@@ -220,6 +221,7 @@ def urdf_to_model(
         namespace=namespace,
         model=model or namespace,
         notices=notices,
+        controllers=controllers,
     )
     transmissions = _transmissions(root, where, notices)
 
