@@ -590,7 +590,7 @@ joint_publisher:
   publish_rate: 20
 velocity_controller:
   type: "diff_drive_controller/DiffDriveController"
-  left_wheel: ['left_wheel_joint']
+  left_wheel: ['$(arg prefix)left_wheel_joint']
   right_wheel: right_wheel_joint
   publish_rate: 25
   cmd_vel_timeout: 0.25
@@ -616,6 +616,7 @@ def test_ros1_gazebo_ros_control_runs_the_controllers_file_the_scenario_names(tm
     path.write_text(text)
     plan, said = compile_with_notices(path)
     assert "controllers are not run" not in said, said
+    assert "launch argument(s) prefix taken as empty" in said  # roslaunch's subst_value, with no value
     topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in plan.robots[0].plugins}
     assert topics["velocity_controller"] == ["velocity_controller/cmd_vel", "velocity_controller/odom"]
     assert topics["joint_publisher"] == ["joint_states"]

@@ -293,11 +293,24 @@ class GazeboReader:
         import yaml
 
         try:
-            doc = yaml.safe_load(path.read_text())
+            text = path.read_text()
         except OSError as e:
             raise SourceError(
                 f"controllers file {str(path)!r} cannot be read: {e.strerror or e}", path
             ) from None
+        # `<rosparam subst_value="true">` substitutes launch arguments in such files: with none given here,
+        # each `$(arg name)` is empty (the usual default of a `prefix`), and said
+        args = sorted(set(_LAUNCH_ARG.findall(text)))
+        if args:
+            text = _LAUNCH_ARG.sub("", text)
+            self.notices.add(
+                f"controllers file: launch argument(s) {', '.join(args)} taken as empty",
+                path,
+                None,
+                hint="write the values into a copy of the file if the robot is launched with others",
+            )
+        try:
+            doc = yaml.safe_load(text)
         except yaml.YAMLError as e:
             mark = getattr(e, "problem_mark", None)
             raise SourceError(
@@ -1049,6 +1062,8 @@ class GazeboReader:
                     self.note(el, f"<{el.tag}> is not a parameter of {filename!r}: Gazebo ignores it too")
         self.ignored(r, context)
 
+
+_LAUNCH_ARG = re.compile(r"\$\(arg\s+([^)\s]+)\s*\)")
 
 # Plugin parameters that name joints of the robot (one, or a list).
 _JOINT_PARAMS = {"left_joint", "right_joint"}
