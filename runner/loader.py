@@ -39,10 +39,22 @@ class Document:
         return self.file.parent if self.file else Path.cwd()
 
 
+# Limits checked before anything expensive: a scenario is a few kilobytes of hand-written YAML.
+MAX_BYTES = 4_000_000
+MAX_DEPTH = 64  # mappings and lists inside each other
+# values once aliases are expanded (a "billion laughs" alias bomb is a few hundred bytes)
+MAX_VALUES = 100_000
+
+
+class _TooMany(Exception):
+    pass
+
+
 class _Builder:
     def __init__(self, file: Path | None):
         self.file = file
         self.positions: dict[PathKey, Location] = {}
+        self.values = 0
         # A SafeLoader instance only to reuse its scalar resolution (ints, floats, bools, nulls...).
         self._scalars = yaml.SafeLoader("")
 
@@ -50,6 +62,9 @@ class _Builder:
         return Location(self.file, node.start_mark.line + 1, node.start_mark.column + 1)
 
     def build(self, node: yaml.Node, path: PathKey) -> Any:
+        self.values += 1
+        if self.values > MAX_VALUES:
+            raise _TooMany
         self.positions[path] = self.mark(node)
         if isinstance(node, yaml.MappingNode):
             self._scalars.flatten_mapping(node)  # handles `<<: *anchor` merges
@@ -183,8 +198,44 @@ def _short(value: Any, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
+def _check_limits(text: str, file: Path | None) -> None:
+    """Size and nesting depth, from the parser's events (linear in the text, before anything is built)."""
+    size = len(text.encode("utf-8", errors="replace"))
+    if size > MAX_BYTES:
+        raise ScenarioError(
+            Problem(
+                f"this file is {size / 1e6:.1f} MB; a scenario may be at most {MAX_BYTES / 1e6:.0f} MB",
+                Location(file, 1, 1),
+                hint="keep data (meshes, maps, long timelines) in files the scenario refers to",
+            )
+        )
+    depth = 0
+    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+        if isinstance(event, yaml.MappingStartEvent | yaml.SequenceStartEvent):
+            depth += 1
+            if depth > MAX_DEPTH:
+                mark = event.start_mark
+                raise ScenarioError(
+                    Problem(
+                        f"this YAML is nested more than {MAX_DEPTH} levels deep",
+                        Location(file, mark.line + 1, mark.column + 1),
+                        hint="a scenario needs a few levels: check for runaway indentation or brackets",
+                    )
+                )
+        elif isinstance(event, yaml.MappingEndEvent | yaml.SequenceEndEvent):
+            depth -= 1
+
+
+def _first_alias(text: str, file: Path | None) -> Location:
+    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+        if isinstance(event, yaml.AliasEvent):
+            return Location(file, event.start_mark.line + 1, event.start_mark.column + 1)
+    return Location(file, 1, 1)
+
+
 def load_text(text: str, file: Path | None = None) -> Document:
     try:
+        _check_limits(text, file)
         node = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.MarkedYAMLError as e:
         raise ScenarioError(_yaml_problem(e, text, file)) from None
@@ -197,6 +248,14 @@ def load_text(text: str, file: Path | None = None) -> Document:
     builder = _Builder(file)
     try:
         data = builder.build(node, ())
+    except _TooMany:
+        raise ScenarioError(
+            Problem(
+                f"aliases expand this YAML to more than {MAX_VALUES} values",
+                _first_alias(text, file),
+                hint="each `*name` repeats everything its `&name` holds; an alias of aliases multiplies it",
+            )
+        ) from None
     except RecursionError:
         raise ScenarioError(Problem("this YAML is nested too deeply to read", Location(file, 1, 1))) from None
     return Document(data, file, builder.positions)
@@ -205,6 +264,15 @@ def load_text(text: str, file: Path | None = None) -> Document:
 def load_file(path: str | Path) -> Document:
     p = Path(path)
     try:
+        if p.is_file() and p.stat().st_size > MAX_BYTES:
+            raise ScenarioError(
+                Problem(
+                    f"this file is {p.stat().st_size / 1e6:.1f} MB; a scenario may be at most "
+                    f"{MAX_BYTES / 1e6:.0f} MB",
+                    Location(p.resolve(), 1, 1),
+                    hint="keep data (meshes, maps, long timelines) in files the scenario refers to",
+                )
+            )
         text = p.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ScenarioError(

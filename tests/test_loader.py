@@ -1,11 +1,12 @@
 from __future__ import annotations
 
 import textwrap
+from pathlib import Path
 
 import pytest
 
 from runner.errors import ScenarioError
-from runner.loader import load_text
+from runner.loader import load_file, load_text
 
 
 def test_positions_point_at_keys_and_items():
@@ -60,7 +61,7 @@ def test_empty_document():
         ("a: !!python/object:os.system 1\n", [":1:4:", "cannot be read", "plain YAML"]),
         ("a: !!timestamp nope\n", [":1:4:", "'nope' cannot be read as !!timestamp"]),
         ("a: !!float abc\n", [":1:4:", "cannot be read as !!float"]),
-        ("[" * 3000 + "]" * 3000 + "\n", [":1:1:", "nested too deeply"]),
+        ("[" * 3000 + "]" * 3000 + "\n", [":1:65:", "nested more than 64 levels"]),
     ],
 )
 def test_values_yaml_cannot_build_are_errors_not_crashes(text: str, pieces: list[str]) -> None:
@@ -105,3 +106,42 @@ def test_the_terminal_prints_file_colon_line_as_written() -> None:
             console.print("warning: my_world.sdf:100: SDF <wind> ignored", markup=False)
             console.print("world.sdf:1:  warning:smile:")
         assert "my_world.sdf:100: SDF" in cap.get() and ":smile:" in cap.get()
+
+
+def test_an_alias_bomb_is_refused_at_once_at_its_alias(tmp_path: Path) -> None:
+    """A "billion laughs" YAML (a few hundred bytes, 9^9 values once aliases are expanded) is refused
+    before it is built: in well under a second, with little memory, at the first alias."""
+    import time
+    import tracemalloc
+
+    rows = ['a: &a ["lol","lol","lol","lol","lol","lol","lol","lol","lol"]']
+    for prev, name in zip("abcdefgh", "bcdefghi", strict=True):
+        rows.append(f"{name}: &{name} [{','.join([f'*{prev}'] * 9)}]")
+    path = tmp_path / "bomb.yaml"
+    path.write_text("name: bomb\n" + "\n".join(rows) + "\n")
+    t0 = time.process_time()  # CPU time: another run beside this one does not count against it
+    with pytest.raises(ScenarioError) as err:
+        load_file(path)
+    seconds = time.process_time() - t0
+    tracemalloc.start()
+    with pytest.raises(ScenarioError):
+        load_file(path)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert seconds < 2.0 and peak < 200e6, (seconds, peak)
+    text = err.value.render()
+    assert f"{path.resolve()}:3:8: aliases expand this YAML to more than" in text, text
+    assert "hint:" in text
+
+
+def test_size_and_nesting_limits_are_said_with_their_lines(tmp_path: Path) -> None:
+    deep = tmp_path / "deep.yaml"
+    deep.write_text("name: deep\nx: " + "[" * 100 + "]" * 100 + "\n")
+    with pytest.raises(ScenarioError) as err:
+        load_file(deep)
+    assert "deep.yaml:2:" in err.value.render() and "nested more than 64 levels" in err.value.render()
+    big = tmp_path / "big.yaml"
+    big.write_text("name: big\ntimeline:\n" + "  - {t: 1, topic: a/b, type: std_msgs/msg/Empty}\n" * 100_000)
+    with pytest.raises(ScenarioError) as err:
+        load_file(big)
+    assert "a scenario may be at most 4 MB" in err.value.render() and "hint:" in err.value.render()
