@@ -100,44 +100,54 @@ _FRAME_REACH_SPANS = 20.0
 
 def _framing(m: mujoco.MjModel, d: mujoco.MjData, rec: Recording) -> tuple[np.ndarray, float, list[str]]:
     """Centre and size of what is worth seeing: every geom but the (infinite) ground planes, at the start,
-    and where the bodies go over the run; and the models left out because they lie far beyond all that
-    moves (a world model posed hundreds of kilometres away would shrink the rest to nothing)."""
-    mujoco.mj_kinematics(m, d)
+    and where the bodies go over the run; and the models left out because they lie far beyond the robots
+    (a world model posed hundreds of kilometres away, a model without collision falling forever would
+    shrink the rest to nothing)."""
     corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
 
     def box(g: int) -> list[np.ndarray]:
         center, half = m.geom_aabb[g][:3], m.geom_aabb[g][3:]
         return list(d.geom_xpos[g] + (center + corners * half) @ d.geom_xmat[g].reshape(3, 3).T)
 
+    def model_of(g: int) -> str:
+        root = int(m.body_rootid[int(m.geom_bodyid[g])])
+        # a scenario's world model is a geom of the world body; an SDF model or a robot, bodies `<name>/...`
+        return (m.body(root).name if root else m.geom(g).name or "a world geom").split("/")[0]
+
     solid = [g for g in range(m.ngeom) if int(m.geom_type[g]) != int(mujoco.mjtGeom.mjGEOM_PLANE)]
+    robots = {b for _, b in _robots(m, rec.robots)}
     # geoms of bodies that can move (their root body has joints), seen whole wherever they go: a box
     # pushed to the edge stays in the picture
     moving = [g for g in solid if int(m.body_jntnum[int(m.body_rootid[int(m.geom_bodyid[g])])]) > 0]
-    still = {g: box(g) for g in solid if g not in moving}
-    travelled: list[np.ndarray] = []
+    boxes: dict[int, list[np.ndarray]] = {}
+    mujoco.mj_kinematics(m, d)
+    for g in solid:
+        if g not in moving:
+            boxes[g] = box(g)
+    subject: list[np.ndarray] = []  # what the picture is about: the robots' paths, else all that moves
     for state in [*rec.states[:: max(1, len(rec.states) // 50)], rec.states[-1]]:
         d.qpos[:] = state[: m.nq]
         mujoco.mj_kinematics(m, d)
-        travelled += [d.xpos[b].copy() for b in range(1, m.nbody) if m.body_jntnum[int(m.body_rootid[b])] > 0]
         for g in moving:
-            travelled += box(g)
+            pts = box(g)
+            boxes.setdefault(g, []).extend(pts)
+            if not robots or int(m.body_rootid[int(m.geom_bodyid[g])]) in robots:
+                subject += pts
+    if not subject:
+        subject = [p for pts in boxes.values() for p in pts]
     left_out: list[str] = []
-    points = list(travelled)
-    if travelled:
-        ref = np.array(travelled)
+    points: list[np.ndarray] = []
+    if subject:
+        ref = np.array(subject)
         lo, hi = ref.min(axis=0), ref.max(axis=0)
         centre, reach = (lo + hi) / 2, max(_FRAME_REACH_M, _FRAME_REACH_SPANS * float(np.max(hi - lo)))
-        for g, pts in still.items():
-            if np.linalg.norm(d.geom_xpos[g] - centre) > reach:
-                root = int(m.body_rootid[int(m.geom_bodyid[g])])
-                # a scenario's world model is a geom of the world body; an SDF model, bodies `<model>/...`
-                name = (m.body(root).name if root else m.geom(g).name or "a world geom").split("/")[0]
-                if name not in left_out:
-                    left_out.append(name)
+        for g, pts in boxes.items():
+            far = np.max(np.linalg.norm(np.array(pts) - centre, axis=1)) > reach
+            if far and int(m.body_rootid[int(m.geom_bodyid[g])]) not in robots:
+                if model_of(g) not in left_out:
+                    left_out.append(model_of(g))
                 continue
             points += pts
-    else:
-        points = [p for pts in still.values() for p in pts]
     if not points:
         return np.array(m.stat.center), 2.0 * float(m.stat.extent), left_out
     pts = np.array(points)
@@ -173,7 +183,7 @@ def frames(
             notes.append(
                 f"the overview leaves out {', '.join(left_out[:5])}{' ...' if len(left_out) > 5 else ''}: "
                 f"farther than {_FRAME_REACH_M:g} m (or {_FRAME_REACH_SPANS:g} times their spread) from "
-                "the robots and all that moves"
+                "the robots at some time of the run"
             )
         # the shadow map must cover what is framed, or its edge speckles the floor (shadow acne)
         extent = max(float(m.stat.extent), 1e-6)

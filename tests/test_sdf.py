@@ -609,7 +609,7 @@ def test_materials_and_friction(tmp_path: Path) -> None:
     np.testing.assert_allclose(model.geom("red/l/c").rgba, [1, 0, 0, 1])  # the link's visual colour
     c = model.geom("red/l/c")
     assert c.friction[0] == pytest.approx(0.3)  # the smaller of mu and mu2
-    assert c.priority[0] == 1
+    assert c.priority[0] == 2  # slippery: its mu wins, as the smaller of two would
     np.testing.assert_allclose(model.geom("rgba/l/v").rgba, [0, 0.5, 0, 0.4])  # diffuse, then transparency
     np.testing.assert_allclose(model.geom("odd/l/v").rgba, [0.7, 0.7, 0.7, 1])
     (notice,) = list(notices)

@@ -897,3 +897,128 @@ def test_a_world_file_without_a_ground_plane_gets_none_unless_the_scenario_asks(
         assert len(planes) == (1 if ground else 0), (world, extra)
         said = "the world file has no ground plane: none is added, as in Gazebo" in text
         assert said == (world == "bare" and not ground), text
+
+
+@pytest.mark.timeout(120)
+def test_a_grippy_floor_model_does_not_make_a_frictionless_caster_drag(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """AWS worlds give their floors mu 100 / mu2 50. Gazebo takes the smaller mu of two surfaces, so the
+    robot's caster (mu 0) still slides; MuJoCo takes the larger unless one has priority: the caster dragged
+    at 50 and the robot drove 0.70 m of 1.0. A grippy world surface now leaves robots their own mu."""
+    from tests.conftest import DIFFBOT
+    from tests.helpers import messages, simulate
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    _write(
+        tmp_path,
+        "floor.world",
+        """
+        <sdf version="1.6"><world name="w">
+          <model name="floor"><static>true</static><pose>0 0 -0.05 0 0 0</pose><link name="link">
+            <collision name="c"><geometry><box><size>20 20 0.1</size></box></geometry>
+              <surface><friction><ode><mu>100</mu><mu2>50</mu2></ode></friction></surface></collision>
+          </link></model>
+        </world></sdf>
+        """,
+    )
+    scenario = _write(
+        tmp_path,
+        "s.yaml",
+        f"""
+        name: floor
+        duration: 6
+        rate: max
+        world: {{sdf: floor.world}}
+        robots:
+          - name: r1
+            description: {DIFFBOT}
+            pose: {{xyz: [0, 0, 0.06]}}
+            plugins: [{{type: diff_drive}}, {{type: ground_truth, params: {{rate: 20}}}}]
+        timeline:
+          - {{t: 0.5, topic: r1/cmd_vel, type: geometry_msgs/msg/Twist, data: {{linear: {{x: 0.2}}}}}}
+          - {{t: 5.5, topic: r1/cmd_vel, type: geometry_msgs/msg/Twist, data: {{}}}}
+        """,
+    )
+    _, bus = simulate(scenario)
+    truth = messages(bus, "r1/ground_truth")
+    start = next(m for t, m in truth if t >= 0.5e9).pose.pose.position
+    end = truth[-1][1].pose.pose.position
+    assert abs(math.hypot(end.x - start.x, end.y - start.y) - 1.0) < 0.05, (end.x, end.y)
+
+
+@pytest.mark.timeout(60)
+def test_a_worlds_package_exports_its_models_and_media_as_gazebo_ros_does(tmp_path: Path) -> None:
+    """AWS world packages keep their models in `<pkg>/models` and refer to meshes as `file://models/...`,
+    found through the package.xml's `<gazebo_ros gazebo_model_path="${prefix}/models"
+    gazebo_media_path="${prefix}"/>` export, which gazebo_ros adds to Gazebo's paths. The world loads from
+    anywhere without setting an environment variable; a model.config with a bare `&` (TinyXML2 takes it) is
+    read leniently, with a warning."""
+    pkg = tmp_path / "src" / "shop_world"
+    _write(pkg, "package.xml", '<package format="2"><name>shop_world</name><export><gazebo_ros '
+           'gazebo_media_path="${prefix}" gazebo_model_path="${prefix}/models"/></export></package>\n')  # fmt: skip
+    _stl(pkg / "models" / "shelf" / "meshes" / "shelf.stl", [((0, 0, 0), (1, 0.4, 1.5))])
+    _write(pkg / "models" / "shelf", "model.config",
+           "<model><name>Shelf & Co</name><sdf version='1.6'>model.sdf</sdf></model>\n")  # fmt: skip
+    _write(
+        pkg / "models" / "shelf",
+        "model.sdf",
+        """
+        <sdf version="1.6"><model name="shelf"><static>true</static><link name="link">
+          <collision name="c"><geometry><mesh><uri>file://models/shelf/meshes/shelf.stl</uri></mesh></geometry></collision>
+        </link></model></sdf>
+        """,
+    )
+    world = _write(
+        pkg / "worlds",
+        "shop.world",
+        '<sdf version="1.6"><world name="w"><include><uri>model://shelf</uri><pose>2 0 0 0 0 0</pose></include>'
+        "</world></sdf>\n",
+    )
+    elsewhere = tmp_path / "scenarios"
+    elsewhere.mkdir()
+    spec, result, notices = _load(world, packages=PackageMap(roots=[elsewhere]))
+    model, _ = _forward(spec)
+    assert result.models == ["shelf"]
+    g = model.geom("shelf/link/c")
+    assert g.type[0] == mujoco.mjtGeom.mjGEOM_MESH
+    messages = _messages(notices)
+    assert any("not well-formed XML" in m and "read leniently" in m for m in messages), messages
+    assert not any("not found" in m for m in messages), messages
+
+
+@pytest.mark.timeout(60)
+def test_a_floor_that_is_one_flat_sheet_is_drawn_and_collides(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """AWS floors are single sheets (19 x 11 x 0 m): MuJoCo refused to compute their volume ("mesh volume
+    is too small") and stopped the world. A flat visual is drawn as a shell; a flat static collision is a
+    slab, so a ball rests on it as on Gazebo's."""
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    sheet = tmp_path / "meshes" / "floor.stl"
+    sheet.parent.mkdir(parents=True)
+    tri = np.array([[[-5, -5, 0], [5, -5, 0], [5, 5, 0]], [[-5, -5, 0], [5, 5, 0], [-5, 5, 0]]], "<f4")
+    with sheet.open("wb") as out:
+        out.write(b"\0" * 80 + struct.pack("<I", 2))
+        for t in tri:
+            out.write(b"\0" * 12 + t.tobytes() + b"\0\0")
+    path = _write(
+        tmp_path,
+        "sheet.world",
+        """
+        <sdf version="1.6"><world name="w">
+          <model name="floor"><static>true</static><pose>0 0 0.5 0 0 0</pose><link name="link">
+            <collision name="c"><geometry><mesh><uri>meshes/floor.stl</uri></mesh></geometry></collision>
+            <visual name="v"><geometry><mesh><uri>meshes/floor.stl</uri></mesh></geometry></visual>
+          </link></model>
+          <model name="ball"><pose>0 0 1 0 0 0</pose><link name="l">
+            <inertial><mass>1</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial>
+            <collision name="c"><geometry><sphere><radius>0.2</radius></sphere></geometry></collision>
+          </link></model>
+        </world></sdf>
+        """,
+    )
+    spec, _, _ = _load(path, spec=_spec(ground=False))
+    model, data = _forward(spec)
+    _step(model, data, 1.0)
+    assert data.xpos[model.body("ball/l").id][2] == pytest.approx(0.5 + 0.2, abs=0.02)

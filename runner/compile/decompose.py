@@ -29,7 +29,7 @@ import numpy as np
 
 from runner.compile.meshes import mesh_cache
 
-VERSION = 2  # of the algorithm: part of the cache key
+VERSION = 3  # of the algorithm: part of the cache key
 RAY_GROUP = 4  # the mesh itself: no contacts, hit by rays
 PIECES_GROUP = 5  # its pieces: contacts, not hit by rays, never drawn
 THICKNESS = 0.02  # metres behind each face of an open or non-convex part
@@ -38,6 +38,7 @@ _PLANE_ANGLE = 1e-4  # normals this close (1 - cos) are one plane ...
 _PLANE_OFFSET = 1e-4  # ... when their offsets are this close (metres)
 _CONVEX_EPS = 1e-6  # how far outside a face's plane a vertex of a convex part may be (relative to its size)
 _MAX_CONVEX_CHECK = 4_000_000  # faces x vertices above which a part is not tested for convexity
+_FLAT = 1e-4  # a piece thinner than this (relative to its size) is a sheet: it gets a thickness
 
 
 @dataclass
@@ -80,8 +81,10 @@ def decompose_file(path: Path, scale: tuple[float, ...]) -> Decomposition | None
 
 def _read(path: Path, scale: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray] | None:
     spec = mujoco.MjSpec()
-    spec.add_mesh(name="m", file=str(path), scale=list(scale))
-    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname="m")
+    mesh = spec.add_mesh(name="m", file=str(path), scale=list(scale))
+    # read, not collided nor weighed: a flat mesh (a floor as one sheet) has neither hull nor volume
+    mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
+    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname="m", contype=0, conaffinity=0)
     try:
         m = spec.compile()
     except Exception:  # MuJoCo raises ValueError or its own errors; the world's compile reports them
@@ -103,6 +106,28 @@ def decompose(vertices: np.ndarray, faces: np.ndarray) -> list[np.ndarray]:
     v, f = _clean(np.asarray(vertices, float), np.asarray(faces, np.int64))
     if len(f) == 0:
         return []
+    return [solid for piece in _pieces(v, f) if (solid := _solid(piece)) is not None]
+
+
+def _solid(points: np.ndarray) -> np.ndarray | None:
+    """A piece MuJoCo can hull: at least 4 distinct points, not in one plane. A flat one (a closed part of
+    zero thickness, a double-sided sheet) gets `THICKNESS` across its plane; a line or a point is None."""
+    keys = np.round(points / _MERGE).astype(np.int64)
+    _, first = np.unique(keys, axis=0, return_index=True)
+    pts = points[np.sort(first)]
+    if len(pts) < 3:
+        return None
+    _, sv, vt = np.linalg.svd(pts - pts.mean(axis=0), full_matrices=False)
+    size = float(sv[0]) or 1.0
+    if len(sv) < 2 or sv[1] <= 1e-9 * size:
+        return None  # points on a line
+    if len(pts) >= 4 and len(sv) == 3 and sv[2] > _FLAT * size:
+        return pts
+    normal = vt[2] if len(vt) == 3 else np.cross(vt[0], vt[1])
+    return np.concatenate([pts + 0.5 * THICKNESS * normal, pts - 0.5 * THICKNESS * normal])
+
+
+def _pieces(v: np.ndarray, f: np.ndarray) -> list[np.ndarray]:
     pieces: list[np.ndarray] = []
     for part in _components(f, len(v)):
         pf = f[part]

@@ -2,7 +2,10 @@
 
 Lookup order: packages given explicitly, then any folder holding a `package.xml` whose `<name>` matches
 (or a Gazebo model folder, holding a `model.config` or a `model.sdf`, by its folder name), under the
-scenario's folder and the folders in SCENARIO_PACKAGE_PATH, ROS_PACKAGE_PATH and GZ_SIM_RESOURCE_PATH.
+scenario's folder and the folders in SCENARIO_PACKAGE_PATH, ROS_PACKAGE_PATH, GZ_SIM_RESOURCE_PATH (and
+Gazebo classic's GAZEBO_MODEL_PATH, GAZEBO_RESOURCE_PATH). A package's `<export><gazebo_ros
+gazebo_model_path="${prefix}/models" gazebo_media_path="${prefix}"/>` adds its model folders and the folders
+relative `file://` paths are looked up in, as gazebo_ros does when it starts Gazebo.
 """
 
 from __future__ import annotations
@@ -13,7 +16,14 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
-ENV_VARS = ("SCENARIO_PACKAGE_PATH", "ROS_PACKAGE_PATH", "GZ_SIM_RESOURCE_PATH")
+ENV_VARS = (
+    "SCENARIO_PACKAGE_PATH",
+    "ROS_PACKAGE_PATH",
+    "GZ_SIM_RESOURCE_PATH",
+    "IGN_GAZEBO_RESOURCE_PATH",
+    "GAZEBO_MODEL_PATH",
+    "GAZEBO_RESOURCE_PATH",
+)
 _SKIP_DIRS = {".git", ".venv", "venv", "node_modules", "__pycache__", "build", "install", "log", "runs"}
 
 
@@ -22,7 +32,9 @@ class PackageMap:
     explicit: dict[str, Path] = field(default_factory=dict)
     roots: list[Path] = field(default_factory=list)
     allowed: list[Path] = field(default_factory=list)  # more folders xacro may read (`allow_paths:`)
+    media: list[Path] = field(default_factory=list)  # gazebo_media_path exports: relative file:// paths
     _found: dict[str, Path] | None = None
+    _exported: set[Path] = field(default_factory=set)
 
     def readable(self, path: Path, description: Path) -> bool:
         """Whether xacro, expanding `description`, may read `path`: a file of the scenario's folder or of a
@@ -53,6 +65,7 @@ class PackageMap:
                         name = _package_name(Path(dirpath) / "package.xml")
                         if name and name not in found:
                             found[name] = Path(dirpath)
+                        self._exports(Path(dirpath), found)
                         dirnames[:] = []  # a package does not nest packages
                     elif "model.config" in filenames or "model.sdf" in filenames:
                         # A Gazebo model folder (model://<folder name>): Gazebo takes a folder that holds a
@@ -65,6 +78,59 @@ class PackageMap:
         if name in self.explicit:
             return self.explicit[name]
         return self._scan().get(name)
+
+    def add_package_of(self, file: Path) -> None:
+        """The exports of the package a file (a world) belongs to, wherever it is: Gazebo started by
+        gazebo_ros knows every package's model and media paths, not only those under our roots."""
+        package = enclosing_package(file)
+        if package is not None:
+            self._exports(package, self._scan())
+
+    def _exports(self, package: Path, found: dict[str, Path]) -> None:
+        package = package.resolve()
+        if package in self._exported:
+            return
+        self._exported.add(package)
+        models, media = gazebo_exports(package)
+        for folder in media:
+            if folder.is_dir() and folder not in self.media:
+                self.media.append(folder)
+        for folder in models:
+            if not folder.is_dir():
+                continue
+            for child in sorted(folder.iterdir()):
+                if child.is_dir() and ((child / "model.config").is_file() or (child / "model.sdf").is_file()):
+                    found.setdefault(child.name, child)
+
+
+def enclosing_package(file: Path, levels: int = 8) -> Path | None:
+    """The nearest folder at or above `file` that holds a package.xml."""
+    folder = file.resolve().parent
+    for _ in range(levels):
+        if (folder / "package.xml").is_file():
+            return folder
+        if folder.parent == folder:
+            return None
+        folder = folder.parent
+    return None
+
+
+def gazebo_exports(package: Path) -> tuple[list[Path], list[Path]]:
+    """A package's `<export><gazebo_ros gazebo_model_path=... gazebo_media_path=...>` folders (`${prefix}`
+    is the package's folder; several paths may be joined by `:`)."""
+    try:
+        root = ET.parse(package / "package.xml").getroot()
+    except (ET.ParseError, OSError):
+        return [], []
+    models: list[Path] = []
+    media: list[Path] = []
+    for el in root.iter("gazebo_ros"):
+        for attr, out in (("gazebo_model_path", models), ("gazebo_media_path", media)):
+            for part in (el.get(attr) or "").split(":"):
+                part = part.strip().replace("${prefix}", str(package))
+                if part:
+                    out.append(Path(part))
+    return models, media
 
 
 def _package_name(package_xml: Path) -> str | None:

@@ -423,6 +423,7 @@ class _Loader:
         return result
 
     def read(self, path: Path) -> SdfWorld:
+        self.packages.add_package_of(path)  # its package's gazebo_model_path / gazebo_media_path exports
         root, src = self.parse(path)
         self.result = result = SdfWorld(file=src.path)
         self.stack.append(src.path)
@@ -909,7 +910,15 @@ class _Loader:
         try:
             root = etree.parse(str(config), etree.XMLParser(remove_comments=True, no_network=True)).getroot()
         except etree.XMLSyntaxError as e:
-            raise SdfError(f"not well-formed XML: {e.msg}", config, e.lineno) from None
+            # a model.config is metadata (names, authors, descriptions with a bare `&`): TinyXML2 takes what
+            # lxml refuses, and Gazebo only wants its <sdf> file names. Read what can be read, and say so.
+            parser = etree.XMLParser(remove_comments=True, no_network=True, recover=True)
+            root = etree.parse(str(config), parser).getroot()
+            if root is None:
+                raise SdfError(f"not well-formed XML: {e.msg}", config, e.lineno) from None
+            self.notices.add(
+                f"not well-formed XML ({e.msg}); read leniently, as Gazebo does", config, e.lineno
+            )
         best: tuple[tuple[int, ...], str] | None = None
         for s in root.findall("sdf"):
             text = (s.text or "").strip()
@@ -1343,8 +1352,11 @@ class _Loader:
                     hint=hint,
                 )
             return None
+        original = path
+        flat = False
         try:  # the same checks and conversions as a URDF's meshes (runner.compile.meshes)
-            path = prepare_mesh(path).file
+            prepared = prepare_mesh(path)
+            path, flat = prepared.file, prepared.flat
         except MeshError as e:
             # a format that cannot be converted may have an STL or OBJ export beside it
             alt = next(
@@ -1366,11 +1378,17 @@ class _Loader:
             path = alt
         key = (str(path.resolve()), tuple(scale))
         if convex_check:
-            self.last_pieces = self.pieces_of(Path(key[0]), scale, uri, what, src, uri_el)
+            self.last_pieces = self.pieces_of(Path(key[0]), scale, uri, what, src, uri_el, flat=flat)
         if key in self.meshes:
             return self.meshes[key]
-        name = self.unique("mesh", f"sdf/{path.stem}")
-        self.spec.add_mesh(name=name, file=key[0], scale=list(scale))
+        # named after the user's file (a converted mesh's cache file is named by a hash), so that MuJoCo's
+        # messages name something the user knows
+        name = self.unique("mesh", f"sdf/{original.stem}")
+        mesh = self.spec.add_mesh(name=name, file=key[0], scale=list(scale))
+        if flat:
+            # no volume (a floor or a sticker as a single sheet): MuJoCo refuses a volume inertia; a
+            # shell's it takes (static world meshes weigh nothing anyway)
+            mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
         self.meshes[key] = name
         return name
 
@@ -1392,7 +1410,8 @@ class _Loader:
                     [],
                     f"no {what} named {m.group(2)!r}: a model is a folder named after it holding a "
                     "model.config or a model.sdf, a package a folder with a package.xml; add its parent "
-                    f"folder under `packages:` or to SCENARIO_PACKAGE_PATH; searched: {roots}",
+                    "folder under `packages:` or to SCENARIO_PACKAGE_PATH (GZ_SIM_RESOURCE_PATH and "
+                    f"GAZEBO_MODEL_PATH are read too); searched: {roots}",
                 )
             target = root / m.group(3)
             return (target if target.exists() else None), [target], f"{m.group(2)!r} is {root}"
@@ -1407,7 +1426,8 @@ class _Loader:
         if rel.is_absolute():
             return (rel if rel.exists() else None), [rel], "the path is absolute"
         looked: list[Path] = []
-        for base in [src.path.parent, *(f.parent for f in reversed(src.chain)), *self.packages.roots]:
+        bases = [src.path.parent, *(f.parent for f in reversed(src.chain)), *self.packages.media]
+        for base in [*bases, *self.packages.roots]:
             candidate = Path(base).resolve() / rel
             if candidate in looked:
                 continue
@@ -1416,13 +1436,22 @@ class _Loader:
                 return candidate, looked, ""
         hint = (
             f"a relative {kind} path is looked up beside the SDF file, beside the files that include it, "
-            "then in the scenario's folder and the folders on SCENARIO_PACKAGE_PATH / GZ_SIM_RESOURCE_PATH"
+            "then in the packages' gazebo_media_path exports, the scenario's folder and the folders on "
+            "SCENARIO_PACKAGE_PATH / GZ_SIM_RESOURCE_PATH / GAZEBO_RESOURCE_PATH"
             + ("; inside a model folder, model://<model>/... is the portable form" if kind == "mesh" else "")
         )
         return None, looked, hint
 
     def pieces_of(
-        self, path: Path, scale: tuple[float, ...], uri: str, what: str, src: _Src, at: etree._Element
+        self,
+        path: Path,
+        scale: tuple[float, ...],
+        uri: str,
+        what: str,
+        src: _Src,
+        at: etree._Element,
+        *,
+        flat: bool = False,
     ) -> list[str] | None:
         """The MuJoCo meshes of a static collision mesh's convex pieces, None when it is convex (MuJoCo
         collides a mesh as its convex hull: a building's walls in one mesh would be a solid block). Said
@@ -1431,14 +1460,16 @@ class _Loader:
         if key in self.decomposed:
             return self.decomposed[key]
         self.decomposed[key] = None
-        stats = _hull_and_volume(path, scale)
-        if stats is None:
+        stats = None if flat else _hull_and_volume(path, scale)
+        if stats is None and not flat:
             return None
-        hull, volume = stats
-        if hull - volume < _NONCONVEX_MIN_EXCESS or hull < _NONCONVEX_RATIO * volume:
-            return None  # near enough to convex: its hull, as MuJoCo takes a mesh (cheap, and smooth)
+        if stats is not None:
+            hull, volume = stats
+            if hull - volume < _NONCONVEX_MIN_EXCESS or hull < _NONCONVEX_RATIO * volume:
+                return None  # near enough to convex: its hull, as MuJoCo takes a mesh (cheap, and smooth)
         found = decompose_file(path, scale)
-        if found is None or len(found.pieces) <= 1:
+        # a flat mesh (a floor as one sheet) has no hull MuJoCo can make: it always collides as its pieces
+        if found is None or (len(found.pieces) <= 1 and not flat) or not found.pieces:
             return None
         if len(found.pieces) > _MAX_PIECES:
             self.note(
@@ -1451,7 +1482,7 @@ class _Loader:
             return None
         names = []
         for k, points in enumerate(found.pieces):
-            name = self.unique("mesh", f"sdf/{path.stem}/piece{k}")
+            name = self.unique("mesh", f"sdf/{Path(uri).stem}/piece{k}")
             self.spec.add_mesh(name=name, uservert=points.ravel().tolist())
             names.append(name)
         self.decomposed[key] = names
@@ -1510,10 +1541,15 @@ class _Loader:
                 self.check(ode, src, {"mu", "mu2"})
                 mus = [self.child_float(ode, t, src) for t in ("mu", "mu2") if ode.find(t) is not None]
                 if mus:
-                    # Gazebo takes the smaller of two surfaces' mu, MuJoCo the larger: priority makes this
-                    # geom's own friction win against plain geoms (the ground, robot bodies).
-                    kw["friction"] = [max(min(mus), 0.0), 0.005, 0.0001]
-                    kw["priority"] = 1
+                    # Gazebo takes the smaller of two surfaces' mu, MuJoCo the larger unless one geom has
+                    # priority. As for the ground (`take_ground`): a slippery surface (mu under 1, every
+                    # surface's default in both) gets the top priority, so what touches it gets its mu, as the
+                    # smaller-of-two would give anything grippier; a grippy one (mu 100 is common) keeps 1 and
+                    # no priority, so a robot's wheels and casters keep the mu they state (a caster's 0)
+                    # instead of dragging at 100.
+                    mu = max(min(mus), 0.0)
+                    kw["friction"] = [min(mu, 1.0), 0.005, 0.0001]
+                    kw["priority"] = 2 if mu < 1.0 else 0
         ct = s.find("contact")
         if ct is None:
             return
@@ -1796,10 +1832,11 @@ def _signed_volume(v: np.ndarray, faces: np.ndarray) -> float:
 
 
 # A static collision mesh is split into convex pieces when its hull is this many times its volume (and
-# larger by this much), unless that takes more pieces than this (a curved, detailed mesh: its hull then)
+# larger by this much), unless that takes more pieces than this (a curved, detailed mesh: its hull then;
+# a thousand slabs already cost a run half its speed)
 _NONCONVEX_RATIO = 3.0
 _NONCONVEX_MIN_EXCESS = 1e-3
-_MAX_PIECES = 5000
+_MAX_PIECES = 1000
 
 
 _FUEL = re.compile(
