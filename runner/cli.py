@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import signal
 import sys
 from collections.abc import Callable
@@ -37,6 +38,10 @@ def _fail(e: Exception) -> typer.Exit:
     text = e.render() if isinstance(e, ScenarioError) else str(e)
     err.print("error: " + text, markup=False, soft_wrap=True, style="red")
     return typer.Exit(1)
+
+
+# A Zenoh endpoint: protocol/address[#config]
+_ENDPOINT = re.compile(r"^(tcp|udp|tls|quic|ws|unixsock-stream|unixpipe|serial|vsock)/[^\s/]+.*$")
 
 
 def _parse_rate(value: str | None) -> str | float | None:
@@ -239,6 +244,15 @@ def run(
       scenario run fleet.yaml --host gpu_box
     """
     parsed_rate = _parse_rate(rate)
+    for option, values in (("--listen", listen), ("--connect", connect)):
+        for value in values or []:
+            if not _ENDPOINT.match(value):
+                raise _fail(
+                    RunError(
+                        f"{option} {value!r}: not a Zenoh endpoint\n  hint:     write it with its "
+                        f"protocol, e.g. tcp/{value.split('/')[-1] or '127.0.0.1:7447'}"
+                    )
+                )
     try:
         plans = _load_variants(file, record, variant)
     except ScenarioError as e:

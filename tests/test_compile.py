@@ -178,3 +178,14 @@ def test_a_robot_placed_inside_something_is_warned(tmp_path):
     assert len(said) == 1 and said[0].startswith("robot 'stuck' starts") and "inside 'ground'" in said[0], (
         said
     )
+
+
+def test_a_record_path_that_names_a_folder_records_into_it(tmp_path):
+    """`record: {path: out/}` wrote a file named `out`: a folder (a trailing slash, or one that exists)
+    holds `<name>.mcap`."""
+    (tmp_path / "existing").mkdir()
+    for given, expected in (("out/", tmp_path / "out" / "s.mcap"), ("existing", tmp_path / "existing" / "s.mcap"),
+                            ("run.mcap", tmp_path / "run.mcap")):  # fmt: skip
+        path = tmp_path / "s.yaml"
+        path.write_text(f"name: s\nduration: 1\nrecord: {{path: {given}}}\n")
+        assert plan_of(path).record.path == str(expected), given

@@ -300,3 +300,12 @@ def test_a_runner_killed_outright_leaves_a_recording_readable_to_its_last_chunk(
     assert abs(len(scans) - (clock[-1] / 1e8 + 1)) <= 2  # nothing missing up to the cut
     info2 = run_cli("info", str(fixed))
     assert "cut:" not in info2.stdout and f"{len(messages)} messages" in info2.stdout
+
+
+@pytest.mark.timeout(60)
+def test_an_endpoint_without_its_protocol_is_a_clear_error_not_a_traceback() -> None:
+    for option in ("--listen", "--connect"):
+        r = run_cli("run", str(SCENARIOS / "two_robots.yaml"), option, "127.0.0.1:7447", timeout=50)
+        assert r.returncode == 1, r.stderr
+        assert f"{option} '127.0.0.1:7447': not a Zenoh endpoint" in r.stderr, r.stderr
+        assert "tcp/127.0.0.1:7447" in r.stderr and "Traceback" not in r.stderr

@@ -266,6 +266,7 @@ def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices
     mjcf = world.to_xml()
 
     timeline = [_timeline_entry(sc, i, doc) for i in range(len(sc.timeline))]
+    _check_timeline_types(timeline, robots, sc, doc)
     timeline.sort(key=lambda ev: ev.t_ns)
 
     record = _record_plan(sc, doc, record_path)
@@ -362,6 +363,8 @@ def _record_plan(sc: Scenario, doc: Document, record_path: str | None) -> Record
         path = Path(record_path)
     elif rec.path is not None:
         path = doc.base_dir / rec.path
+        if rec.path.endswith(("/", "\\")) or path.is_dir():  # a folder: the recording goes in it
+            path = path / f"{sc.name}.mcap"
     else:
         path = Path("runs") / f"{sc.name}.mcap"
     record = RecordPlan(
@@ -888,6 +891,37 @@ def _timeline_entry(sc: Scenario, i: int, doc: Document) -> TimelinePlan:
     topic = ev.topic
     key = f"{sc.name}/{topic.lstrip('/')}"
     return TimelinePlan(t_ns=round(ev.t * 1e9), key=key, type=type_name, data=ev.data)
+
+
+def _check_timeline_types(
+    timeline: list[TimelinePlan], robots: list[RobotPlan], sc: Scenario, doc: Document
+) -> None:
+    """A timeline entry must carry the type its topic's subscriber takes: a `std_msgs/msg/String` on a
+    drive's `cmd_vel` would reach the world (and a ROS client) as garbage."""
+    takes = {
+        t.key: (t.type, f"{p.type} {p.name!r} of robot {r.name!r}")
+        for r in robots
+        for p in r.plugins
+        for t in p.topics
+        if t.direction == "sub"
+    }
+    problems = []
+    for i, ev in enumerate(timeline):  # still in the scenario's order
+        wanted = takes.get(ev.key)
+        if wanted is not None and msgs.normalize_type(wanted[0]) != ev.type:
+            where: PathKey = ("timeline", i, "type")
+            problems.append(
+                Problem(
+                    f"{sc.timeline[i].topic} is taken by {wanted[1]} as {wanted[0]}",
+                    doc.locate(where),
+                    where,
+                    expected=wanted[0],
+                    found=ev.type,
+                    hint=f"write `type: {wanted[0]}` (and its fields under `data:`)",
+                )
+            )
+    if problems:
+        raise ScenarioError(problems)
 
 
 def _full_expr(run: str, expr: str) -> str:
