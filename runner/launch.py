@@ -30,7 +30,7 @@ from runner.graph import GraphTokens
 from runner.nodes import NodeError, Nodes, OutputTail
 from runner.plan import NodePlan, RunPlan
 from runner.record import Recorder, TopicStats
-from runner.tools import announce, withdraw
+from runner.tools import announce, update_announcement, withdraw
 from runner.transport import free_port, make_config, meta_key, unpack_attachment
 
 STOP_GRACE_S = 1.2  # after SIGINT, how long the world gets before SIGKILL
@@ -218,7 +218,10 @@ def run_plan(
             session.close()
             raise
         print(f"Foxglove: connect to ws://127.0.0.1:{live.port}", file=sys.stderr, flush=True)
-    announced = announce(plan.name, listen, plan.zenoh)  # `scenario echo/pub/topics` find the local run by it
+    # `scenario echo/pub/topics` find the local run by it
+    announced = announce(
+        plan.name, listen, plan.zenoh, recording=plan.record.path if plan.record.enabled else None
+    )
     parts = [
         _WorldPart(
             w,
@@ -240,7 +243,15 @@ def run_plan(
             try:
                 recorder = Recorder(Path(plan.record.path), plan.record.include, plan.record.exclude)
             except OSError as e:
-                raise RunError(f"cannot write the recording {plan.record.path}: {e.strerror}") from None
+                raise RunError(f"cannot write the recording {plan.record.path}: {e.strerror or e}") from None
+            if recorder.path != recorder.asked:
+                print(
+                    f"another run is recording to {recorder.asked}: this one records to {recorder.path}",
+                    file=sys.stderr,
+                    flush=True,
+                )
+                plan.record.path = str(recorder.path)
+                update_announcement(announced, recording=str(recorder.path))
             # the recorder's own FIFO subscriber, drained by its thread; undeclared (after recording what
             # it still queued) by recorder.close()
             recorder.subscribe(session, f"{plan.name}/**")

@@ -19,6 +19,7 @@ another process with none lost, ~6 µs of CPU per message in the recording proce
 from __future__ import annotations
 
 import contextlib
+import os
 import struct
 import sys
 import threading
@@ -303,6 +304,8 @@ class Recorder:
 
     def __post_init__(self) -> None:
         self.path.parent.mkdir(parents=True, exist_ok=True)
+        self.asked = self.path  # the path the plan gave; `path` is the one recorded to (see `_claim`)
+        self.path, self._claim_fd = _claim(self.path)
         self._file: IO[bytes] = open(self.path, "wb")  # noqa: SIM115 - closed in close()
         self._mcap = _McapFile(self._file, profile="ros2", library=self.library, chunk_size=self.chunk_size)
         self._lock = threading.Lock()
@@ -507,6 +510,9 @@ class Recorder:
                 self._mcap.finish()
             finally:
                 self._file.close()
+                with contextlib.suppress(OSError):  # the path is free for the next run
+                    self.path.with_name(f".{self.path.name}.lock").unlink()
+                    os.close(self._claim_fd)
 
 
 def foxglove_schema(type_name: str) -> Any:
@@ -626,3 +632,22 @@ def recover(path: Path, out: Path) -> dict[str, Any]:
                 )
         writer.finish()
     return read_summary(out)
+
+
+def _claim(path: Path) -> tuple[Path, int]:
+    """The recording path this run may write, and the descriptor that holds it: a lock on a hidden
+    `.<name>.lock` beside it (released when the process ends, however it ends). A path another live run
+    is recording to is not touched: the next free `<stem>-2.mcap`, `-3`... is taken instead."""
+    import fcntl
+
+    for n in range(1, 1000):
+        candidate = path if n == 1 else path.with_name(f"{path.stem}-{n}{path.suffix}")
+        lock = candidate.with_name(f".{candidate.name}.lock")
+        fd = os.open(lock, os.O_WRONLY | os.O_CREAT, 0o600)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            continue
+        return candidate, fd
+    raise OSError(f"a thousand runs are recording beside {path}")

@@ -1,8 +1,9 @@
 """What `scenario echo`, `scenario pub` and `scenario topics` share: finding a running run, and joining it.
 
-A run announces itself in a small file while it runs (`<tmp>/scenario-runs/<run>.json`: its name, its
-endpoints and the runner's pid), so the tools find the local run without being told; `--connect` joins
-any run by endpoint (another host's, say) and `--run` picks one of several.
+A run announces itself in a small file while it runs (`<tmp>/scenario-runs/<id>.json`, or under
+`$SCENARIO_RUNS_DIR`: its id (`<name>-<pid>`, unique on the machine), its name, its endpoints, its recording
+and the runner's pid), so the tools find the local run without being told; `--connect` joins any run by
+endpoint (another host's, say) and `--run` picks one of several, by id or by name.
 """
 
 from __future__ import annotations
@@ -22,7 +23,10 @@ import zenoh
 from runner.errors import RunError
 from runner.transport import make_config, use_run_settings
 
-RUNS_DIR = Path(tempfile.gettempdir()) / "scenario-runs"
+
+def runs_dir() -> Path:
+    """Where runs announce themselves: `$SCENARIO_RUNS_DIR`, else `<tmp>/scenario-runs`."""
+    return Path(os.environ.get("SCENARIO_RUNS_DIR") or Path(tempfile.gettempdir()) / "scenario-runs")
 
 
 @dataclass
@@ -31,18 +35,49 @@ class RunInfo:
     endpoints: list[str]
     pid: int
     zenoh: dict[str, Any] | None = None  # the run's Zenoh settings (scenario `zenoh:`)
+    id: str = ""  # `<name>-<pid>`: unique among the machine's runs
+    recording: str | None = None
 
 
-def announce(name: str, endpoints: list[str], zenoh_settings: dict[str, Any] | None = None) -> Path:
+def announce(
+    name: str,
+    endpoints: list[str],
+    zenoh_settings: dict[str, Any] | None = None,
+    recording: str | None = None,
+) -> Path:
     """Write the run's discovery file (with the run's Zenoh settings: a tool joining a TLS run needs its
     certificates); the caller removes it at the end (`withdraw`). Readable by this user only."""
-    RUNS_DIR.mkdir(parents=True, exist_ok=True)
-    path = RUNS_DIR / f"{name}.json"
-    info = {"name": name, "endpoints": endpoints, "pid": os.getpid(), "zenoh": zenoh_settings}
-    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    folder = runs_dir()
+    folder.mkdir(parents=True, exist_ok=True)
+    run_id = f"{name}-{os.getpid()}"
+    path = folder / f"{run_id}.json"
+    info = {
+        "id": run_id,
+        "name": name,
+        "endpoints": endpoints,
+        "pid": os.getpid(),
+        "zenoh": zenoh_settings,
+        "recording": recording,
+    }
+    _write(path, info)
+    return path
+
+
+def update_announcement(path: Path | None, **changes: Any) -> None:
+    if path is None:
+        return
+    with contextlib.suppress(OSError, ValueError):
+        info = json.loads(path.read_text())
+        info.update(changes)
+        _write(path, info)
+
+
+def _write(path: Path, info: dict[str, Any]) -> None:
+    tmp = path.with_name(f".{path.name}.{os.getpid()}")
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
     with os.fdopen(fd, "w") as f:
         f.write(json.dumps(info))
-    return path
+    tmp.replace(path)  # readers never see half a file
 
 
 def withdraw(path: Path | None) -> None:
@@ -63,10 +98,18 @@ def _alive(pid: int) -> bool:
 
 def running_runs() -> list[RunInfo]:
     out = []
-    for path in sorted(RUNS_DIR.glob("*.json")) if RUNS_DIR.is_dir() else []:
+    folder = runs_dir()
+    for path in sorted(folder.glob("*.json")) if folder.is_dir() else []:
         try:
             info = json.loads(path.read_text())
-            run = RunInfo(str(info["name"]), list(info["endpoints"]), int(info["pid"]), info.get("zenoh"))
+            run = RunInfo(
+                str(info["name"]),
+                list(info["endpoints"]),
+                int(info["pid"]),
+                info.get("zenoh"),
+                str(info.get("id") or f"{info['name']}-{info['pid']}"),
+                info.get("recording"),
+            )
         except (OSError, ValueError, KeyError, TypeError):
             continue
         if _alive(run.pid):
@@ -83,18 +126,20 @@ def find_run(run: str | None, connect: list[str] | None) -> tuple[str, list[str]
             if len(runs) != 1:
                 raise RunError("with --connect, say which run with --run NAME")
             run = runs[0].name
-        use_run_settings(next((r.zenoh for r in runs if r.name == run), None))
-        return run, list(connect)
-    chosen = [r for r in runs if run is None or r.name == run]
+        known = next((r for r in runs if run in (r.id, r.name)), None)
+        use_run_settings(known.zenoh if known else None)
+        return (known.name if known else run), list(connect)
+    chosen = [r for r in runs if run is None or run in (r.id, r.name)]
     if not chosen:
         what = f"no run named {run!r}" if run else "no scenario is running on this machine"
         raise RunError(
             f"{what}; start one with `scenario run FILE`, or join one with --connect ENDPOINT --run NAME"
         )
     if len(chosen) > 1:
-        raise RunError(
-            "several runs are going: " + ", ".join(r.name for r in chosen) + "; pick one with --run"
+        listed = ", ".join(
+            f"{r.id} ({r.name}" + (f", recording {r.recording}" if r.recording else "") + ")" for r in chosen
         )
+        raise RunError(f"several runs are going: {listed}; pick one with --run ID")
     use_run_settings(chosen[0].zenoh)  # a TLS run: its certificates, for this tool's session too
     return chosen[0].name, [e.replace("0.0.0.0", "127.0.0.1") for e in chosen[0].endpoints]
 

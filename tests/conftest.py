@@ -19,16 +19,19 @@ DIFFBOT = SCENARIOS / "robots" / "diffbot.urdf.xacro"
 
 
 @pytest.fixture(scope="session", autouse=True)
-def _own_cache(tmp_path_factory: pytest.TempPathFactory):
-    """The session's own cache folder (converted meshes, decomposed meshes), inherited by every process the
-    tests start: the user's cache is neither read nor written, and what a test finds there is its own."""
-    before = os.environ.get("XDG_CACHE_HOME")
+def _own_folders(tmp_path_factory: pytest.TempPathFactory):
+    """The session's own cache folder (converted meshes, decomposed meshes) and its own folder where runs
+    announce themselves, inherited by every process the tests start: the user's cache is neither read nor
+    written, and the tools never see a run another suite or the user started beside this one."""
+    saved = {k: os.environ.get(k) for k in ("XDG_CACHE_HOME", "SCENARIO_RUNS_DIR")}
     os.environ["XDG_CACHE_HOME"] = str(tmp_path_factory.mktemp("cache"))
+    os.environ["SCENARIO_RUNS_DIR"] = str(tmp_path_factory.mktemp("runs"))
     yield
-    if before is None:
-        os.environ.pop("XDG_CACHE_HOME", None)
-    else:
-        os.environ["XDG_CACHE_HOME"] = before
+    for key, value in saved.items():
+        if value is None:
+            os.environ.pop(key, None)
+        else:
+            os.environ[key] = value
 
 
 @pytest.fixture

@@ -204,3 +204,57 @@ def test_a_long_run_keeps_its_memory_flat_and_loses_nothing() -> None:
         # the peak on the way may swing with the recorder's queue on a loaded machine, never run away
         assert doc[f"{process}_rss_peak_growth_pct"] < 25.0, doc
     assert doc["assertions_passed"] == doc["assertions"] > 0
+
+
+@pytest.mark.timeout(120)
+def test_two_runs_of_one_scenario_record_apart_and_are_told_apart(write_scenario, tmp_path) -> None:
+    """Two runs of the same scenario at once used to record into the same file (corrupt: the plain reader
+    failed) and announce themselves as one. Now the second takes a numbered recording and says so; both
+    files read whole with mcap's own reader; both runs are listed, by id, and a tool asks which one."""
+    from mcap.reader import make_reader
+
+    from runner.errors import RunError
+    from runner.tools import find_run, running_runs
+
+    path = write_scenario(
+        """
+        name: twice
+        duration: 4
+        rate: 1
+        robots:
+          - {name: r1, description: "{diffbot}", plugins: [{type: diff_drive}]}
+        record: {path: out/}
+        """
+    )
+    procs = [
+        subprocess.Popen(scenario_cmd("run", str(path), "--no-judge"), stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+        for _ in range(2)
+    ]  # fmt: skip
+    try:
+        deadline = time.monotonic() + 60
+        runs = []
+        while time.monotonic() < deadline:
+            runs = [r for r in running_runs() if r.name == "twice"]
+            if len(runs) == 2 and all(r.recording for r in runs) and len({r.recording for r in runs}) == 2:
+                break
+            time.sleep(0.05)
+        assert len(runs) == 2 and len({r.id for r in runs}) == 2, runs
+        with pytest.raises(RunError) as err:
+            find_run("twice", None)
+        assert "several runs are going" in str(err.value) and runs[0].id in str(err.value)
+        assert find_run(runs[1].id, None)[0] == "twice"
+        outs = [p.communicate(timeout=90) for p in procs]
+    finally:
+        for p in procs:
+            p.kill()
+    assert [p.returncode for p in procs] == [0, 0], outs
+    said = [e for _, e in outs if "another run is recording to" in e]
+    assert len(said) == 1, outs
+    files = sorted((tmp_path / "out").glob("*.mcap"))
+    assert [f.name for f in files] == ["twice-2.mcap", "twice.mcap"], files
+    for f in files:
+        with f.open("rb") as stream:
+            clocks = [m for _, ch, m in make_reader(stream).iter_messages() if ch.topic == "twice/clock"]
+        assert len(clocks) >= 300, (f, len(clocks))  # the whole 4 s at 100 Hz, read by mcap's reader
+    assert not list((tmp_path / "out").glob(".*.lock"))  # released at the end
