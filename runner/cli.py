@@ -621,6 +621,9 @@ def _print_summary(result: Any) -> None:
         )
     if result.topics:
         out.print(table)
+    for key, whys in sorted(getattr(result, "rejected", {}).items()):
+        for why, n in whys.items():
+            out.print(f"rejected: {n} message(s) on {key}: {why}", markup=False, style="yellow")
     sim = result.sim_ns / 1e9
     rtf = sim / result.wall_s if result.wall_s > 0 else 0.0
     where = f" -> {result.mcap}" if result.mcap else ""

@@ -38,6 +38,30 @@ DRAIN_TIMEOUT_S = 3.0  # how long the recorder waits for messages still in fligh
 START_TIMEOUT_S = 30.0
 
 
+def _types(plan: RunPlan) -> dict[str, str]:
+    """The type of each key the plan's worlds publish or subscribe: what the recorder accepts there."""
+    out: dict[str, str] = {}
+    for part in plan.every_plan():
+        for robot in part.robots:
+            for p in robot.plugins:
+                for t in p.topics:
+                    out.setdefault(t.key, msgs.normalize_type(t.type))
+        for ev in part.timeline:
+            out.setdefault(ev.key, ev.type)
+    return out
+
+
+def _inbound(plan: RunPlan) -> set[str]:
+    """Keys the worlds subscribe and do not publish themselves: what other processes send them."""
+    subs, pubs = set(), set()
+    for part in plan.every_plan():
+        for robot in part.robots:
+            for p in robot.plugins:
+                for t in p.topics:
+                    (subs if t.direction == "sub" else pubs).add(t.key)
+    return subs - pubs
+
+
 @dataclass
 class RunResult:
     reason: str  # completed | interrupted | failed
@@ -48,6 +72,7 @@ class RunResult:
     published: dict[str, int] = field(default_factory=dict)
     error: str | None = None
     endpoints: list[str] = field(default_factory=list)
+    rejected: dict[str, dict[str, int]] = field(default_factory=dict)  # inbound samples dropped: key, why
 
     @property
     def exit_code(self) -> int:
@@ -241,7 +266,13 @@ def run_plan(
     try:
         if plan.record.enabled:
             try:
-                recorder = Recorder(Path(plan.record.path), plan.record.include, plan.record.exclude)
+                recorder = Recorder(
+                    Path(plan.record.path),
+                    plan.record.include,
+                    plan.record.exclude,
+                    types=_types(plan),
+                    inbound=_inbound(plan),
+                )
             except OSError as e:
                 raise RunError(f"cannot write the recording {plan.record.path}: {e.strerror or e}") from None
             if recorder.path != recorder.asked:
@@ -435,8 +466,16 @@ def run_plan(
     sim_ns = min(int(i.get("sim_ns", fallback)) for i in infos)
     walls = [float(i["wall_s"]) for i in infos if "wall_s" in i]
     published: dict[str, int] = {}
+    rejected: dict[str, dict[str, int]] = {}
     for i in infos:
         published.update(i.get("published", {}))
+        for key, whys in i.get("rejected", {}).items():
+            for why, n in whys.items():
+                rejected.setdefault(key, {})[why] = rejected.get(key, {}).get(why, 0) + n
+    if recorder is not None:
+        for key, whys in recorder.mistyped.items():
+            for why, n in whys.items():
+                rejected.setdefault(key, {}).setdefault(f"not recorded: {why}", n)
     return RunResult(
         reason=reason,
         sim_ns=sim_ns,
@@ -446,6 +485,7 @@ def run_plan(
         published=published,
         error=error,
         endpoints=listen,
+        rejected=rejected,
     )
 
 

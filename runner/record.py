@@ -301,6 +301,8 @@ class Recorder:
     exclude: list[str] = field(default_factory=list)
     library: str = "scenario-runner"
     chunk_size: int = CHUNK_SIZE
+    types: dict[str, str] = field(default_factory=dict)  # the type each known key carries (the plan's)
+    inbound: set[str] = field(default_factory=set)  # keys the worlds take from others: checked to decode
 
     def __post_init__(self) -> None:
         self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -319,6 +321,7 @@ class Recorder:
         self.closed = False
         self.error: OSError | None = None  # what stopped the drain thread's recording, if anything
         self.rejected = 0  # samples the drain thread could not record (an exception each)
+        self.mistyped: dict[str, dict[str, int]] = {}  # key -> why -> samples of another type, not recorded
         self._subscriber: Any = None
         self._drainer: threading.Thread | None = None
         self._taps: dict[str, Callable[[str, int, bytes], None]] = {}
@@ -392,6 +395,18 @@ class Recorder:
         key = str(sample.key_expr)
         att = sample.attachment
         ch = self._channels.get(key)
+        if self.types and key in self.types:
+            given = type_from_encoding(sample.encoding)
+            if given is not None and given != self.types[key] and not given.startswith("foxglove."):
+                # another type on a typed key (a stray publisher): never on that key's channel
+                self._mistyped(key, f"{given}, not {self.types[key]}")
+                return
+            if key in self.inbound:  # what others send the worlds: it must decode, or it is not recorded
+                try:
+                    msgs.decode(sample.payload.to_bytes(), self.types[key])
+                except Exception:
+                    self._mistyped(key, f"payloads that do not decode as {self.types[key]}")
+                    return
         if ch is not None and att is not None:
             raw = att.to_bytes()
             if len(raw) == _ATT_SIZE:
@@ -407,6 +422,12 @@ class Recorder:
                 self.latest_ns = max(self.latest_ns, parsed[1])
             return
         self._write(key, type_from_encoding(sample.encoding), sample.payload.to_bytes(), parsed)
+
+    def _mistyped(self, key: str, why: str) -> None:
+        counts = self.mistyped.setdefault(key, {})
+        if why not in counts:
+            print(f"recorder: not recording messages on {key}: {why}", file=sys.stderr, flush=True)
+        counts[why] = counts.get(why, 0) + 1
 
     def write(self, key: str, type_name: str | None, payload: bytes, att: tuple[int, int] | None) -> None:
         """Record one message: `att` is (sequence number, sim time ns) or None (no attachment)."""

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+import struct
 import subprocess
 import time
 from pathlib import Path
@@ -258,3 +260,76 @@ def test_two_runs_of_one_scenario_record_apart_and_are_told_apart(write_scenario
             clocks = [m for _, ch, m in make_reader(stream).iter_messages() if ch.topic == "twice/clock"]
         assert len(clocks) >= 300, (f, len(clocks))  # the whole 4 s at 100 Hz, read by mcap's reader
     assert not list((tmp_path / "out").glob(".*.lock"))  # released at the end
+
+
+@pytest.mark.timeout(120)
+def test_a_stray_publisher_on_cmd_vel_is_rejected_counted_and_never_recorded(
+    write_scenario, tmp_path
+) -> None:
+    """A careless neighbour publishes on the robot's cmd_vel: a 52-byte std_msgs/String (a Twist's size:
+    it was taken as a Twist with linear.x = 1e161) and typed garbage that does not decode. Both are dropped
+    and counted (said once on stderr, and in the end-of-run table), the robot does not move, and the MCAP
+    decodes whole with mcap_ros2's reader (nothing foreign on the Twist channel)."""
+    import zenoh
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+
+    from runner.transport import free_port, make_config
+
+    port = free_port()
+    path = write_scenario(
+        """
+        name: stray
+        duration: 6
+        rate: 1
+        robots:
+          - {name: r1, description: "{diffbot}", plugins: [{type: diff_drive}, {type: ground_truth}]}
+        """
+    )
+    mcap = tmp_path / "stray.mcap"
+    proc = subprocess.Popen(
+        scenario_cmd("run", str(path), "--no-judge", "--listen", f"tcp/127.0.0.1:{port}", "--record", str(mcap)),
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        session = None
+        deadline = time.monotonic() + 40
+        while session is None and time.monotonic() < deadline:
+            try:
+                session = zenoh.open(make_config("peer", connect=[f"tcp/127.0.0.1:{port}"]))
+            except zenoh.ZError:
+                time.sleep(0.1)
+        assert session is not None
+        string = bytes([0, 1, 0, 0]) + struct.pack("<I", 44) + b"x" * 43 + b"\0"  # 52 bytes of String CDR
+        as_string = session.declare_publisher(
+            "stray/r1/cmd_vel", encoding=zenoh.Encoding.APPLICATION_CDR.with_schema("std_msgs/msg/String")
+        )
+        garbage = session.declare_publisher(
+            "stray/r1/cmd_vel", encoding=zenoh.Encoding.APPLICATION_CDR.with_schema("geometry_msgs/msg/Twist")
+        )
+        for _ in range(40):
+            as_string.put(string)
+            garbage.put(b"\x00\x01")
+            time.sleep(0.05)
+        session.close()
+        out, err = proc.communicate(timeout=90)
+    finally:
+        proc.kill()
+    assert proc.returncode == 0, err
+    assert (
+        err.count("dropping messages on stray/r1/cmd_vel: std_msgs/msg/String, not geometry_msgs/msg/Twist")
+        == 1
+    )
+    assert "do not decode as geometry_msgs/msg/Twist" in err
+    rejected = dict(
+        (why, int(n)) for n, why in re.findall(r"rejected: (\d+) message\(s\) on stray/r1/cmd_vel: (.*)", out)
+    )
+    # every one of the 80 was either dropped by the world or not recorded (or sent before the run listened)
+    assert rejected.get("not recorded: std_msgs/msg/String, not geometry_msgs/msg/Twist", 0) >= 1, out
+    assert rejected.get("not recorded: payloads that do not decode as geometry_msgs/msg/Twist", 0) >= 1, out
+    with mcap.open("rb") as f:
+        decoded = list(make_reader(f, decoder_factories=[DecoderFactory()]).iter_decoded_messages(
+            topics=["stray/r1/ground_truth", "stray/r1/cmd_vel"]))  # fmt: skip
+    assert not [m for _, ch, _, m in decoded if ch.topic == "stray/r1/cmd_vel"]
+    truth = [m for _, ch, _, m in decoded if ch.topic == "stray/r1/ground_truth"]
+    assert truth and max(abs(m.twist.twist.linear.x) for m in truth) < 0.01  # the robot stayed put

@@ -95,6 +95,7 @@ def main(argv: list[str] | None = None) -> int:
                         "steps": stats.steps,
                         "wall_s": stats.wall_s,
                         "published": stats.published,
+                        "rejected": stats.rejected,
                         "error": stats.error,
                     }
                 ).encode()

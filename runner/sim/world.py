@@ -137,6 +137,7 @@ class WorldStats:
     wall_s: float = 0.0
     published: dict[str, int] = field(default_factory=dict)
     error: str | None = None  # why the world stopped early on its own (physics went unstable)
+    rejected: dict[str, dict[str, int]] = field(default_factory=dict)  # inbound samples dropped: key, why
 
 
 # MuJoCo's warnings for NaN/Inf/huge positions, velocities, accelerations: it then resets the data and goes
@@ -304,7 +305,11 @@ class World:
                 try:
                     msg = msgs.decode(payload, type_name)
                 except Exception:
-                    continue  # not a message of the subscribed type; a foreign publisher's mistake
+                    # not a message of the subscribed type: a foreign publisher's mistake, dropped and counted
+                    reject = getattr(self.bus, "reject", None)
+                    if reject is not None:
+                        reject(key, f"{len(payload)} bytes that do not decode as {type_name}")
+                    continue
                 cb(msg, self.now_ns)
 
     # ------------------------------------------------------------------------------------------- loop
@@ -516,7 +521,15 @@ class World:
         for link in self.remote_renders.values():
             link.close()
         gc.unfreeze()  # collectable again (a process that builds several worlds must not keep them all)
-        return WorldStats(steps=steps, sim_ns=self.now_ns, wall_s=wall_s, published=published, error=error)
+        rejected = {k: dict(v) for k, v in getattr(self.bus, "rejected", {}).items()}
+        return WorldStats(
+            steps=steps,
+            sim_ns=self.now_ns,
+            wall_s=wall_s,
+            published=published,
+            error=error,
+            rejected=rejected,
+        )
 
     def _instability(self, t0_ns: int, t1_ns: int) -> str:
         """What went unstable, where (the joint of the degree of freedom MuJoCo names, and its robot)."""

@@ -15,6 +15,7 @@ import json
 import os
 import socket
 import struct
+import sys
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
@@ -129,6 +130,7 @@ class ZenohBus:
     def __init__(self, session: zenoh.Session, graph: Any = None, best_effort: Sequence[str] = ()):
         self.session = session
         self.graph = graph
+        self.rejected: dict[str, dict[str, int]] = {}  # key -> why -> how many inbound samples were dropped
         self.best_effort = [zenoh.KeyExpr(e) for e in best_effort]
         self._keep: list[Any] = []
         self._pubs: list[Any] = []
@@ -161,12 +163,24 @@ class ZenohBus:
 
         def on_sample(sample: zenoh.Sample) -> None:
             att = sample.attachment
+            given = type_from_encoding(sample.encoding)
+            if type_name is not None and given is not None and given != type_name:
+                # another type on this key (a stray publisher): never delivered as the subscribed type
+                self.reject(str(sample.key_expr), f"{given}, not {type_name}")
+                return
             callback(str(sample.key_expr), sample.payload.to_bytes(), att.to_bytes() if att else None)
 
         # REMOTE only: what this process publishes is delivered to its own plugins directly, in order.
         self._keep.append(
             self.session.declare_subscriber(key, on_sample, allowed_origin=zenoh.Locality.REMOTE)
         )
+
+    def reject(self, key: str, why: str) -> None:
+        """Count a dropped inbound sample; the first of each kind on a key is said on stderr."""
+        counts = self.rejected.setdefault(key, {})
+        if why not in counts:
+            print(f"world: dropping messages on {key}: {why} (another publisher's mistake)", file=sys.stderr)
+        counts[why] = counts.get(why, 0) + 1
 
     def all_matched(self) -> bool:
         """Whether every publisher declared so far has a subscriber somewhere."""
@@ -186,6 +200,7 @@ class MemoryBus:
     """An in-process bus for unit tests of logic: keeps what was published, lets a test inject input."""
 
     def __init__(self) -> None:
+        self.rejected: dict[str, dict[str, int]] = {}
         self.sent: list[tuple[str, str, bytes, bytes]] = []
         self._subs: dict[str, list[Callable[[str, bytes, bytes | None], None]]] = {}
 
@@ -199,6 +214,10 @@ class MemoryBus:
         self, key: str, callback: Callable[[str, bytes, bytes | None], None], type_name: str | None = None
     ) -> None:
         self._subs.setdefault(key, []).append(callback)
+
+    def reject(self, key: str, why: str) -> None:
+        counts = self.rejected.setdefault(key, {})
+        counts[why] = counts.get(why, 0) + 1
 
     def inject(self, key: str, payload: bytes, attachment: bytes | None = None) -> None:
         for cb in self._subs.get(key, []):
