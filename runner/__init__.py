@@ -1,6 +1,26 @@
 """scenario-runner: declarative YAML robot-simulation scenarios (URDF/xacro, MuJoCo, Zenoh, MCAP)."""
 
-from runner.gl import ensure_gl_backend
+
+def _quiet_early_signals() -> None:
+    """Ctrl-C or SIGTERM while the `scenario` command (or one of its `python -m runner...` processes) is
+    still importing: nothing has started and nothing is recorded yet, so it ends at once with 130 / 143,
+    without a KeyboardInterrupt traceback. The command's `main` replaces these handlers once it runs.
+    Left alone when runner is imported as a library (by tests, by a user's program)."""
+    import os
+    import signal
+    import sys
+
+    first = os.path.basename(sys.argv[0]) if sys.argv else ""
+    if first not in ("scenario", "-m") and not first.startswith("scenario"):
+        return
+    for sig, code in ((signal.SIGINT, 130), (signal.SIGTERM, 143)):
+        if signal.getsignal(sig) in (signal.SIG_DFL, signal.default_int_handler):
+            signal.signal(sig, lambda *_, code=code: os._exit(code))
+
+
+_quiet_early_signals()
+
+from runner.gl import ensure_gl_backend  # noqa: E402
 
 # We never open a window: render offscreen (EGL, else OSMesa) unless the user chose a backend. MuJoCo reads
 # MUJOCO_GL once, when it is first imported, so this runs before any of our modules imports it.

@@ -257,8 +257,8 @@ def run(
         plans = _load_variants(file, record, variant)
     except ScenarioError as e:
         raise _fail(e) from None
-    # SIGTERM ends the run like Ctrl-C: in order, with the recording finished.
-    signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(KeyboardInterrupt()))
+    # SIGTERM ends the run like Ctrl-C: in order, with the recording finished (exit 143, Ctrl-C's 130).
+    signal.signal(signal.SIGTERM, _terminated)
     suites = []
     code = 0
     for i, (label, plan) in enumerate(plans):
@@ -294,7 +294,7 @@ def run(
     if results_json is not None:
         data = suites[0].to_json() if len(suites) == 1 else {"variants": [s.to_json() for s in suites]}
         results_json.write_text(json.dumps(data, indent=2))
-    raise typer.Exit(code)
+    raise typer.Exit(143 if code == 130 and _TERMINATED else code)
 
 
 def _load_variants(file: Path, record: str | None, variant: int | None) -> list[tuple[str, Any]]:
@@ -1230,11 +1230,27 @@ def bench(ctx: typer.Context) -> None:
 
 
 def main() -> None:
+    # From here Ctrl-C raises KeyboardInterrupt (a run stops its worlds and finishes its recording) and
+    # SIGTERM does the same; either, escaping a command, ends it with 130 / 143 and no traceback.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, _terminated)
     try:
         app()
     except ScenarioError as e:  # a user mistake that escaped a command: still no traceback
         err.print("error: " + e.render(), markup=False, style="red")
         sys.exit(1)
+    except KeyboardInterrupt:
+        err.print("interrupted", markup=False)
+        sys.exit(143 if _TERMINATED else 130)
+
+
+_TERMINATED = False
+
+
+def _terminated(*_: Any) -> None:
+    global _TERMINATED
+    _TERMINATED = True
+    raise KeyboardInterrupt
 
 
 if __name__ == "__main__":

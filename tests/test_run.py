@@ -309,3 +309,43 @@ def test_an_endpoint_without_its_protocol_is_a_clear_error_not_a_traceback() -> 
         assert r.returncode == 1, r.stderr
         assert f"{option} '127.0.0.1:7447': not a Zenoh endpoint" in r.stderr, r.stderr
         assert "tcp/127.0.0.1:7447" in r.stderr and "Traceback" not in r.stderr
+
+
+@pytest.mark.timeout(120)
+@pytest.mark.parametrize("after", [0.1, 0.5, 1.0, 2.0, 3.0])
+def test_ctrl_c_at_any_moment_of_start_up_ends_the_run_at_once(after: float) -> None:
+    """SIGINT while the command imports, compiles, starts its worlds or runs: exit 130 within 2 s, no
+    traceback from the runner or its worlds (it used to be lost in the first seconds: the run went on)."""
+    proc = subprocess.Popen(
+        scenario_cmd("run", str(SCENARIOS / "two_robots.yaml"), "--no-record", "--rate", "1"),
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        time.sleep(after)
+        t0 = time.monotonic()
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=30)
+        elapsed = time.monotonic() - t0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, err
+    assert elapsed < 2.0, elapsed
+    assert "Traceback" not in err, err
+
+
+@pytest.mark.timeout(60)
+def test_sigterm_ends_a_run_with_143() -> None:
+    proc = subprocess.Popen(
+        scenario_cmd("run", str(SCENARIOS / "two_robots.yaml"), "--no-record", "--rate", "1"),
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        time.sleep(2.5)
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 143, err
+    assert "Traceback" not in err, err
