@@ -243,6 +243,12 @@ def run(
       scenario run scenarios/two_robots.yaml --rate realtime --foxglove 8765
       scenario run fleet.yaml --host gpu_box
     """
+    # Until a run starts its processes (loading, compiling), Ctrl-C and SIGTERM end the command at once:
+    # nothing is started or recorded yet. Then (runner.launch) they stop the run in order, recording kept.
+    import os
+
+    signal.signal(signal.SIGINT, lambda *_: os._exit(130))
+    signal.signal(signal.SIGTERM, lambda *_: os._exit(143))
     parsed_rate = _parse_rate(rate)
     for option, values in (("--listen", listen), ("--connect", connect)):
         for value in values or []:
@@ -257,8 +263,6 @@ def run(
         plans = _load_variants(file, record, variant)
     except ScenarioError as e:
         raise _fail(e) from None
-    # SIGTERM ends the run like Ctrl-C: in order, with the recording finished (exit 143, Ctrl-C's 130).
-    signal.signal(signal.SIGTERM, _terminated)
     suites = []
     code = 0
     for i, (label, plan) in enumerate(plans):
@@ -294,7 +298,9 @@ def run(
     if results_json is not None:
         data = suites[0].to_json() if len(suites) == 1 else {"variants": [s.to_json() for s in suites]}
         results_json.write_text(json.dumps(data, indent=2))
-    raise typer.Exit(143 if code == 130 and _TERMINATED else code)
+    from runner import launch
+
+    raise typer.Exit(143 if code == 130 and (_TERMINATED or launch.TERMINATED) else code)
 
 
 def _load_variants(file: Path, record: str | None, variant: int | None) -> list[tuple[str, Any]]:
@@ -656,6 +662,13 @@ def info(mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")]) -> 
         )
     out.print(table)
     out.print(f"{s['messages']} messages, sim time {start / 1e9:.3f} s .. {end / 1e9:.3f} s ({span:.3f} s)")
+    stopped = s.get("stopped")
+    if stopped:
+        out.print(
+            f"stopped early: {stopped.get('stopped', 'the recording ended')} ({stopped.get('error', '?')}); "
+            f"it holds everything up to {end / 1e9:.3f} s sim, and is complete",
+            markup=False,
+        )
     if s["cut"]:
         out.print(
             f"cut: the recording has no summary (its runner was killed); it reaches {end / 1e9:.3f} s sim, "

@@ -38,6 +38,27 @@ DRAIN_TIMEOUT_S = 3.0  # how long the recorder waits for messages still in fligh
 START_TIMEOUT_S = 30.0
 
 
+TERMINATED = False  # the run was ended by SIGTERM (exit 143), not Ctrl-C (130)
+
+
+def _arm_interrupts() -> None:
+    """Ctrl-C raises KeyboardInterrupt and SIGTERM does the same (the run loop stops every part in order
+    and finishes the recording). Until a run starts processes, the command ends at once instead (nothing to
+    stop, nothing recorded): see `runner._quiet_early_signals` and `runner.cli.run`."""
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return
+
+    def terminated(*_: Any) -> None:
+        global TERMINATED
+        TERMINATED = True
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, terminated)
+
+
 def _types(plan: RunPlan) -> dict[str, str]:
     """The type of each key the plan's worlds publish or subscribe: what the recorder accepts there."""
     out: dict[str, str] = {}
@@ -215,6 +236,7 @@ def run_plan(
 
     With `plan.hosts`, this runner plays `host` (None: the first, main host, which records and judges);
     the parts placed on other hosts are run by their own `scenario run FILE --host NAME`, and joined."""
+    _arm_interrupts()  # from here on, processes start: Ctrl-C stops them in order and keeps the recording
     if plan.hosts and host not in (None, plan.main_host):
         return _run_member(plan, host, connect=connect, listen=listen)  # type: ignore[arg-type]
     if plan.hosts and not listen:
@@ -368,6 +390,12 @@ def run_plan(
                 time.sleep(0.05)
                 if recorder is not None:
                     recorder.flush_stale(1.0)  # killed outright, the file loses at most a second
+                    if recorder.error is not None and error is None:
+                        # the disk is full (or the file cannot be written): nothing more can be kept
+                        why = recorder.error.strerror or str(recorder.error)
+                        reason, error = "failed", f"the recording stopped: {why} ({recorder.path})"
+                        print(error + "; stopping the run", file=sys.stderr, flush=True)
+                        stop_all()
                 all_ready = all(p.ready.is_set() for p in parts) and bridge_ready.is_set()
                 if all_ready and not started["at"]:
                     started["at"] = time.perf_counter()

@@ -19,6 +19,7 @@ another process with none lost, ~6 µs of CPU per message in the recording proce
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import struct
 import sys
@@ -41,6 +42,8 @@ from mcap.records import (
     DataEnd,
     Header,
     McapRecord,
+    Metadata,
+    MetadataIndex,
     Schema,
     Statistics,
     SummaryOffset,
@@ -134,10 +137,32 @@ class _McapFile:
         self._end_ns = 0
         self._pos = 0
         self._write(_MAGIC + _record_bytes(Header(profile=profile, library=library)))
+        self._good = self._pos  # the end of the last chunk written whole
+        self._chunk_counts: list[dict[int, int]] = []  # messages per channel of each chunk written
+        self.note: dict[str, str] = {}  # written as a metadata record `scenario` by `finish`
 
     def _write(self, data: bytes | bytearray) -> None:
-        self._stream.write(data)
+        view = memoryview(data)
+        while view:
+            n = self._stream.write(view)  # an unbuffered file may take part of it (a disk filling up)
+            if n is None or n >= len(view):
+                break
+            if n == 0:
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+            view = view[n:]
         self._pos += len(data)
+
+    def cut_back(self) -> None:
+        """After a failed write (a full disk): drop what was written of the chunk that failed, so the file
+        ends with whole chunks and `finish` can add its summary in the space that freed."""
+        good = self._good
+        fd = self._stream.fileno()
+        os.ftruncate(fd, good)
+        os.lseek(fd, good, os.SEEK_SET)
+        self._pos = good
+        self.chunk.clear()
+        for ch in self._by_id.values():
+            del ch.index[:]
 
     def register_schema(self, name: str, encoding: str, data: bytes) -> int:
         schema = Schema(id=len(self._schemas) + 1, data=data, encoding=encoding, name=name)
@@ -218,6 +243,7 @@ class _McapFile:
                 _MESSAGE_INDEX_HEAD.pack(int(Opcode.MESSAGE_INDEX), 6 + len(data), channel_id, len(data))
             )
             self._write(data)
+        self._chunk_counts.append({cid: len(data) // 16 for cid, data in indexes})  # (stamp, offset) pairs
         self._chunk_indexes.append(
             ChunkIndex(
                 message_start_time=start,
@@ -234,11 +260,38 @@ class _McapFile:
         # Handed to the OS with every chunk: a runner killed outright (kill -9) leaves a file readable up
         # to its last chunk (`scenario info` says so, `scenario recover` completes it)
         self._stream.flush()
+        self._good = self._pos
         self.flushed_at = time.monotonic()
+
+    def finish_in_room(self) -> int:
+        """`finish`, after a failed write: where the summary does not fit in what cutting back freed (a
+        full disk, a size limit), the last chunks are given up one by one until it does. Returns how many
+        chunks were given up."""
+        given_up = 0
+        while True:
+            try:
+                self.finish()
+                return given_up
+            except OSError:
+                if not self._chunk_indexes:
+                    raise
+            last = self._chunk_indexes.pop()
+            for cid, n in self._chunk_counts.pop().items():
+                self._by_id[cid].stats.count -= n
+            self._good = last.chunk_start_offset
+            self.cut_back()
+            self._end_ns = max((c.message_end_time for c in self._chunk_indexes), default=0)
+            given_up += 1
 
     def finish(self) -> None:
         """Write the last chunk, the summary and the footer. Does not close the stream."""
         self.flush_chunk()
+        metadata_index = []
+        if self.note:
+            start = self._pos
+            record = _record_bytes(Metadata(name="scenario", metadata=dict(self.note)))
+            self._write(record)
+            metadata_index.append(MetadataIndex(offset=start, length=len(record), name="scenario"))
         self._write(_record_bytes(DataEnd(data_section_crc=0)))
         summary_start = self._pos
         summary = RecordBuilder()
@@ -261,13 +314,14 @@ class _McapFile:
             message_count=sum(counts.values()),
             message_end_time=self._end_ns,
             message_start_time=self._start_ns or 0,
-            metadata_count=0,
+            metadata_count=len(metadata_index),
             schema_count=len(self._schemas),
         )
         group(Opcode.SCHEMA, self._schemas)
         group(Opcode.CHANNEL, self._channels)
         group(Opcode.STATISTICS, [stats])
         group(Opcode.CHUNK_INDEX, self._chunk_indexes)
+        group(Opcode.METADATA_INDEX, metadata_index)
         summary_offset_start = summary_start + summary.count
         for o in offsets:
             o.write(summary)
@@ -308,7 +362,9 @@ class Recorder:
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self.asked = self.path  # the path the plan gave; `path` is the one recorded to (see `_claim`)
         self.path, self._claim_fd = _claim(self.path)
-        self._file: IO[bytes] = open(self.path, "wb")  # noqa: SIM115 - closed in close()
+        # unbuffered: whole chunks are written at once, and a failed write (a full disk) leaves no buffer
+        # behind that a later flush would write past the point the file is cut back to
+        self._file: IO[bytes] = open(self.path, "wb", buffering=0)  # noqa: SIM115 - closed in close()
         self._mcap = _McapFile(self._file, profile="ros2", library=self.library, chunk_size=self.chunk_size)
         self._lock = threading.Lock()
         self._schemas: dict[str, int] = {}
@@ -382,6 +438,8 @@ class Recorder:
                 return
             except OSError as e:  # the disk is full...: stop recording, say it once, keep the queue moving
                 self.error = e
+                with contextlib.suppress(OSError):
+                    self._mcap.cut_back()  # the file ends with whole chunks: `close` adds the summary
                 print(f"recorder: recording stopped: {e}", file=sys.stderr, flush=True)
             except Exception as e:  # one sample that cannot be recorded (as a callback's would): skip it
                 self.rejected += 1
@@ -512,8 +570,16 @@ class Recorder:
         """Write the chunk being built if the last one went out more than `max_age_s` ago: a slow run
         killed outright loses at most that much (the runner calls this as it watches the run)."""
         with self._lock:
-            if not self.closed and self._mcap.chunk and time.monotonic() - self._mcap.flushed_at > max_age_s:
-                self._mcap.flush_chunk()
+            if self.closed or self.error is not None:
+                return
+            if self._mcap.chunk and time.monotonic() - self._mcap.flushed_at > max_age_s:
+                try:
+                    self._mcap.flush_chunk()
+                except OSError as e:  # the disk is full: as in the drain thread
+                    self.error = e
+                    with contextlib.suppress(OSError):
+                        self._mcap.cut_back()
+                    print(f"recorder: recording stopped: {e}", file=sys.stderr, flush=True)
 
     def close(self) -> None:
         """Stop recording (what `subscribe` queued first) and finish the file. Idempotent."""
@@ -527,8 +593,24 @@ class Recorder:
             if self.closed:
                 return
             self.closed = True
+            if self.error is not None:
+                self._mcap.note = {
+                    "stopped": "the recording could not be written",
+                    "error": self.error.strerror or str(self.error),
+                }
             try:
-                self._mcap.finish()
+                if self.error is not None:
+                    self._mcap.finish_in_room()
+                else:
+                    self._mcap.finish()
+            except OSError as e:  # not even the summary fits: the file stays readable chunk by chunk
+                self.error = self.error or e
+                print(
+                    f"recorder: the recording's summary could not be written ({e.strerror or e}); "
+                    f"`scenario recover {self.path}` completes it",
+                    file=sys.stderr,
+                    flush=True,
+                )
             finally:
                 self._file.close()
                 with contextlib.suppress(OSError):  # the path is free for the next run
@@ -573,12 +655,19 @@ def read_summary(path: Path) -> dict[str, Any]:
                     "count": stats.channel_message_counts.get(cid, 0),
                 }
             )
+        stopped = None
+        for index in summary.metadata_indexes if hasattr(summary, "metadata_indexes") else []:
+            if index.name == "scenario":
+                with contextlib.suppress(McapError, struct.error, ValueError, EOFError):
+                    meta = next((m for m in make_reader(f).iter_metadata() if m.name == "scenario"), None)
+                    stopped = dict(meta.metadata) if meta is not None else None
         return {
             "start_ns": stats.message_start_time,
             "end_ns": stats.message_end_time,
             "messages": stats.message_count,
             "topics": topics,
             "cut": False,
+            "stopped": stopped,  # why the recording ended early, when it says so (a full disk)
         }
 
 

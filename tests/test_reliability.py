@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import signal
 import struct
 import subprocess
 import time
@@ -333,3 +334,43 @@ def test_a_stray_publisher_on_cmd_vel_is_rejected_counted_and_never_recorded(
     assert not [m for _, ch, _, m in decoded if ch.topic == "stray/r1/cmd_vel"]
     truth = [m for _, ch, _, m in decoded if ch.topic == "stray/r1/ground_truth"]
     assert truth and max(abs(m.twist.twist.linear.x) for m in truth) < 0.01  # the robot stayed put
+
+
+@pytest.mark.timeout(120)
+def test_a_recording_that_cannot_be_written_stops_the_run_at_once_and_stays_readable(tmp_path) -> None:
+    """A full disk mid-run (here the process's file-size limit, which fails a write the same way, with no
+    mount needed): the recorder used to say "recording stopped" while the sim went on for 40 s, then a
+    traceback and no table. Now the run stops at once with exit 1 and the reason, prints its table, and
+    the file ends with whole chunks and a summary: mcap's own reader reads it, `scenario info` says why it
+    stopped."""
+    import resource
+
+    from mcap.reader import make_reader
+
+    limit = 3_000_000
+
+    def small_disk() -> None:
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails (EFBIG) instead
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    mcap = tmp_path / "full.mcap"
+    t0 = time.monotonic()
+    r = subprocess.run(
+        scenario_cmd("run", str(REPO / "scenarios" / "two_robots.yaml"), "--no-judge", "--duration", "600",
+                     "--record", str(mcap)),
+        capture_output=True, text=True, timeout=100, preexec_fn=small_disk,
+    )  # fmt: skip
+    assert r.returncode == 1, r.stderr[-2000:]
+    assert "Traceback" not in r.stderr, r.stderr[-3000:]
+    assert "the recording stopped: File too large" in r.stderr, r.stderr[-2000:]
+    assert "Recorded" in r.stdout and "failed:" in r.stdout, r.stdout[-2000:]
+    assert time.monotonic() - t0 < 60  # not the 600 s asked for
+    assert mcap.stat().st_size <= limit
+    with mcap.open("rb") as f:
+        clocks = [m.log_time for _, ch, m in make_reader(f).iter_messages() if ch.topic == "two_robots/clock"]
+    assert len(clocks) > 100 and clocks == sorted(clocks)
+    info = subprocess.run(scenario_cmd("info", str(mcap)), capture_output=True, text=True, timeout=60)
+    assert (
+        info.returncode == 0
+        and "stopped early: the recording could not be written (File too large)" in info.stdout
+    )
