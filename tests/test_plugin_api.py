@@ -32,14 +32,25 @@ timeline:
 
 
 @pytest.fixture(scope="module")
-def installed() -> None:
+def installed(tmp_path_factory: pytest.TempPathFactory):
+    """The package installed as pip installs it (its .dist-info and entry points), but into a folder of
+    this test's, put on PYTHONPATH for the processes it starts: the user's environment is not touched."""
+    import os
+
+    target = tmp_path_factory.mktemp("site")
     proc = subprocess.run(
-        [sys.executable, "-m", "pip", "install", "-q", "--no-deps", str(PACKAGE)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+        [sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target",
+         str(target), str(PACKAGE)],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
     assert proc.returncode == 0, proc.stderr
+    before = os.environ.get("PYTHONPATH")
+    os.environ["PYTHONPATH"] = os.pathsep.join([str(target), *([before] if before else [])])
+    yield target
+    if before is None:
+        os.environ.pop("PYTHONPATH", None)
+    else:
+        os.environ["PYTHONPATH"] = before
 
 
 @pytest.mark.timeout(180)
