@@ -229,7 +229,15 @@ def test_a_required_node_lost_on_the_other_host_fails_the_run(
             out = subprocess.run(["pgrep", "-f", "python.* node.py"], capture_output=True, text=True).stdout
             node = next((int(p) for p in out.split() if _ancestor(int(p), far.pid)), None)
         assert node is not None, "the node did not start"
-        time.sleep(1.5)
+        # killed once its commands are in the recording (its whole chunks, read as they are written),
+        # however long the start took on a loaded machine
+        from runner.record import read_summary
+
+        while time.monotonic() < deadline + 40:
+            counts = {t["topic"]: t["count"] for t in read_summary(mcap)["topics"]} if mcap.exists() else {}
+            if counts.get("spread/yonder/r2/cmd_vel", 0) >= 5:
+                break
+            time.sleep(0.3)
         os.kill(node, signal.SIGKILL)
         main_out, main_err = main.communicate(timeout=30)
         _far_out, far_err = far.communicate(timeout=30)
