@@ -6,6 +6,7 @@ Used for the scenario itself and for every plugin's `Params` (with a path prefix
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import re
 from typing import Any, TypeVar, get_args, get_origin
@@ -259,7 +260,7 @@ def problems_from_validation(
             )
             continue
         for e, value, missing in errs:
-            problems.append(_problem(e, value, missing, path, doc, model, prefix, data))
+            problems.append(_with_hint(_problem(e, value, missing, path, doc, model, prefix, data), value))
     return problems
 
 
@@ -370,6 +371,58 @@ def _problem(
         expected = expected.split(", unable to parse")[0]
         return Problem("wrong value", doc.locate(full), full, expected=expected, found=_short(value))
     return Problem(msg, doc.locate(full), full, found=_short(value))
+
+
+# Units people write after numbers, and what the scenario wants instead (SI: seconds, metres, radians)
+_UNITS = {
+    "ms": ("seconds", 1e-3),
+    "s": ("seconds", 1.0),
+    "sec": ("seconds", 1.0),
+    "us": ("seconds", 1e-6),
+    "mm": ("metres", 1e-3),
+    "cm": ("metres", 1e-2),
+    "m": ("metres", 1.0),
+    "km": ("metres", 1e3),
+    "deg": ("radians", 3.141592653589793 / 180),
+    "°": ("radians", 3.141592653589793 / 180),
+    "rad": ("radians", 1.0),
+    "hz": ("Hz", 1.0),
+    "kg": ("kilograms", 1.0),
+    "g": ("kilograms", 1e-3),
+}
+_SYNONYMS = {"cube": "box", "ball": "sphere", "cylinder": "cylinder", "tube": "cylinder", "rect": "box"}
+_NUMBER_WITH_UNIT = re.compile(r"^\s*([-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)\s*([a-zA-Z°]+)\s*$")
+
+
+def _with_hint(problem: Problem, value: Any) -> Problem:
+    """Every problem says what to do: a number written with its unit gets the plain number in SI units,
+    a word close to (or meaning) an allowed one gets it, and anything else a hint from what was expected."""
+    if problem.hint:
+        return problem
+    expected = problem.expected or ""
+    hint = None
+    if isinstance(value, str) and "number" in expected:
+        m = _NUMBER_WITH_UNIT.match(value)
+        if m and m.group(2).lower() in _UNITS:
+            unit, factor = _UNITS[m.group(2).lower()]
+            hint = f"numbers are plain, in {unit}: write {float(m.group(1)) * factor:g}"
+        else:
+            hint = "write a plain number (SI units: metres, seconds, radians), without quotes"
+    elif isinstance(value, str) and expected:
+        options = re.findall(r"'([^']+)'", expected)
+        word = value.strip().lower()
+        close = [_SYNONYMS[word]] if _SYNONYMS.get(word) in options else []
+        close = close or difflib.get_close_matches(word, options, n=1)
+        hint = (
+            f"did you mean {close[0]!r}?"
+            if close
+            else (f"use one of: {', '.join(options)}" if options else None)
+        )
+    if hint is None and expected:
+        hint = f"give {expected}"
+    if hint is None:
+        hint = "see the scenario's JSON schema (`scenario schema`) for what this key takes"
+    return dataclasses.replace(problem, hint=hint)
 
 
 def validate_model(model: type[M], data: Any, doc: Document, prefix: PathKey = ()) -> M:
