@@ -659,3 +659,21 @@ def test_skid_steer_moves_as_commanded_with_gazebo_friction_directions(tmp_path:
     # isotropic wheels (mu1 = mu2, as Gazebo then is): no pair, they scrub and turn much less
     _, _, _, iso = _drive_and_turn(tmp_path, _four_wheels(SKID_DRIVE))
     assert iso < 0.6 * turned, (iso, turned)
+
+
+def test_a_plugin_parameter_that_is_not_a_number_is_said_at_its_line(tmp_path: Path):
+    """`<wheelSeparation>wide</wheelSeparation>` was taken without a word (as no value at all). Gazebo logs
+    that it cannot read it and uses its default; we do the same, with a warning at the tag."""
+    urdf = _four_wheels(
+        SKID_DRIVE.replace(
+            "<wheelSeparation>0.34</wheelSeparation>", "<wheelSeparation>wide</wheelSeparation>"
+        )
+    )
+    plan, text = compile_with_notices(_write(tmp_path, urdf, 1.0))
+    assert (
+        "<wheelSeparation> 'wide' in <plugin filename='libgazebo_ros_skid_steer_drive.so'> is not a number"
+        in text
+    ), text
+    assert "robot.urdf:" in text and "write a plain number" in text
+    skid = next(p for p in plan.robots[0].plugins if p.type == "skid_steer")
+    assert skid.params.get("wheel_separation") is None  # its default: measured from the model

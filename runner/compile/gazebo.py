@@ -105,6 +105,7 @@ class _Reader:
         self.single: set[str] = set()  # tags read as one value: a repeated one is reported, not dropped
         # elements read one by one, kept alive: lxml hands out the same proxy only while one is referenced
         self._taken: list[Any] = []
+        self.not_numbers: list[tuple[Any, str | None]] = []  # (element, text) asked as a number, not one
 
     def child(self, *names: str) -> Any | None:
         for n in names:
@@ -138,6 +139,8 @@ class _Reader:
         try:
             return float(t) if t is not None else None
         except ValueError:
+            # Gazebo logs that it cannot read it and uses its default: so do we, said at the tag
+            self.not_numbers.append((self.child(*names), t))
             return None
 
     def bool(self, *names: str) -> bool | None:
@@ -208,6 +211,17 @@ class GazeboReader:
         self.notices.add(message, file, line, hint)
 
     def ignored(self, reader: _Reader, context: str) -> None:
+        seen: set[int] = set()
+        for el, text in reader.not_numbers:
+            if el is None or id(el) in seen:
+                continue
+            seen.add(id(el))
+            self.note(
+                el,
+                f"<{el.tag}> {text!r} in {context} is not a number: it is not used (Gazebo falls back to "
+                "its default too)",
+                hint=f"write a plain number, e.g. <{el.tag}>0.3</{el.tag}>",
+            )
         for el in reader.leftovers():
             if el.tag in reader.single:
                 self.note(
