@@ -426,14 +426,26 @@ Assertion = Annotated[
 ]
 
 
+_ENDPOINT_PATTERN = r"^(tcp|udp|tls|quic|ws|unixsock-stream|unixpipe|serial|vsock)/\S+$"
+
+
 class Host(Strict):
     """A machine of the run, by the Zenoh endpoint its runner listens on."""
 
     endpoint: str = Field(
         description="Zenoh endpoint of this host's runner, e.g. `tcp/10.0.0.2:7447`. The first host of "
         "`hosts:` is the main one: it records and judges; the others run `scenario run FILE --host NAME` "
-        "and join it."
+        "and join it.",
+        json_schema_extra={"pattern": _ENDPOINT_PATTERN},
     )
+
+    @field_validator("endpoint")
+    @classmethod
+    def _an_endpoint(cls, value: str) -> str:
+        if not re.match(_ENDPOINT_PATTERN, value):
+            example = value.split("/")[-1] or "10.0.0.2:7447"
+            raise ValueError(f"not a Zenoh endpoint: write it with its protocol, e.g. tcp/{example}")
+        return value
 
 
 class Node(Strict):

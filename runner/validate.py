@@ -399,6 +399,9 @@ def _with_hint(problem: Problem, value: Any) -> Problem:
     a word close to (or meaning) an allowed one gets it, and anything else a hint from what was expected."""
     if problem.hint:
         return problem
+    if ": write " in problem.message:  # a validator's own advice: "<what is wrong>: write <the fix>"
+        what, fix = problem.message.split(": write ", 1)
+        return dataclasses.replace(problem, message=what, hint=f"write {fix}")
     expected = problem.expected or ""
     hint = None
     if isinstance(value, str) and "number" in expected:
