@@ -281,5 +281,14 @@ def load_file(path: str | Path) -> Document:
     except IsADirectoryError:
         raise ScenarioError(Problem("this is a folder, not a scenario file", Location(p))) from None
     except UnicodeDecodeError as e:
-        raise ScenarioError(Problem(f"not a UTF-8 text file ({e.reason})", Location(p))) from None
+        before = e.object[: e.start]
+        line = before.count(b"\n") + 1
+        column = e.start - (before.rfind(b"\n") + 1) + 1
+        raise ScenarioError(
+            Problem(
+                f"not a UTF-8 text file: byte 0x{e.object[e.start]:02x} ({e.reason})",
+                Location(p.resolve(), line, column),
+                hint="save the file as UTF-8 (an editor's 'encoding' setting; `iconv -f latin1 -t utf-8`)",
+            )
+        ) from None
     return load_text(text, p.resolve())

@@ -145,3 +145,13 @@ def test_size_and_nesting_limits_are_said_with_their_lines(tmp_path: Path) -> No
     with pytest.raises(ScenarioError) as err:
         load_file(big)
     assert "a scenario may be at most 4 MB" in err.value.render() and "hint:" in err.value.render()
+
+
+def test_a_file_that_is_not_utf8_is_located_at_its_byte(tmp_path: Path) -> None:
+    path = tmp_path / "latin1.yaml"
+    path.write_bytes("name: x\ndescription: caf\xe9\n".encode("latin-1"))
+    with pytest.raises(ScenarioError) as err:
+        load_file(path)
+    text = err.value.render()
+    assert f"{path.resolve()}:2:17: not a UTF-8 text file: byte 0xe9" in text, text
+    assert "hint:" in text
