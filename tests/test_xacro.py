@@ -80,3 +80,30 @@ def test_a_urdf_named_file_that_uses_xacro_is_expanded(tmp_path: Path):
     m = mujoco.MjModel.from_xml_string(plan.mjcf)
     box = [g for g in range(m.ngeom) if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX]
     assert [round(float(x), 3) for x in m.geom_size[box[0]]] == [0.25, 0.25, 0.05]  # the arg reached it
+
+
+def test_a_macro_call_without_its_parameters_and_a_macro_without_end_are_located(tmp_path: Path):
+    """xacro said "Undefined parameters [radius]" and "maximum recursion depth exceeded", with no line."""
+    from runner.compile.xacro_expand import XacroError
+
+    head = '<?xml version="1.0"?>\n<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+    call = tmp_path / "call.urdf.xacro"
+    call.write_text(
+        head + '  <xacro:macro name="wheel" params="name radius">\n    <link name="${name}"/>\n'
+        '  </xacro:macro>\n  <link name="base"/>\n  <xacro:wheel name="w1"/>\n</robot>\n'
+    )
+    with pytest.raises(XacroError) as err:
+        expand(call, {}, PackageMap(roots=[tmp_path]))
+    assert err.value.line == 7 and "the call of macro 'wheel' does not give parameters [radius]" in str(
+        err.value
+    )
+    assert "radius:=" in (err.value.hint or "")
+    loop = tmp_path / "loop.urdf.xacro"
+    loop.write_text(
+        head + '  <xacro:macro name="again" params="n">\n    <xacro:again n="${n}"/>\n  </xacro:macro>\n'
+        '  <link name="base"/>\n  <xacro:again n="1"/>\n</robot>\n'
+    )
+    with pytest.raises(XacroError) as err:
+        expand(loop, {}, PackageMap(roots=[tmp_path]))
+    assert err.value.line == 3 and "macro 'again' calls itself without end" in str(err.value)
+    assert "<xacro:if>" in (err.value.hint or "")

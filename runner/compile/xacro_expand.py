@@ -127,7 +127,31 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
             if isinstance(missing, FileNotFoundError) and missing.filename:
                 message = f"included file not found: {missing.filename}"
             file = _current_file(path)
-            file, line = _locate_message(message, file, [path, *map(Path, xacro.all_includes)])
+            sources = [path, *map(Path, xacro.all_includes)]
+            macros = getattr(e, "macros", None) or []
+            name = macros[0].body.getAttribute("name") if macros and hasattr(macros[0], "body") else ""
+            if message.startswith("Undefined parameters") and name:
+                # the call that lacks them: `<xacro:wheel .../>` (not the definition, `<xacro:macro ...>`)
+                message = f"the call of macro {name!r} does not give {message.removeprefix('Undefined ')}"
+                for candidate in dict.fromkeys([file, *sources]):
+                    line = _line_of(candidate, f"<xacro:{name}")
+                    if line is not None:
+                        raise XacroError(
+                            message,
+                            candidate,
+                            line,
+                            hint="give them at the call, or defaults in the macro's params "
+                            '(params="radius:=0.05")',
+                        ) from None
+            if isinstance(e, RecursionError) or "maximum recursion depth" in message:
+                loop = _self_calling_macro(sources)
+                raise XacroError(
+                    f"macro {loop[0]!r} calls itself without end" if loop else "xacro recursed without end",
+                    loop[1] if loop else file,
+                    loop[2] if loop else None,
+                    hint="a macro that calls itself needs an <xacro:if> that stops it",
+                ) from None
+            file, line = _locate_message(message, file, sources)
             raise XacroError(message, file, line, hint=_hint(message)) from None
         finally:
             xacro.parse = real_parse
@@ -144,6 +168,21 @@ def _line_of(file: Path, needle: str, also: str = "") -> int | None:
                 return i + 1
     except OSError:
         pass
+    return None
+
+
+def _self_calling_macro(sources: list[Path]) -> tuple[str, Path, int] | None:
+    """(macro, file, line of its definition) of a macro whose body calls itself, in the expansion's files."""
+    definition = re.compile(r'<xacro:macro\s[^>]*name="([^"]+)"')
+    for file in dict.fromkeys(sources):
+        try:
+            text = file.read_text(encoding="utf-8", errors="replace")
+        except OSError:
+            continue
+        for m in definition.finditer(text):
+            end = text.find("</xacro:macro>", m.end())
+            if end >= 0 and f"<xacro:{m.group(1)}" in text[m.end() : end]:
+                return m.group(1), file, text.count("\n", 0, m.start()) + 1
     return None
 
 
