@@ -140,11 +140,24 @@ def _check_structure(root: Any, where: Any) -> str:
         if not name:
             raise DescriptionError("a <link> has no name", *where(el))
         if name in links:
-            raise DescriptionError(f"link {name!r} is defined twice", *where(el))
+            raise DescriptionError(
+                f"link {name!r} is defined twice",
+                *where(el),
+                hint="rename one (a xacro macro called twice with the same name or prefix does this)",
+            )
         links.append(name)
     children: dict[str, str] = {}
+    joint_lines: dict[str, Any] = {}
     for j in root.findall("joint"):
         jname = j.get("name") or "?"
+        if jname in joint_lines:
+            first = where(joint_lines[jname])[1]
+            raise DescriptionError(
+                f"joint {jname!r} is defined twice" + (f" (first at line {first})" if first else ""),
+                *where(j),
+                hint="rename one (a xacro macro called twice with the same name or prefix does this)",
+            )
+        joint_lines[jname] = j
         jtype = j.get("type")
         if jtype not in _JOINT_TYPES:
             raise DescriptionError(
