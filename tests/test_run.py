@@ -316,6 +316,22 @@ def test_an_endpoint_without_its_protocol_is_a_clear_error_not_a_traceback() -> 
 def test_ctrl_c_at_any_moment_of_start_up_ends_the_run_at_once(after: float) -> None:
     """SIGINT while the command imports, compiles, starts its worlds or runs: exit 130 within 2 s, no
     traceback from the runner or its worlds (it used to be lost in the first seconds: the run went on)."""
+    code, elapsed, err = _signalled_demo(signal.SIGINT, after)
+    assert code == 130, err
+    assert elapsed < 2.0, elapsed
+    assert "Traceback" not in err, err
+
+
+@pytest.mark.timeout(60)
+def test_sigterm_ends_a_run_with_143() -> None:
+    code, _, err = _signalled_demo(signal.SIGTERM, 2.5)
+    assert code == 143, err
+    assert "Traceback" not in err, err
+
+
+def _signalled_demo(sig: int, after: float) -> tuple[int, float, str]:
+    """The demo run at real time, sent `sig` `after` seconds from launch: (exit code, seconds it took to
+    exit after the signal, stderr)."""
     proc = subprocess.Popen(
         scenario_cmd("run", str(SCENARIOS / "two_robots.yaml"), "--no-record", "--rate", "1"),
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
@@ -323,29 +339,9 @@ def test_ctrl_c_at_any_moment_of_start_up_ends_the_run_at_once(after: float) -> 
     try:
         time.sleep(after)
         t0 = time.monotonic()
-        proc.send_signal(signal.SIGINT)
+        proc.send_signal(sig)
         _, err = proc.communicate(timeout=30)
-        elapsed = time.monotonic() - t0
+        return proc.returncode, time.monotonic() - t0, err
     finally:
         if proc.poll() is None:
             proc.kill()
-    assert proc.returncode == 130, err
-    assert elapsed < 2.0, elapsed
-    assert "Traceback" not in err, err
-
-
-@pytest.mark.timeout(60)
-def test_sigterm_ends_a_run_with_143() -> None:
-    proc = subprocess.Popen(
-        scenario_cmd("run", str(SCENARIOS / "two_robots.yaml"), "--no-record", "--rate", "1"),
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-    )  # fmt: skip
-    try:
-        time.sleep(2.5)
-        proc.send_signal(signal.SIGTERM)
-        _, err = proc.communicate(timeout=30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-    assert proc.returncode == 143, err
-    assert "Traceback" not in err, err

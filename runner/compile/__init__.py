@@ -576,6 +576,19 @@ def _description_path(robot: Robot, base: Path) -> Path:
     return (base / robot.desc.file).resolve()
 
 
+def _needs_file(path: Path, doc: Document, where: PathKey, what: str, kind: str) -> None:
+    if not path.is_file():
+        raise ScenarioError(
+            Problem(
+                f"{what} file not found",
+                doc.locate(where),
+                where,
+                expected=f"{kind} (relative to the scenario's folder)",
+                found=str(path),
+            )
+        )
+
+
 def _looks_like_xacro(path: Path) -> bool:
     """A file whatever its name that uses xacro (launch files run xacro on `.urdf` files too: nav2's
     sam_bot is one): it declares the xacro namespace or uses xacro elements."""
@@ -595,30 +608,11 @@ def _robot_model(
     else:
         file_path = (*desc_path, "file")
     path = _description_path(robot, doc.base_dir)
-    if not path.is_file():
-        raise ScenarioError(
-            Problem(
-                "robot description file not found",
-                doc.locate(file_path),
-                file_path,
-                expected="a URDF or xacro file (relative to the scenario's folder)",
-                found=str(path),
-            )
-        )
+    _needs_file(path, doc, file_path, "robot description", "a URDF or xacro file")
     controllers = []
     for k, name in enumerate(robot.controllers):
-        where: PathKey = ("robots", i, "controllers", k)
         found = doc.base_dir / name
-        if not found.is_file():
-            raise ScenarioError(
-                Problem(
-                    "controllers file not found",
-                    doc.locate(where),
-                    where,
-                    expected="a ros_control YAML file (relative to the scenario's folder)",
-                    found=str(found),
-                )
-            )
+        _needs_file(found, doc, ("robots", i, "controllers", k), "controllers", "a ros_control YAML file")
         controllers.append(found)
     try:
         if path.suffix == ".xacro" or _looks_like_xacro(path):

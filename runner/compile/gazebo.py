@@ -1336,12 +1336,7 @@ def _diff_drive_gz(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[
     radius = params["wheel_radius"]
     if accel and radius:
         params["max_wheel_acceleration"] = accel / radius
-    if len(lefts) > 1 or len(rights) > 1:
-        params["left_joints"], params["right_joints"] = lefts, rights
-        return "skid_steer", params
-    params["left_joint"] = lefts[0] if lefts else None
-    params["right_joint"] = rights[0] if rights else None
-    return "diff_drive", params
+    return _by_wheels(params, lefts, rights)
 
 
 def _skid_steer(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str, dict[str, Any]]:
@@ -1480,6 +1475,16 @@ def _ros_control(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> None:
     return None
 
 
+def _by_wheels(params: dict[str, Any], lefts: list[str], rights: list[str]) -> tuple[str, dict[str, Any]]:
+    """A drive with one wheel a side is a diff_drive; with several, a skid_steer driving them all."""
+    if len(lefts) > 1 or len(rights) > 1:
+        params["left_joints"], params["right_joints"] = lefts, rights
+        return "skid_steer", params
+    params["left_joint"] = lefts[0] if lefts else None
+    params["right_joint"] = rights[0] if rights else None
+    return "diff_drive", params
+
+
 def _ros_parameters(doc: Any, path: tuple[str, ...] = ()) -> dict[str, dict[str, Any]]:
     """Node name -> its `ros__parameters` in a ROS 2 parameters file (under `/**`, namespaces, or plain)."""
     out: dict[str, dict[str, Any]] = {}
@@ -1592,12 +1597,7 @@ def _diff_drive_controller(
     accel = _param(p, "linear.x.max_acceleration")
     if accel and radius and _param(p, "linear.x.has_acceleration_limits"):
         params["max_wheel_acceleration"] = float(accel) / float(radius)
-    if len(lefts) > 1 or len(rights) > 1:
-        params["left_joints"], params["right_joints"] = lefts, rights
-        return "skid_steer", params
-    params["left_joint"] = lefts[0] if lefts else None
-    params["right_joint"] = rights[0] if rights else None
-    return "diff_drive", params
+    return _by_wheels(params, lefts, rights)
 
 
 # The parameters the real Gazebo plugins read (classic ROS 1 and ROS 2 spellings, gz-sim systems): anything
