@@ -39,7 +39,10 @@ def _few_malloc_arenas() -> None:
     if not sys.platform.startswith("linux"):
         return
     try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+        try:  # glibc's name, without find_library's helper process (ldconfig), forked at every start
+            libc = ctypes.CDLL("libc.so.6")
+        except OSError:
+            libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
         libc.mallopt(-8, 2)  # M_ARENA_MAX
         # a fixed mmap threshold: big buffers (chunks, frames) always go back to the system when freed,
         # instead of glibc raising the threshold and carving them out of (and fragmenting) the heap

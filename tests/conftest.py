@@ -46,6 +46,27 @@ def write_scenario(tmp_path: Path):
     return write
 
 
+def processes_of(root: int, pattern: str, *, direct: bool = False) -> list[int]:
+    """The processes whose command line matches `pattern` (pgrep -f) that `root` started: its children
+    (`direct`), else any descendant. Another suite running beside this one has processes of the same
+    names; a process forking a helper has, until the helper execs, a copy of its command line."""
+    out = subprocess.run(["pgrep", "-f", pattern], capture_output=True, text=True).stdout
+    found = []
+    for pid in (int(p) for p in out.split()):
+        try:
+            parents = []
+            p = pid
+            while p > 1 and len(parents) < 64:
+                status = Path(f"/proc/{p}/status").read_text()
+                p = int(next(ln.split()[1] for ln in status.splitlines() if ln.startswith("PPid:")))
+                parents.append(p)
+        except (OSError, StopIteration, ValueError):
+            continue
+        if (parents[:1] == [root]) if direct else (root in parents):
+            found.append(pid)
+    return found
+
+
 def scenario_cmd(*args: str) -> list[str]:
     return [sys.executable, "-m", "runner.cli", *args]
 

@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from tests.conftest import REPO, scenario_cmd
+from tests.conftest import REPO, processes_of, scenario_cmd
 
 SCENE = """
 name: spread
@@ -164,9 +164,9 @@ def test_a_world_lost_on_the_other_host_fails_the_run(two_namespaces, write_scen
         deadline = time.monotonic() + 40
         while far_world is None and time.monotonic() < deadline:
             time.sleep(0.3)
-            out = subprocess.run(["pgrep", "-f", r"runner\.sim /"], capture_output=True, text=True).stdout
-            # this run's far world (not a process some other test left behind)
-            far_world = next((int(w) for w in out.split() if _ancestor(int(w), far.pid)), None)
+            # this run's far world (not another test's, nor a helper a world forks)
+            mine = processes_of(far.pid, r"runner\.sim /", direct=True)
+            far_world = mine[0] if mine else None
         assert far_world is not None, "the far world did not start"
         time.sleep(1.0)
         killed = time.monotonic()

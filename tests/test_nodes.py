@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from tests.conftest import SCENARIOS, read_mcap, run_cli, scenario_cmd
+from tests.conftest import SCENARIOS, processes_of, read_mcap, run_cli, scenario_cmd
 
 NODE = """
 import sys
@@ -147,8 +147,8 @@ def test_a_required_node_that_dies_ends_the_run_within_a_second(write_scenario, 
         deadline = time.monotonic() + 30
         while node is None and time.monotonic() < deadline:
             time.sleep(0.2)
-            out = subprocess.run(["pgrep", "-f", "python.* node.py"], capture_output=True, text=True).stdout
-            node = int(out.split()[0]) if out.split() else None
+            mine = processes_of(proc.pid, "python.* node.py")  # not another suite's node
+            node = mine[0] if mine else None
         assert node is not None, "the node did not start"
         time.sleep(1.5)
         killed = time.monotonic()

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from tests.conftest import run_cli, scenario_cmd
+from tests.conftest import processes_of, run_cli, scenario_cmd
 
 SCENE = """
 name: cams
@@ -87,8 +87,7 @@ def test_a_renderer_that_dies_fails_the_run_and_keeps_the_recording(write_scenar
         deadline = time.monotonic() + 30
         while renderer is None and time.monotonic() < deadline:
             time.sleep(0.2)
-            out = subprocess.run(["pgrep", "-f", "runner.sim.render"], capture_output=True, text=True).stdout
-            pids = [int(p) for p in out.split()]
+            pids = processes_of(proc.pid, "runner.sim.render")  # this run's, not another suite's
             renderer = pids[0] if pids else None
         assert renderer is not None, "no renderer process"
         time.sleep(1.5)  # some frames first

@@ -13,8 +13,7 @@ from pathlib import Path
 import pytest
 
 from runner.record import read_summary
-from tests.conftest import SCENARIOS, read_mcap, run_cli, scenario_cmd
-from tests.test_hosts import _ancestor
+from tests.conftest import SCENARIOS, processes_of, read_mcap, run_cli, scenario_cmd
 
 TWO = """
 name: pair
@@ -121,8 +120,7 @@ def test_a_world_that_dies_ends_the_run(write_scenario, tmp_path: Path) -> None:
         deadline = time.monotonic() + 30
         while len(worlds) < 2 and time.monotonic() < deadline:
             time.sleep(0.2)
-            out = subprocess.run(["pgrep", "-f", r"runner\.sim /"], capture_output=True, text=True)
-            worlds = [int(p) for p in out.stdout.split() if _ancestor(int(p), proc.pid)]  # this run's
+            worlds = processes_of(proc.pid, r"runner\.sim /", direct=True)  # this run's, not a helper's fork
         assert len(worlds) == 2, "two world processes"
         # both worlds running and recorded (a loaded machine starts them slowly): the recorder hands a
         # chunk to the OS at least every second, readable while the file is being written
