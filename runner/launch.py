@@ -31,7 +31,7 @@ from runner.nodes import NodeError, Nodes, OutputTail
 from runner.plan import NodePlan, RunPlan
 from runner.record import Recorder, TopicStats
 from runner.tools import announce, update_announcement, withdraw
-from runner.transport import free_port, make_config, meta_key, unpack_attachment
+from runner.transport import free_port, make_config, meta_key, unpack_attachment, zenoh_reason
 
 STOP_GRACE_S = 1.2  # after SIGINT, how long the world gets before SIGKILL
 DRAIN_TIMEOUT_S = 3.0  # how long the recorder waits for messages still in flight at the end
@@ -253,7 +253,7 @@ def run_plan(
     try:
         session = zenoh.open(conf)
     except zenoh.ZError as e:
-        raise RunError(f"cannot open the Zenoh network on {', '.join(listen)}: {e}") from None
+        raise RunError(f"cannot open the Zenoh network on {', '.join(listen)}: {zenoh_reason(e)}") from None
 
     live = None
     if foxglove_port is not None:  # `--foxglove PORT`: the run, live, to Foxglove
@@ -529,7 +529,7 @@ def _run_member(
     try:
         session = zenoh.open(make_config("router", listen=listen, connect=connect))
     except zenoh.ZError as e:
-        raise RunError(f"cannot open the Zenoh network on {', '.join(listen)}: {e}") from None
+        raise RunError(f"cannot open the Zenoh network on {', '.join(listen)}: {zenoh_reason(e)}") from None
     parts = [
         _WorldPart(w, f"world {w.name.rsplit('/', 1)[-1]}" if plan.worlds else "world")
         for w in plan.parts()

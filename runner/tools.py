@@ -21,7 +21,7 @@ from typing import Any
 import zenoh
 
 from runner.errors import RunError
-from runner.transport import make_config, use_run_settings
+from runner.transport import make_config, use_run_settings, zenoh_reason
 
 
 def runs_dir() -> Path:
@@ -150,7 +150,7 @@ def joined(endpoints: list[str]) -> Iterator[Any]:
     try:
         session = zenoh.open(make_config("client", connect=endpoints))
     except zenoh.ZError as e:
-        raise RunError(f"cannot reach {', '.join(endpoints)}: {e}") from None
+        raise RunError(f"cannot reach {', '.join(endpoints)}: {zenoh_reason(e)}") from None
     try:
         yield session
     finally:

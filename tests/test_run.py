@@ -345,3 +345,20 @@ def _signalled_demo(sig: int, after: float) -> tuple[int, float, str]:
     finally:
         if proc.poll() is None:
             proc.kill()
+
+
+@pytest.mark.timeout(60)
+def test_zenohs_rust_source_paths_stay_out_of_messages() -> None:
+    """A port another program holds: Zenoh's error carries its Rust source location (`at .../unicast.rs:342`);
+    the user gets the reason alone."""
+    import socket
+
+    with socket.socket() as held:
+        held.bind(("127.0.0.1", 0))
+        held.listen()
+        port = held.getsockname()[1]
+        r = run_cli("run", str(SCENARIOS / "two_robots.yaml"), "--no-record", "--listen", f"tcp/127.0.0.1:{port}",
+                    timeout=50)  # fmt: skip
+    assert r.returncode == 1, r.stderr
+    assert f"cannot open the Zenoh network on tcp/127.0.0.1:{port}" in r.stderr, r.stderr
+    assert ".rs:" not in r.stderr and "Traceback" not in r.stderr, r.stderr

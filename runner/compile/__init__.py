@@ -42,6 +42,7 @@ from runner.plan import (
 from runner.plugin import BuildContext, PluginConfigError
 from runner.registry import PluginLookupError, load
 from runner.schema import NoCollision, PluginEntry, Record, Robot, Scenario, WorldModel
+from runner.transport import zenoh_reason
 from runner.validate import validate_model
 
 _GEOM = {
@@ -931,15 +932,6 @@ def _check_key_exprs(record: RecordPlan, doc: Document, given: Record | None = N
             _check_expr(e, doc, ("record", field_name, j), written[j])
 
 
-def _zenoh_reason(err: Exception) -> str:
-    """Zenoh's error text without the Rust source location it carries (`Str("x") at .../x.rs:86`)."""
-    import re
-
-    text = re.sub(r"\s+at \S+\.rs:\d+\.?", "", str(err)).strip()
-    quoted = re.fullmatch(r'Str\("(.*)"\)', text)
-    return quoted.group(1) if quoted else text
-
-
 def _zenoh_settings(sc: Scenario, doc: Document) -> dict[str, Any]:
     """`zenoh:` checked against Zenoh itself (each setting inserted into a config), paths made absolute."""
     import json
@@ -965,7 +957,7 @@ def _zenoh_settings(sc: Scenario, doc: Document) -> dict[str, Any]:
             zenoh.Config.from_file(str(path))
         except Exception as e:
             raise ScenarioError(
-                Problem(f"Zenoh cannot read this configuration: {_zenoh_reason(e)}", doc.locate(where), where)
+                Problem(f"Zenoh cannot read this configuration: {zenoh_reason(e)}", doc.locate(where), where)
             ) from None
         file = str(path.resolve())
     settings: dict[str, Any] = {}
@@ -979,7 +971,7 @@ def _zenoh_settings(sc: Scenario, doc: Document) -> dict[str, Any]:
         except Exception as e:
             raise ScenarioError(
                 Problem(
-                    f"Zenoh refuses the setting {key!r}: {_zenoh_reason(e)}",
+                    f"Zenoh refuses the setting {key!r}: {zenoh_reason(e)}",
                     doc.locate(where),
                     where,
                     hint="a path in Zenoh's configuration, e.g. transport/link/tls/root_ca_certificate",

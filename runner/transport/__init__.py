@@ -42,6 +42,15 @@ def encoding_for(type_name: str) -> zenoh.Encoding:
     return zenoh.Encoding.APPLICATION_CDR.with_schema(type_name)
 
 
+def zenoh_reason(err: Exception) -> str:
+    """Zenoh's error text without the Rust source location it carries (`Str("x") at .../x.rs:86`)."""
+    import re
+
+    text = re.sub(r"\s+at \S+\.rs:\d+(?::\d+)?\.?", "", str(err)).strip()
+    quoted = re.fullmatch(r'Str\("(.*)"\)', text)
+    return quoted.group(1) if quoted else text
+
+
 def type_from_encoding(encoding: Any) -> str | None:
     text = str(encoding)
     if text.startswith(("application/cdr;", "application/protobuf;")):
