@@ -218,3 +218,24 @@ def test_the_go_to_goal_example_reaches_its_goal(tmp_path: Path) -> None:
     )
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "[controller] arrived at" in proc.stderr
+
+
+@pytest.mark.timeout(60)
+def test_a_required_node_whose_script_is_missing_fails_the_run_without_a_traceback(write_scenario) -> None:
+    """The node dies at once, while the world is still starting: the world is stopped quietly (it used to
+    print a KeyboardInterrupt traceback) and the run fails with the node's own words."""
+    path = write_scenario(
+        """
+        name: gone
+        duration: 5
+        rate: realtime
+        robots:
+          - {name: r1, description: "{diffbot}", plugins: [{type: diff_drive}]}
+        nodes:
+          - {name: driver, cmd: python missing_script.py, required: true}
+        """
+    )
+    r = run_cli("run", str(path), "--no-record", timeout=50)
+    assert r.returncode == 1, r.stderr
+    assert "required node 'driver' exited with code 2" in r.stderr and "missing_script.py" in r.stderr
+    assert "Traceback" not in r.stderr and "KeyboardInterrupt" not in r.stderr, r.stderr
