@@ -175,7 +175,10 @@ class _WorldPart:
 
     def stop(self) -> None:
         if self.remote_host is None and self.running():
-            _stop(self.child)  # type: ignore[arg-type]
+            # a world still starting (importing, compiling) has nothing to finish: SIGTERM ends it quietly,
+            # where SIGINT would print a KeyboardInterrupt from wherever Python was in its start-up
+            started = self.ready.is_set()
+            _stop(self.child, signal.SIGINT if started else signal.SIGTERM)  # type: ignore[arg-type]
 
     def renderer_error(self) -> str | None:
         r = self.renderer
@@ -662,9 +665,9 @@ def _connectable(endpoint: str) -> str:
     return endpoint.replace("0.0.0.0", "127.0.0.1").replace("[::]", "[::1]")
 
 
-def _stop(child: subprocess.Popen[bytes]) -> None:
+def _stop(child: subprocess.Popen[bytes], sig: int = signal.SIGINT) -> None:
     try:
-        child.send_signal(signal.SIGINT)
+        child.send_signal(sig)
         child.wait(timeout=STOP_GRACE_S)
     except subprocess.TimeoutExpired:
         child.kill()

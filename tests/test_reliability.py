@@ -308,6 +308,13 @@ def test_a_stray_publisher_on_cmd_vel_is_rejected_counted_and_never_recorded(
             except zenoh.ZError:
                 time.sleep(0.1)
         assert session is not None
+        # the world is up (its clock ticks) before the stray publisher starts, however slow the start
+        import threading
+
+        ticking = threading.Event()
+        clock = session.declare_subscriber("stray/clock", lambda _s: ticking.set())
+        assert ticking.wait(40), "the world did not start"
+        clock.undeclare()
         string = bytes([0, 1, 0, 0]) + struct.pack("<I", 44) + b"x" * 43 + b"\0"  # 52 bytes of String CDR
         as_string = session.declare_publisher(
             "stray/r1/cmd_vel", encoding=zenoh.Encoding.APPLICATION_CDR.with_schema("std_msgs/msg/String")
