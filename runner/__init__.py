@@ -10,12 +10,13 @@ def _quiet_early_signals() -> None:
     import signal
     import sys
 
+    from runner.interrupts import exit_at_once
+
     first = os.path.basename(sys.argv[0]) if sys.argv else ""
     if first not in ("scenario", "-m") and not first.startswith("scenario"):
         return
-    for sig, code in ((signal.SIGINT, 130), (signal.SIGTERM, 143)):
-        if signal.getsignal(sig) in (signal.SIG_DFL, signal.default_int_handler):
-            signal.signal(sig, lambda *_, code=code: os._exit(code))
+    if signal.getsignal(signal.SIGINT) in (signal.SIG_DFL, signal.default_int_handler):
+        exit_at_once()
 
 
 _quiet_early_signals()

@@ -9,7 +9,6 @@ from __future__ import annotations
 import json
 import math
 import re
-import signal
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -19,6 +18,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from runner import interrupts
 from runner.errors import RunError, ScenarioError
 from runner.plan import RobotPlan
 
@@ -245,10 +245,7 @@ def run(
     """
     # Until a run starts its processes (loading, compiling), Ctrl-C and SIGTERM end the command at once:
     # nothing is started or recorded yet. Then (runner.launch) they stop the run in order, recording kept.
-    import os
-
-    signal.signal(signal.SIGINT, lambda *_: os._exit(130))
-    signal.signal(signal.SIGTERM, lambda *_: os._exit(143))
+    interrupts.exit_at_once()
     parsed_rate = _parse_rate(rate)
     for option, values in (("--listen", listen), ("--connect", connect)):
         for value in values or []:
@@ -298,9 +295,7 @@ def run(
     if results_json is not None:
         data = suites[0].to_json() if len(suites) == 1 else {"variants": [s.to_json() for s in suites]}
         results_json.write_text(json.dumps(data, indent=2))
-    from runner import launch
-
-    raise typer.Exit(143 if code == 130 and (_TERMINATED or launch.TERMINATED) else code)
+    raise typer.Exit(143 if code == 130 and interrupts.terminated() else code)
 
 
 def _load_variants(file: Path, record: str | None, variant: int | None) -> list[tuple[str, Any]]:
@@ -1245,8 +1240,7 @@ def bench(ctx: typer.Context) -> None:
 def main() -> None:
     # From here Ctrl-C raises KeyboardInterrupt (a run stops its worlds and finishes its recording) and
     # SIGTERM does the same; either, escaping a command, ends it with 130 / 143 and no traceback.
-    signal.signal(signal.SIGINT, signal.default_int_handler)
-    signal.signal(signal.SIGTERM, _terminated)
+    interrupts.interruptible()
     try:
         app()
     except ScenarioError as e:  # a user mistake that escaped a command: still no traceback
@@ -1254,16 +1248,7 @@ def main() -> None:
         sys.exit(1)
     except KeyboardInterrupt:
         err.print("interrupted", markup=False)
-        sys.exit(143 if _TERMINATED else 130)
-
-
-_TERMINATED = False
-
-
-def _terminated(*_: Any) -> None:
-    global _TERMINATED
-    _TERMINATED = True
-    raise KeyboardInterrupt
+        sys.exit(143 if interrupts.terminated() else 130)
 
 
 if __name__ == "__main__":

@@ -27,6 +27,7 @@ import zenoh
 from runner import msgs
 from runner.errors import RunError
 from runner.graph import GraphTokens
+from runner.interrupts import interruptible
 from runner.nodes import NodeError, Nodes, OutputTail
 from runner.plan import NodePlan, RunPlan
 from runner.record import Recorder, TopicStats
@@ -36,27 +37,6 @@ from runner.transport import free_port, make_config, meta_key, unpack_attachment
 STOP_GRACE_S = 1.2  # after SIGINT, how long the world gets before SIGKILL
 DRAIN_TIMEOUT_S = 3.0  # how long the recorder waits for messages still in flight at the end
 START_TIMEOUT_S = 30.0
-
-
-TERMINATED = False  # the run was ended by SIGTERM (exit 143), not Ctrl-C (130)
-
-
-def _arm_interrupts() -> None:
-    """Ctrl-C raises KeyboardInterrupt and SIGTERM does the same (the run loop stops every part in order
-    and finishes the recording). Until a run starts processes, the command ends at once instead (nothing to
-    stop, nothing recorded): see `runner._quiet_early_signals` and `runner.cli.run`."""
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        return
-
-    def terminated(*_: Any) -> None:
-        global TERMINATED
-        TERMINATED = True
-        raise KeyboardInterrupt
-
-    signal.signal(signal.SIGINT, signal.default_int_handler)
-    signal.signal(signal.SIGTERM, terminated)
 
 
 def _types(plan: RunPlan) -> dict[str, str]:
@@ -239,7 +219,7 @@ def run_plan(
 
     With `plan.hosts`, this runner plays `host` (None: the first, main host, which records and judges);
     the parts placed on other hosts are run by their own `scenario run FILE --host NAME`, and joined."""
-    _arm_interrupts()  # from here on, processes start: Ctrl-C stops them in order and keeps the recording
+    interruptible()  # from here on, processes start: Ctrl-C stops them in order and keeps the recording
     if plan.hosts and host not in (None, plan.main_host):
         return _run_member(plan, host, connect=connect, listen=listen)  # type: ignore[arg-type]
     if plan.hosts and not listen:

@@ -1,0 +1,40 @@
+"""Ctrl-C and SIGTERM, in the two states a command can be in.
+
+- Nothing started and nothing recorded yet (importing, loading, compiling): `exit_at_once` ends the process
+  with 130 (Ctrl-C) or 143 (SIGTERM), without a KeyboardInterrupt traceback from wherever Python was.
+- Processes started or a recording open: `interruptible` makes both raise KeyboardInterrupt, which the run
+  loop (and each command) handles in order; `terminated()` then tells SIGTERM (143) from Ctrl-C (130).
+
+Kept free of heavy imports: `runner/__init__` uses it before anything else is loaded.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+from typing import Any
+
+_state = {"terminated": False}
+
+
+def exit_at_once() -> None:
+    signal.signal(signal.SIGINT, lambda *_: os._exit(130))
+    signal.signal(signal.SIGTERM, lambda *_: os._exit(143))
+
+
+def interruptible() -> None:
+    if threading.current_thread() is not threading.main_thread():
+        return  # only the main thread may set handlers (a run started from a test's thread keeps its own)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, _on_term)
+
+
+def terminated() -> bool:
+    """Whether the KeyboardInterrupt being handled came from SIGTERM."""
+    return _state["terminated"]
+
+
+def _on_term(*_: Any) -> None:
+    _state["terminated"] = True
+    raise KeyboardInterrupt
