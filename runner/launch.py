@@ -39,28 +39,20 @@ DRAIN_TIMEOUT_S = 3.0  # how long the recorder waits for messages still in fligh
 START_TIMEOUT_S = 30.0
 
 
-def _types(plan: RunPlan) -> dict[str, str]:
-    """The type of each key the plan's worlds publish or subscribe: what the recorder accepts there."""
-    out: dict[str, str] = {}
-    for part in plan.every_plan():
-        for robot in part.robots:
-            for p in robot.plugins:
-                for t in p.topics:
-                    out.setdefault(t.key, msgs.normalize_type(t.type))
-        for ev in part.timeline:
-            out.setdefault(ev.key, ev.type)
-    return out
-
-
-def _inbound(plan: RunPlan) -> set[str]:
-    """Keys the worlds subscribe and do not publish themselves: what other processes send them."""
+def _keys(plan: RunPlan) -> tuple[dict[str, str], set[str]]:
+    """The type of each key the plan's worlds publish or subscribe (what the recorder accepts there), and
+    the keys they subscribe without publishing them: what other processes send them."""
+    types: dict[str, str] = {}
     subs, pubs = set(), set()
     for part in plan.every_plan():
         for robot in part.robots:
             for p in robot.plugins:
                 for t in p.topics:
+                    types.setdefault(t.key, msgs.normalize_type(t.type))
                     (subs if t.direction == "sub" else pubs).add(t.key)
-    return subs - pubs
+        for ev in part.timeline:
+            types.setdefault(ev.key, ev.type)
+    return types, subs - pubs
 
 
 @dataclass
@@ -271,12 +263,13 @@ def run_plan(
     try:
         if plan.record.enabled:
             try:
+                types, inbound = _keys(plan)
                 recorder = Recorder(
                     Path(plan.record.path),
                     plan.record.include,
                     plan.record.exclude,
-                    types=_types(plan),
-                    inbound=_inbound(plan),
+                    types=types,
+                    inbound=inbound,
                 )
             except OSError as e:
                 raise RunError(f"cannot write the recording {plan.record.path}: {e.strerror or e}") from None
