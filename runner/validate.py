@@ -390,7 +390,7 @@ _UNITS = {
     "kg": ("kilograms", 1.0),
     "g": ("kilograms", 1e-3),
 }
-_SYNONYMS = {"cube": "box", "ball": "sphere", "cylinder": "cylinder", "tube": "cylinder", "rect": "box"}
+_SYNONYMS = {"cube": "box", "ball": "sphere", "tube": "cylinder", "rect": "box"}
 _NUMBER_WITH_UNIT = re.compile(r"^\s*([-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)\s*([a-zA-Z°]+)\s*$")
 
 
