@@ -44,3 +44,28 @@ def messages(bus: MemoryBus, key_suffix: str) -> list[tuple[int, Any]]:
             assert parsed is not None
             out.append((parsed[1], msgs.decode(payload, type_name)))
     return out
+
+
+def robot_scenario(
+    tmp_path: Path,
+    urdf: str,
+    *,
+    name: str = "t",
+    seed: int = 1,
+    duration: float = 0.5,
+    world: str = "",
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.05),
+    plugins: str = "[]",
+    timeline: str = "",
+) -> Path:
+    """`urdf` as <name>.urdf, and a scenario `g` that runs it as robot `bot` (its path, <name><seed>.yaml):
+    `world` is YAML for the scenario's `world:` (without the key), `timeline` its entries."""
+    (tmp_path / f"{name}.urdf").write_text(urdf)
+    path = tmp_path / f"{name}{seed}.yaml"
+    path.write_text(
+        f"name: g\nduration: {duration}\nrate: max\nseed: {seed}"
+        + (f"\nworld:\n{world}" if world else "")
+        + f"\nrobots:\n  - name: bot\n    description: {name}.urdf\n    pose: {{xyz: {list(xyz)}}}\n"
+        f"    plugins: {plugins}\n" + (f"timeline:\n{timeline}" if timeline else "")
+    )
+    return path

@@ -19,7 +19,7 @@ import pytest
 
 from runner.plan import RunPlan
 from runner.transport import MemoryBus
-from tests.helpers import compile_with_notices, messages, simulate
+from tests.helpers import compile_with_notices, messages, robot_scenario, simulate
 
 IMAGE, INFO, POINTS = "sensor_msgs/msg/Image", "sensor_msgs/msg/CameraInfo", "sensor_msgs/msg/PointCloud2"
 
@@ -66,15 +66,15 @@ def _write(
     name: str = "t",
 ) -> Path:
     """ROBOT with `extra` tags as <name>.urdf, and a scenario that runs it (its path)."""
-    (tmp_path / f"{name}.urdf").write_text(ROBOT.replace("EXTRA", extra))
-    physics = f"\nworld:\n  physics: {{gravity: {gravity}}}" if gravity else ""
-    path = tmp_path / f"{name}{seed}.yaml"
-    path.write_text(
-        f"name: g\nduration: {duration}\nrate: max\nseed: {seed}{physics}\nrobots:\n"
-        f"  - name: bot\n    description: {name}.urdf\n    pose: {{xyz: [0, 0, 0.05]}}\n"
-        f"    plugins: {plugins}\n"
+    return robot_scenario(
+        tmp_path,
+        ROBOT.replace("EXTRA", extra),
+        name=name,
+        seed=seed,
+        duration=duration,
+        world=f"  physics: {{gravity: {gravity}}}" if gravity else "",
+        plugins=plugins,
     )
-    return path
 
 
 def _camera_topics(plan: RunPlan) -> dict[str, str]:

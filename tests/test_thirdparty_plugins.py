@@ -12,7 +12,7 @@ import numpy as np
 
 from plugins.gps import earth_radii
 from runner.plan import RunPlan
-from tests.helpers import compile_with_notices, messages, simulate
+from tests.helpers import compile_with_notices, messages, robot_scenario, simulate
 
 ROBOT = """<?xml version="1.0"?>
 <robot name="t">
@@ -162,15 +162,17 @@ def _write(
     timeline: str = "",
     name: str = "t",
 ) -> Path:
-    (tmp_path / f"{name}.urdf").write_text(ROBOT.replace("EXTRA", extra))
-    world = f"\nworld:\n  models:\n{models}" if models else ""
-    path = tmp_path / f"{name}{seed}.yaml"
-    path.write_text(
-        f"name: g\nduration: {duration}\nrate: max\nseed: {seed}{world}\nrobots:\n"
-        f"  - name: bot\n    description: {name}.urdf\n    pose: {{xyz: {list(xyz)}}}\n"
-        f"    plugins: {plugins}\n" + (f"timeline:\n{timeline}" if timeline else "")
+    return robot_scenario(
+        tmp_path,
+        ROBOT.replace("EXTRA", extra),
+        name=name,
+        seed=seed,
+        duration=duration,
+        world=f"  models:\n{models}" if models else "",
+        xyz=xyz,
+        plugins=plugins,
+        timeline=timeline,
     )
-    return path
 
 
 def _topics(plan: RunPlan) -> dict[str, str]:
