@@ -49,22 +49,38 @@ class Decomposition:
     cached: bool
 
 
-def decompose_file(path: Path, scale: tuple[float, ...]) -> Decomposition | None:
-    """The pieces of a mesh file as MuJoCo reads it (STL, OBJ: see `runner.compile.meshes`), at `scale`;
-    None when MuJoCo cannot read it (the world's compile says why)."""
-    t0 = time.perf_counter()
+def _cache_file(path: Path, scale: tuple[float, ...]) -> Path:
     digest = hashlib.sha256()
     digest.update(path.read_bytes())
     digest.update(repr((tuple(float(s) for s in scale), VERSION, THICKNESS)).encode())
-    cached = mesh_cache() / "pieces" / f"{digest.hexdigest()[:32]}.npz"
-    if cached.is_file():
-        try:
-            with np.load(cached) as data:
-                points, counts, triangles = data["points"], data["counts"], int(data["triangles"])
-            pieces = np.split(points, np.cumsum(counts)[:-1]) if len(counts) else []
-            return Decomposition(list(pieces), triangles, time.perf_counter() - t0, True)
-        except (OSError, ValueError, KeyError):
-            pass  # a damaged cache file: made again
+    return mesh_cache() / "pieces" / f"{digest.hexdigest()[:32]}.npz"
+
+
+def cached_decomposition(path: Path, scale: tuple[float, ...]) -> Decomposition | None:
+    """The pieces `decompose_file` made of this mesh before, from the cache; None if there are none."""
+    return _load(_cache_file(path, scale), time.perf_counter())
+
+
+def _load(cached: Path, t0: float) -> Decomposition | None:
+    if not cached.is_file():
+        return None
+    try:
+        with np.load(cached) as data:
+            points, counts, triangles = data["points"], data["counts"], int(data["triangles"])
+    except (OSError, ValueError, KeyError):
+        return None  # a damaged cache file: made again
+    pieces = np.split(points, np.cumsum(counts)[:-1]) if len(counts) else []
+    return Decomposition(list(pieces), triangles, time.perf_counter() - t0, True)
+
+
+def decompose_file(path: Path, scale: tuple[float, ...]) -> Decomposition | None:
+    """The pieces of a mesh file as MuJoCo reads it (STL, OBJ: see `runner.compile.meshes`), at `scale`;
+    None when MuJoCo cannot read it (the world's compile says why). Cached: see `cached_decomposition`."""
+    t0 = time.perf_counter()
+    cached = _cache_file(path, scale)
+    found = _load(cached, t0)
+    if found is not None:
+        return found
     mesh = _read(path, scale)
     if mesh is None:
         return None

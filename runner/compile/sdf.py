@@ -45,7 +45,7 @@ import mujoco
 import numpy as np
 from lxml import etree
 
-from runner.compile.decompose import PIECES_GROUP, RAY_GROUP, decompose_file
+from runner.compile.decompose import PIECES_GROUP, RAY_GROUP, cached_decomposition, decompose_file
 from runner.compile.materials import gazebo_material
 from runner.compile.meshes import MeshError, prepare_mesh
 from runner.compile.packages import URI_RE, PackageMap
@@ -1460,14 +1460,17 @@ class _Loader:
         if key in self.decomposed:
             return self.decomposed[key]
         self.decomposed[key] = None
-        stats = None if flat else _hull_and_volume(path, scale)
-        if stats is None and not flat:
-            return None
-        if stats is not None:
-            hull, volume = stats
-            if hull - volume < _NONCONVEX_MIN_EXCESS or hull < _NONCONVEX_RATIO * volume:
-                return None  # near enough to convex: its hull, as MuJoCo takes a mesh (cheap, and smooth)
-        found = decompose_file(path, scale)
+        # pieces in the cache were made for a mesh that passed the test below: it need not be made again
+        found = cached_decomposition(path, scale)
+        if found is None:
+            stats = None if flat else _hull_and_volume(path, scale)
+            if stats is None and not flat:
+                return None
+            if stats is not None:
+                hull, volume = stats
+                if hull - volume < _NONCONVEX_MIN_EXCESS or hull < _NONCONVEX_RATIO * volume:
+                    return None  # near enough to convex: its hull, as MuJoCo takes a mesh (cheap, smooth)
+            found = decompose_file(path, scale)
         # a flat mesh (a floor as one sheet) has no hull MuJoCo can make: it always collides as its pieces
         if found is None or (len(found.pieces) <= 1 and not flat) or not found.pieces:
             return None
