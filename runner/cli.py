@@ -637,7 +637,7 @@ def info(mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")]) -> 
 
     Example: scenario info runs/two_robots.mcap
     """
-    from runner.record import read_summary
+    from runner.record import read_summary, recording_live
 
     if not mcap.is_file():
         raise _fail(RunError(f"{mcap}: file not found"))
@@ -659,12 +659,19 @@ def info(mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")]) -> 
     out.print(f"{s['messages']} messages, sim time {start / 1e9:.3f} s .. {end / 1e9:.3f} s ({span:.3f} s)")
     stopped = s.get("stopped")
     if stopped:
+        why = stopped.get("stopped", "the recording ended")
+        if stopped.get("error"):
+            why += f" ({stopped['error']})"
         out.print(
-            f"stopped early: {stopped.get('stopped', 'the recording ended')} ({stopped.get('error', '?')}); "
-            f"it holds everything up to {end / 1e9:.3f} s sim, and is complete",
+            f"stopped early: {why}; it holds everything up to {end / 1e9:.3f} s sim, and is complete",
             markup=False,
         )
-    if s["cut"]:
+    if s["cut"] and recording_live(mcap):
+        out.print(
+            f"live: a run is still recording this file; read up to its last chunk ({end / 1e9:.3f} s sim)",
+            markup=False,
+        )
+    elif s["cut"]:
         out.print(
             f"cut: the recording has no summary (its runner was killed); it reaches {end / 1e9:.3f} s sim, "
             f"every complete chunk read. `scenario recover {mcap}` writes a complete copy.",

@@ -270,6 +270,7 @@ def run_plan(
                     plan.record.exclude,
                     types=types,
                     inbound=inbound,
+                    guarded=True,
                 )
             except OSError as e:
                 raise RunError(f"cannot write the recording {plan.record.path}: {e.strerror or e}") from None

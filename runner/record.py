@@ -36,20 +36,10 @@ import zenoh
 import zstandard
 from mcap.data_stream import RecordBuilder
 from mcap.opcode import Opcode
-from mcap.records import (
-    Channel,
-    ChunkIndex,
-    DataEnd,
-    Header,
-    McapRecord,
-    Metadata,
-    MetadataIndex,
-    Schema,
-    Statistics,
-    SummaryOffset,
-)
+from mcap.records import Channel, ChunkIndex, Header, McapRecord, Schema
 
 from runner import msgs
+from runner.finisher import MAGIC, TRAILER, Guard, Tail
 from runner.transport import ATTACHMENT, type_from_encoding, unpack_attachment
 
 CHUNK_SIZE = 256 * 1024  # uncompressed bytes per chunk
@@ -59,7 +49,6 @@ ZSTD_LEVEL = 1  # vs the default 3: 10-30% faster here, for the same ratio on se
 FIFO_CAPACITY = 1024
 DRAIN_BATCH = 256  # samples the drain thread records per lock acquisition, at most
 
-_MAGIC = b"\x89MCAP0\r\n"
 # Message record: opcode, record length, channel id, sequence, log time, publish time (then the data).
 _MESSAGE_HEAD = struct.Struct("<BQHIQQ")
 _MESSAGE_FIXED = _MESSAGE_HEAD.size - 9  # the record's length minus the data's
@@ -123,23 +112,24 @@ class _McapFile:
         profile: str,
         library: str,
         chunk_size: int = CHUNK_SIZE,
+        guard: Guard | None = None,
     ):
         self._stream = stream
         self.chunk_size = chunk_size
         self.chunk = bytearray()  # the uncompressed records of the chunk being built
         self._zstd = zstandard.ZstdCompressor(level=ZSTD_LEVEL)
-        self._schemas: list[Schema] = []
-        self._channels: list[Channel] = []
+        self._tail = Tail()  # the summary's records, as chunks are written
         self._by_id: dict[int, _Channel] = {}
         self._chunk_indexes: list[ChunkIndex] = []
         self.flushed_at = time.monotonic()
-        self._start_ns: int | None = None
-        self._end_ns = 0
         self._pos = 0
-        self._write(_MAGIC + _record_bytes(Header(profile=profile, library=library)))
+        self.guard = guard
+        self._write_trailed(MAGIC + _record_bytes(Header(profile=profile, library=library)))
         self._good = self._pos  # the end of the last chunk written whole
         self._chunk_counts: list[dict[int, int]] = []  # messages per channel of each chunk written
         self.note: dict[str, str] = {}  # written as a metadata record `scenario` by `finish`
+        if guard is not None:
+            guard.send(("header", self._good))
 
     def _write(self, data: bytes | bytearray) -> None:
         view = memoryview(data)
@@ -165,23 +155,29 @@ class _McapFile:
             del ch.index[:]
 
     def register_schema(self, name: str, encoding: str, data: bytes) -> int:
-        schema = Schema(id=len(self._schemas) + 1, data=data, encoding=encoding, name=name)
-        self._schemas.append(schema)
-        self.chunk += _record_bytes(schema)
+        schema = Schema(id=len(self._tail.schemas) + 1, data=data, encoding=encoding, name=name)
+        record = _record_bytes(schema)
+        self._tail.schemas.append(record)
+        self.chunk += record
+        if self.guard is not None:
+            self.guard.send(("schema", record))
         return schema.id
 
     def register_channel(
         self, topic: str, message_encoding: str, schema_id: int, stats: TopicStats
     ) -> _Channel:
         channel = Channel(
-            id=len(self._channels) + 1,
+            id=len(self._tail.channels) + 1,
             topic=topic,
             message_encoding=message_encoding,
             schema_id=schema_id,
             metadata={},
         )
-        self._channels.append(channel)
-        self.chunk += _record_bytes(channel)
+        record = _record_bytes(channel)
+        self._tail.channels.append(record)
+        self.chunk += record
+        if self.guard is not None:
+            self.guard.send(("channel", record))
         ch = self._by_id[channel.id] = _Channel(channel.id, stats)
         return ch
 
@@ -214,13 +210,11 @@ class _McapFile:
             del entries[:]
         self._write_chunk(self.chunk, start, end, indexes)
         self.chunk.clear()
-        self._start_ns = start if self._start_ns is None else min(self._start_ns, start)
-        self._end_ns = max(self._end_ns, end)
 
     def _write_chunk(self, chunk: bytearray, start: int, end: int, indexes: list[tuple[int, bytes]]) -> None:
         compressed = self._zstd.compress(chunk)
         chunk_start = self._pos
-        self._write(
+        out = bytearray(
             _CHUNK_HEAD.pack(
                 int(Opcode.CHUNK),
                 _CHUNK_HEAD.size - 9 + len(compressed),
@@ -233,35 +227,49 @@ class _McapFile:
                 len(compressed),
             )
         )
-        self._write(compressed)
-        chunk_length = self._pos - chunk_start
+        out += compressed
+        chunk_length = len(out)
         offsets: dict[int, int] = {}
-        index_start = self._pos
         for channel_id, data in indexes:
-            offsets[channel_id] = self._pos
-            self._write(
-                _MESSAGE_INDEX_HEAD.pack(int(Opcode.MESSAGE_INDEX), 6 + len(data), channel_id, len(data))
-            )
-            self._write(data)
-        self._chunk_counts.append({cid: len(data) // 16 for cid, data in indexes})  # (stamp, offset) pairs
-        self._chunk_indexes.append(
-            ChunkIndex(
-                message_start_time=start,
-                message_end_time=end,
-                chunk_start_offset=chunk_start,
-                chunk_length=chunk_length,
-                message_index_offsets=offsets,
-                message_index_length=self._pos - index_start,
-                compression=_ZSTD.decode(),
-                compressed_size=len(compressed),
-                uncompressed_size=len(chunk),
-            )
+            offsets[channel_id] = chunk_start + len(out)
+            out += _MESSAGE_INDEX_HEAD.pack(int(Opcode.MESSAGE_INDEX), 6 + len(data), channel_id, len(data))
+            out += data
+        counts = {cid: len(data) // 16 for cid, data in indexes}  # (stamp, offset) pairs
+        index = ChunkIndex(
+            message_start_time=start,
+            message_end_time=end,
+            chunk_start_offset=chunk_start,
+            chunk_length=chunk_length,
+            message_index_offsets=offsets,
+            message_index_length=len(out) - chunk_length,
+            compression=_ZSTD.decode(),
+            compressed_size=len(compressed),
+            uncompressed_size=len(chunk),
         )
-        # Handed to the OS with every chunk: a runner killed outright (kill -9) leaves a file readable up
-        # to its last chunk (`scenario info` says so, `scenario recover` completes it)
-        self._stream.flush()
+        # One write, over the previous trailer: the chunk, its indexes and a new trailer. Handed to the OS
+        # with every chunk, so a runner killed outright (kill -9) leaves a file that any MCAP reader reads
+        # up to its last chunk, which the guard then completes with its summary.
+        self._write_trailed(out)
+        index_record = _record_bytes(index)
+        self._chunk_counts.append(counts)
+        self._chunk_indexes.append(index)
+        tail = self._tail
+        tail.chunk_indexes.append(index_record)
+        for cid, n in counts.items():
+            tail.counts[cid] = tail.counts.get(cid, 0) + n
+        tail.start_ns = start if tail.start_ns is None else min(tail.start_ns, start)
+        tail.end_ns = max(tail.end_ns, end)
         self._good = self._pos
         self.flushed_at = time.monotonic()
+        if self.guard is not None:
+            self.guard.send(("chunk", index_record, counts, start, end, self._good))
+
+    def _write_trailed(self, data: bytes | bytearray) -> None:
+        """Write `data` followed by `TRAILER` (an MCAP end without a summary), the file position staying
+        at the end of `data`: until the next write the file is complete, only without an index."""
+        self._write(data + TRAILER)
+        self._stream.seek(-len(TRAILER), os.SEEK_CUR)
+        self._pos -= len(TRAILER)
 
     def finish_in_room(self) -> int:
         """`finish`, after a failed write: where the summary does not fit in what cutting back freed (a
@@ -276,60 +284,23 @@ class _McapFile:
                 if not self._chunk_indexes:
                     raise
             last = self._chunk_indexes.pop()
+            tail = self._tail
+            tail.chunk_indexes.pop()
             for cid, n in self._chunk_counts.pop().items():
                 self._by_id[cid].stats.count -= n
+                tail.counts[cid] -= n
             self._good = last.chunk_start_offset
             self.cut_back()
-            self._end_ns = max((c.message_end_time for c in self._chunk_indexes), default=0)
+            tail.end_ns = max((c.message_end_time for c in self._chunk_indexes), default=0)
             given_up += 1
 
     def finish(self) -> None:
         """Write the last chunk, the summary and the footer. Does not close the stream."""
         self.flush_chunk()
-        metadata_index = []
-        if self.note:
-            start = self._pos
-            record = _record_bytes(Metadata(name="scenario", metadata=dict(self.note)))
-            self._write(record)
-            metadata_index.append(MetadataIndex(offset=start, length=len(record), name="scenario"))
-        self._write(_record_bytes(DataEnd(data_section_crc=0)))
-        summary_start = self._pos
-        summary = RecordBuilder()
-        offsets: list[SummaryOffset] = []
-
-        def group(opcode: Opcode, records: list[Any]) -> None:
-            if not records:
-                return
-            begin = summary.count
-            for r in records:
-                r.write(summary)
-            offsets.append(SummaryOffset(int(opcode), summary_start + begin, summary.count - begin))
-
-        counts = {ch.id: ch.stats.count for ch in self._by_id.values()}
-        stats = Statistics(
-            attachment_count=0,
-            channel_count=len(self._channels),
-            channel_message_counts=counts,
-            chunk_count=len(self._chunk_indexes),
-            message_count=sum(counts.values()),
-            message_end_time=self._end_ns,
-            message_start_time=self._start_ns or 0,
-            metadata_count=len(metadata_index),
-            schema_count=len(self._schemas),
-        )
-        group(Opcode.SCHEMA, self._schemas)
-        group(Opcode.CHANNEL, self._channels)
-        group(Opcode.STATISTICS, [stats])
-        group(Opcode.CHUNK_INDEX, self._chunk_indexes)
-        group(Opcode.METADATA_INDEX, metadata_index)
-        summary_offset_start = summary_start + summary.count
-        for o in offsets:
-            o.write(summary)
-        data = summary.end()
-        footer_head = struct.pack("<BQQQ", int(Opcode.FOOTER), 8 + 8 + 4, summary_start, summary_offset_start)
-        crc = zlib.crc32(footer_head, zlib.crc32(data))
-        self._write(data)
-        self._write(footer_head + struct.pack("<I", crc) + _MAGIC)
+        for ch in self._by_id.values():  # channels registered in a chunk never written: 0 messages
+            self._tail.counts.setdefault(ch.id, 0)
+        self._write(self._tail.end(self._pos, self.note))
+        self._stream.truncate()  # (the summary always covers the trailer it replaces: only to be sure)
         self._stream.flush()
 
 
@@ -357,6 +328,8 @@ class Recorder:
     chunk_size: int = CHUNK_SIZE
     types: dict[str, str] = field(default_factory=dict)  # the type each known key carries (the plan's)
     inbound: set[str] = field(default_factory=set)  # keys the worlds take from others: checked to decode
+    # a guard process finishes the file if this process dies before it does (kill -9): runner.finisher
+    guarded: bool = False
 
     def __post_init__(self) -> None:
         self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -365,7 +338,14 @@ class Recorder:
         # unbuffered: whole chunks are written at once, and a failed write (a full disk) leaves no buffer
         # behind that a later flush would write past the point the file is cut back to
         self._file: IO[bytes] = open(self.path, "wb", buffering=0)  # noqa: SIM115 - closed in close()
-        self._mcap = _McapFile(self._file, profile="ros2", library=self.library, chunk_size=self.chunk_size)
+        self._guard = Guard(self.path, self._claim_fd) if self.guarded else None
+        self._mcap = _McapFile(
+            self._file,
+            profile="ros2",
+            library=self.library,
+            chunk_size=self.chunk_size,
+            guard=self._guard,
+        )
         self._lock = threading.Lock()
         self._schemas: dict[str, int] = {}
         self._channels: dict[str, _Channel] = {}
@@ -613,6 +593,8 @@ class Recorder:
                 )
             finally:
                 self._file.close()
+                if self._guard is not None:
+                    self._guard.done()
                 with contextlib.suppress(OSError):  # the path is free for the next run
                     self.path.with_name(f".{self.path.name}.lock").unlink()
                     os.close(self._claim_fd)
@@ -742,6 +724,23 @@ def recover(path: Path, out: Path) -> dict[str, Any]:
                 )
         writer.finish()
     return read_summary(out)
+
+
+def recording_live(path: Path) -> bool:
+    """Whether a live run (or its guard) holds the claim on the recording `path` (see `_claim`)."""
+    import fcntl
+
+    try:
+        fd = os.open(path.with_name(f".{path.name}.lock"), os.O_RDONLY)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except OSError:
+        return True
+    finally:
+        os.close(fd)
+    return False
 
 
 def _claim(path: Path) -> tuple[Path, int]:

@@ -164,3 +164,80 @@ def test_mcap_layout_chunks_indexes_and_summary(tmp_path: Path):
                 indexed += 1
         assert lengths == ci.message_index_length
     assert indexed == s.statistics.message_count == sum(map(len, expected.values()))
+
+
+def _twists(n: int) -> list[bytes]:
+    return [
+        msgs.encode(
+            msgs.from_data("geometry_msgs/msg/Twist", {"linear": {"x": float(i)}}), "geometry_msgs/msg/Twist"
+        )
+        for i in range(n)
+    ]
+
+
+def test_a_recording_reads_at_every_chunk_while_it_is_written(tmp_path: Path):
+    """Each chunk goes out with an end that says "no summary yet": a reader opening the file mid-run (or
+    after a crash) reads every chunk written so far with the standard reader, from the start."""
+    path = tmp_path / "live.mcap"
+    rec = Recorder(path, ["r/**"], chunk_size=1024)
+    try:
+        with open(path, "rb") as f:  # header only: complete, empty
+            assert list(make_reader(f).iter_messages()) == []
+        for i, data in enumerate(_twists(300)):
+            rec.write("r/cmd", "geometry_msgs/msg/Twist", data, (i, i * 1000))
+        with open(path, "rb") as f:
+            reader = make_reader(f, decoder_factories=[DecoderFactory()])
+            assert reader.get_summary() is None
+            xs = [m.linear.x for _, _, _, m in reader.iter_decoded_messages()]
+        assert 250 < len(xs) < 300 and xs == [float(i) for i in range(len(xs))]  # all but the open chunk
+    finally:
+        rec.close()
+    with open(path, "rb") as f:
+        assert len(list(make_reader(f).iter_messages())) == 300
+
+
+_KILLED_WRITER = """
+import os, signal, sys
+from pathlib import Path
+from runner import msgs
+from runner.record import Recorder
+
+path = Path(sys.argv[1])
+rec = Recorder(path, ["r/**"], chunk_size=1024, guarded=True)
+data = [msgs.encode(msgs.from_data("geometry_msgs/msg/Twist", {"linear": {"x": float(i)}}),
+        "geometry_msgs/msg/Twist") for i in range(500)]
+for i, d in enumerate(data):
+    rec.write("r/cmd", "geometry_msgs/msg/Twist", d, (i, i * 1000))
+rec._mcap.flush_chunk()
+with open(path, "ab") as f:  # the head of a chunk whose write was cut short by the kill
+    f.write(bytes([0x06]) + (10**6).to_bytes(8, "little") + os.urandom(3000))
+os.kill(os.getpid(), signal.SIGKILL)
+"""
+
+
+@pytest.mark.timeout(60)
+def test_the_guard_finishes_a_recording_whose_process_was_killed(tmp_path: Path):
+    """A recording process killed outright, in the middle of writing a chunk: its guard drops the partial
+    chunk, writes summary, indexes and a note; the standard reader reads every whole chunk, CRCs checked."""
+    import subprocess
+    import sys
+
+    path = tmp_path / "killed.mcap"
+    # stderr is shared with the guard: run() returns once the guard is done too
+    proc = subprocess.run(
+        [sys.executable, "-c", _KILLED_WRITER, str(path)], capture_output=True, text=True, timeout=50
+    )
+    assert proc.returncode == -9
+    assert "finished it" in proc.stderr, proc.stderr
+    with open(path, "rb") as f:
+        reader = SeekingReader(f, validate_crcs=True, decoder_factories=[DecoderFactory()])
+        summary = reader.get_summary()
+        assert summary is not None and summary.statistics is not None
+        xs = [m.linear.x for _, _, _, m in reader.iter_decoded_messages()]
+        meta = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
+    assert xs == [float(i) for i in range(500)]
+    assert summary.statistics.message_count == 500 and len(summary.chunk_indexes) > 10
+    assert "killed" in meta["scenario"]["stopped"]
+    info = read_summary(path)
+    assert info["messages"] == 500 and not info["cut"] and "killed" in info["stopped"]["stopped"]
+    assert not path.with_name(f".{path.name}.lock").exists()

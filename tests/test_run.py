@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 from runner.transport import free_port
-from tests.conftest import REPO, SCENARIOS, read_mcap, run_cli, scenario_cmd
+from tests.conftest import REPO, SCENARIOS, processes_of, read_mcap, run_cli, scenario_cmd
 
 # topic suffix -> rate (sim Hz) in scenarios/two_robots.yaml
 DEMO_RATES = {
@@ -238,7 +238,7 @@ def test_a_dead_world_process_fails_the_run_and_keeps_the_recording(tmp_path: Pa
     mcap = tmp_path / "crash.mcap"
     proc = _start_long_run(mcap)
     try:
-        children = _children(proc.pid)
+        children = processes_of(proc.pid, r"runner\.sim /", direct=True)  # (not the recording's guard)
         assert len(children) == 1
         killed = time.monotonic()
         os.kill(children[0], signal.SIGKILL)
@@ -264,42 +264,102 @@ def test_unwritable_recording_is_a_clear_error(tmp_path: Path):
     assert "cannot write the recording" in proc.stderr and "Traceback" not in proc.stderr
 
 
+def _kill_outright(proc: subprocess.Popen[str], *, guard_too: bool = False) -> list[int]:
+    """kill -9 the runner (and its recording's guard, with `guard_too`); returns the runner's children."""
+    children = _children(proc.pid)
+    guards = [c for c in children if b"runner/finisher.py" in Path(f"/proc/{c}/cmdline").read_bytes()]
+    assert len(guards) == 1, "a recording run has one guard"
+    if guard_too:
+        os.kill(guards[0], signal.SIGKILL)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=10)
+    return [c for c in children if c not in guards]
+
+
+def _gone(pids: list[int], within: float = 5.0) -> bool:
+    deadline = time.monotonic() + within
+    while any(Path(f"/proc/{c}").exists() for c in pids) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    return not any(Path(f"/proc/{c}").exists() for c in pids)
+
+
 @pytest.mark.timeout(90)
-def test_a_runner_killed_outright_leaves_a_recording_readable_to_its_last_chunk(tmp_path: Path):
-    """kill -9 of the runner: no summary is written, yet every chunk it wrote (at most a second behind)
-    reads back; `scenario info` says the file was cut and how far it reaches, `scenario recover` writes a
-    complete copy; the world, orphaned, stops by itself."""
+def test_a_runner_killed_outright_leaves_a_complete_recording(tmp_path: Path):
+    """kill -9 of the runner: its guard writes the summary at the last whole chunk (at most a second
+    behind), so the standard reader (`make_reader(f).iter_messages()`, summary and indexes) reads every
+    message, right after the kill; `scenario info` says how it ended; the orphaned world stops by itself."""
+    from mcap.reader import make_reader
+
     mcap = tmp_path / "killed.mcap"
     proc = _start_long_run(mcap)
     try:
         time.sleep(2.5)
-        children = _children(proc.pid)
-        os.kill(proc.pid, signal.SIGKILL)
+        live = run_cli("info", str(mcap))
+        assert live.returncode == 0, live.stderr
+        assert "live: a run is still recording this file" in live.stdout
+        worlds = _kill_outright(proc)
+        proc.communicate(timeout=10)  # its stderr is closed once the guard, which shares it, is done
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    with open(mcap, "rb") as f:
+        reader = make_reader(f)
+        summary = reader.get_summary()
+        assert summary is not None and summary.chunk_indexes, "the guard wrote the summary and its indexes"
+        counted = sum(summary.statistics.channel_message_counts.values())
+        assert counted == sum(1 for _ in reader.iter_messages()) > 0
+    assert not mcap.with_name(f".{mcap.name}.lock").exists(), "the guard gave the recording's name back"
+    assert _gone(worlds), "the world outlived its runner"
+
+    info = run_cli("info", str(mcap))
+    assert info.returncode == 0, info.stderr
+    assert "stopped early: its runner ended without finishing the recording (killed)" in info.stdout
+    assert "live:" not in info.stdout and "cut:" not in info.stdout
+    messages = read_mcap(mcap)  # every message decodes (mcap_ros2, mcap_protobuf)
+    clock = [t for topic, _, t, _ in messages if topic == "two_robots/clock"]
+    scans = [t for topic, _, t, _ in messages if topic == "two_robots/r1/scan"]
+    assert clock[-1] / 1e9 >= 2.0  # ~3.5 s of sim were run at real time; a second at most is lost
+    assert abs(len(scans) - (clock[-1] / 1e8 + 1)) <= 2  # nothing missing up to the end
+
+
+@pytest.mark.timeout(90)
+def test_a_recording_whose_guard_is_killed_too_still_reads_to_its_last_chunk(tmp_path: Path):
+    """Runner and guard both killed (-9): no summary, but each chunk is written with an end that says
+    "no summary", so the standard reader still reads every chunk from the start; `scenario info` says the
+    file was cut and how far it reaches, `scenario recover` writes a complete, indexed copy."""
+    from mcap.reader import make_reader
+
+    mcap = tmp_path / "killed.mcap"
+    proc = _start_long_run(mcap)
+    try:
+        time.sleep(2.5)
+        worlds = _kill_outright(proc, guard_too=True)
         proc.communicate(timeout=10)
     finally:
         if proc.poll() is None:
             proc.kill()
-    deadline = time.monotonic() + 5
-    while any(Path(f"/proc/{c}").exists() for c in children) and time.monotonic() < deadline:
-        time.sleep(0.1)
-    assert not any(Path(f"/proc/{c}").exists() for c in children), "the world outlived its runner"
+    assert _gone(worlds), "the world outlived its runner"
+    with open(mcap, "rb") as f:
+        reader = make_reader(f)
+        assert reader.get_summary() is None
+        plain = sum(1 for _ in reader.iter_messages())
+    assert plain > 0
 
     info = run_cli("info", str(mcap))
     assert info.returncode == 0, info.stderr
     assert "cut: the recording has no summary" in info.stdout
     reach = float(info.stdout.split("it reaches ")[1].split(" s sim")[0])
-    assert reach >= 2.0  # ~3.5 s of sim were run at real time; a second at most is lost
+    assert reach >= 2.0
 
     fixed = tmp_path / "fixed.mcap"
     rec = run_cli("recover", str(mcap), "-o", str(fixed))
     assert rec.returncode == 0, rec.stderr
     messages = read_mcap(fixed)  # complete: summary and indexes, read by the standard reader
+    assert len(messages) == plain
     clock = [t for topic, _, t, _ in messages if topic == "two_robots/clock"]
     scans = [t for topic, _, t, _ in messages if topic == "two_robots/r1/scan"]
     assert clock[-1] / 1e9 == pytest.approx(reach, abs=0.05)
     assert abs(len(scans) - (clock[-1] / 1e8 + 1)) <= 2  # nothing missing up to the cut
-    info2 = run_cli("info", str(fixed))
-    assert "cut:" not in info2.stdout and f"{len(messages)} messages" in info2.stdout
 
 
 @pytest.mark.timeout(60)
