@@ -187,6 +187,16 @@ def _print_notices(notices: list[str], verbose: bool) -> None:
         err.print("warning: " + text, markup=False, style="yellow")
 
 
+AllowUndecided = Annotated[
+    bool,
+    typer.Option(
+        "--allow-undecided",
+        help="An assertion the run could not decide (its window lies past the run's end, the run was "
+        "interrupted, its topic carried nothing) does not fail the run (by default it does).",
+    ),
+]
+
+
 @app.command()
 def run(
     file: Annotated[Path, typer.Argument(help="Scenario YAML file.")],
@@ -232,6 +242,7 @@ def run(
             max=65535,
         ),
     ] = None,
+    allow_undecided: AllowUndecided = False,
 ) -> None:
     """Validate, compile and run a scenario; record every message to MCAP; judge its assertions. With a
     `matrix:`, every variant runs and is judged on its own. With `hosts:`, this plays the first (main)
@@ -282,7 +293,16 @@ def run(
         if label and not quiet:
             err.print(f"variant {i}: {label}", markup=False)
         suite, rc = _run_one(
-            plan, label, quiet, listen, connect, no_judge, None if local else host, strict, foxglove
+            plan,
+            label,
+            quiet,
+            listen,
+            connect,
+            no_judge,
+            None if local else host,
+            strict,
+            foxglove,
+            allow_undecided=allow_undecided,
         )
         suites.append(suite)
         code = max(code, rc)
@@ -327,8 +347,11 @@ def _run_one(
     host: str | None = None,
     strict: bool = False,
     foxglove: int | None = None,
+    allow_undecided: bool = False,
 ) -> tuple[Any, int]:
-    from runner.checks.report import Suite, judge_for
+    from runner.checks.report import Suite, _now, judge_for
+
+    started = _now()
     from runner.launch import run_plan
     from runner.transport import free_port, use_run_settings
 
@@ -385,11 +408,14 @@ def _run_one(
         if progress is not None:
             progress.stop()
 
-    results = judge.finish(result.sim_ns) if judge is not None else []
+    ended = None if result.reason == "completed" else _ended(result.reason, result.sim_ns)
+    results = (
+        judge.finish(result.sim_ns, complete=ended is None, why=ended or "") if judge is not None else []
+    )
     if not quiet:
         _print_summary(result)
     if results:
-        _print_results(results)
+        _print_results(results, allow_undecided)
     error = result.error
     lost = sum(result.lost.values()) + sum(t.lost for t in result.topics)
     if strict and lost and error is None:
@@ -398,7 +424,17 @@ def _run_one(
     if error:
         err.print("error: " + error, markup=False, style="red")
     name = f"{plan.name}[{label}]" if label else plan.name
-    suite = Suite(name, results, error, result.wall_s, str(result.mcap) if result.mcap else None)
+    suite = Suite(
+        name,
+        results,
+        error,
+        result.wall_s,
+        str(result.mcap) if result.mcap else None,
+        sim_s=result.sim_ns / 1e9,
+        allow_undecided=allow_undecided,
+        timestamp=started,
+        interrupted=ended,
+    )
     if results and not suite.passed and result.mcap is not None:
         _plot(plan, result.mcap, results)
     code = result.exit_code
@@ -420,7 +456,20 @@ def _plot(plan: Any, mcap: Path, results: list[Any]) -> None:
         out.print(f"trajectory plot: {png}", markup=False)
 
 
-def _print_results(results: list[Any]) -> None:
+def _ended(reason: str, sim_ns: int) -> str:
+    """Why a run ended before its planned end, as a verdict's reason says it."""
+    how = {
+        "interrupted": "terminated (SIGTERM)" if interrupts.terminated() else "interrupted",
+        "stopped": "stopped early",
+        "failed": "stopped by an error",
+    }.get(reason, reason)
+    return f"the run was {how} at t={sim_ns / 1e9:.3f} s"
+
+
+MARKS = {"pass": "[green]pass[/]", "fail": "[bold red]FAIL[/]", "undecided": "[yellow]not decided[/]"}
+
+
+def _print_results(results: list[Any], allow_undecided: bool = False) -> None:
     table = Table(
         "assertion",
         "type",
@@ -432,12 +481,22 @@ def _print_results(results: list[Any]) -> None:
         title_justify="left",
     )
     for r in results:
-        mark = "[green]pass[/]" if r.passed else "[bold red]FAIL[/]"
-        table.add_row(r.name, r.type, mark, f"{r.t:.3f}" if r.t is not None else "", r.value, r.bound)
+        table.add_row(
+            r.name, r.type, MARKS[r.status], f"{r.t:.3f}" if r.t is not None else "", r.value, r.bound
+        )
     out.print(table)
-    failed = [r for r in results if not r.passed]
-    summary = f"{len(results) - len(failed)} passed, {len(failed)} failed"
-    out.print(summary, style="red" if failed else "green", markup=False)
+    failed = [r for r in results if r.status == "fail"]
+    undecided = [r for r in results if r.undecided]
+    summary = f"{len(results) - len(failed) - len(undecided)} passed, {len(failed)} failed"
+    if undecided:
+        counted = (
+            "not counted as failures: --allow-undecided" if allow_undecided else "each counts as a failure"
+        )
+        summary += f", {len(undecided)} not decided ({counted})"
+    bad = failed or (undecided and not allow_undecided)
+    out.print(summary, style="red" if bad else ("yellow" if undecided else "green"), markup=False)
+    for r in undecided:
+        out.print(f"  not decided: {r.name}: {r.message}", markup=False)
 
 
 @app.command()
@@ -450,6 +509,7 @@ def check(
     variant: Annotated[
         int | None, typer.Option(help="The matrix variant the recording is of (0-based).", min=0)
     ] = None,
+    allow_undecided: AllowUndecided = False,
 ) -> None:
     """Judge a recording with a scenario's assertions (the same judge as the live run).
 
@@ -469,11 +529,18 @@ def check(
     if not mcap.is_file():
         raise _fail(RunError(f"{mcap}: file not found"))
     try:
-        results, _end = judge_recording(plan, mcap)
+        results, end, ended = judge_recording(plan, mcap)
     except Exception as e:
         raise _fail(RunError(f"{mcap}: cannot judge it: {type(e).__name__}: {e}")) from None
-    _print_results(results)
-    suite = Suite(plan.name, results, mcap=str(mcap))
+    _print_results(results, allow_undecided)
+    suite = Suite(
+        plan.name,
+        results,
+        mcap=str(mcap),
+        sim_s=end / 1e9,
+        allow_undecided=allow_undecided,
+        interrupted=ended,
+    )
     if not suite.passed:
         _plot(plan, mcap, results)
     if junit is not None:
@@ -490,6 +557,7 @@ def test_cmd(
     no_record: Annotated[
         bool, typer.Option("--no-record", help="Judge live only; write no recordings.")
     ] = False,
+    allow_undecided: AllowUndecided = False,
 ) -> None:
     """Run many scenarios (in parallel processes), print a results table, write JUnit XML; exit 0 only if
     every run completes and every assertion passes.
@@ -531,6 +599,8 @@ def test_cmd(
             cmd += ["--no-record"] if no_record else ["--record", str(out_dir / f"{stem}.mcap")]
             if index is not None:
                 cmd += ["--variant", str(index)]
+            if allow_undecided:
+                cmd += ["--allow-undecided"]
             proc = subprocess.run(cmd, capture_output=True, text=True)
             if res.is_file():
                 suite = Suite.from_json(json.loads(res.read_text()))
@@ -558,6 +628,7 @@ def test_cmd(
         "assertions",
         "passed",
         "failed",
+        *(["not decided"] if any(s.undecided for s in suites) else []),
         "result",
         "time (s)",
         *(["report"] if reports else []),
@@ -565,7 +636,7 @@ def test_cmd(
         title_justify="left",
     )
     for s in suites:
-        failed = sum(1 for r in s.results if not r.passed)
+        failed = sum(1 for r in s.results if r.status == "fail")
         verdict = "[green]pass[/]" if s.passed else ("[bold red]ERROR[/]" if s.error else "[bold red]FAIL[/]")
         link = (
             [f"[link=file://{Path(reports[s.name]).resolve()}]{reports[s.name]}[/link]"]
@@ -575,8 +646,9 @@ def test_cmd(
         table.add_row(
             s.name,
             str(len(s.results)),
-            str(len(s.results) - failed),
+            str(len(s.results) - failed - s.undecided),
             str(failed),
+            *([str(s.undecided)] if any(x.undecided for x in suites) else []),
             verdict,
             f"{s.time_s:.1f}",
             *(link or ([""] if reports else [])),

@@ -27,7 +27,7 @@ import zenoh
 from runner import msgs
 from runner.errors import RunError
 from runner.graph import GraphTokens
-from runner.interrupts import interruptible
+from runner.interrupts import interruptible, terminated
 from runner.nodes import NodeError, Nodes, OutputTail
 from runner.plan import NodePlan, RunPlan
 from runner.record import Recorder, TopicStats
@@ -460,6 +460,12 @@ def run_plan(
             with contextlib.suppress(Exception):
                 s.undeclare()
         if recorder is not None:
+            # how the run ended, for judging the recording by itself later (`scenario check`)
+            how = "terminated" if reason == "interrupted" and terminated() else reason
+            if sys.exc_info()[0] is not None or (error is not None and how == "completed"):
+                how = "failed"  # (a start-up that timed out...: leaving through an exception)
+            ends = [int(p.end_info["sim_ns"]) for p in parts if "sim_ns" in p.end_info]
+            recorder.end_note(ended=how, sim_ns=str(min(ends, default=recorder.latest_ns)))
             recorder.close()
         if live is not None:
             live.close()

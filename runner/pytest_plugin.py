@@ -2,7 +2,8 @@
 collected as tests, one item per assertion, so `pytest scenarios/` works in an existing suite.
 
 Each scenario runs once (`scenario run --no-record`, judged live); its assertions report their verdicts,
-with the time, value and bound of a failure.
+with the time, value and bound of a failure. An assertion the run could not decide (its window lies past
+the run's end...) fails, saying why; `--scenario-allow-undecided` makes it a skip instead.
 """
 
 from __future__ import annotations
@@ -15,6 +16,14 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption(
+        "--scenario-allow-undecided",
+        action="store_true",
+        help="scenario assertions that a run could not decide are skipped, not failed",
+    )
 
 
 def pytest_collect_file(parent: pytest.Collector, file_path: Path) -> pytest.Collector | None:
@@ -76,6 +85,11 @@ class ScenarioItem(pytest.Item):
         result = next((r for r in data["results"] if r["name"] == self.name), None)
         if result is None:
             raise ScenarioFailure(f"assertion {self.name!r} was not judged")
+        if result.get("status") == "undecided":
+            why = f"{self.name} ({result['type']}) not decided: {result['message']}"
+            if self.config.getoption("--scenario-allow-undecided", False):
+                pytest.skip(why)
+            raise ScenarioFailure(why)
         if not result["passed"]:
             at = f" at t={result['t']:.3f} s" if result["t"] is not None else ""
             raise ScenarioFailure(

@@ -561,6 +561,11 @@ class Recorder:
                         self._mcap.cut_back()
                     print(f"recorder: recording stopped: {e}", file=sys.stderr, flush=True)
 
+    def end_note(self, **values: str) -> None:
+        """Say how the run ended, in the recording's `scenario` metadata record (written by `close`)."""
+        with self._lock:
+            self._mcap.note.update(values)
+
     def close(self) -> None:
         """Stop recording (what `subscribe` queued first) and finish the file. Idempotent."""
         sub, self._subscriber = self._subscriber, None
@@ -574,10 +579,9 @@ class Recorder:
                 return
             self.closed = True
             if self.error is not None:
-                self._mcap.note = {
-                    "stopped": "the recording could not be written",
-                    "error": self.error.strerror or str(self.error),
-                }
+                self._mcap.note.update(
+                    stopped="the recording could not be written", error=self.error.strerror or str(self.error)
+                )
             try:
                 if self.error is not None:
                     self._mcap.finish_in_room()
@@ -637,12 +641,13 @@ def read_summary(path: Path) -> dict[str, Any]:
                     "count": stats.channel_message_counts.get(cid, 0),
                 }
             )
-        stopped = None
+        note: dict[str, str] = {}
         for index in summary.metadata_indexes if hasattr(summary, "metadata_indexes") else []:
             if index.name == "scenario":
                 with contextlib.suppress(McapError, struct.error, ValueError, EOFError):
                     meta = next((m for m in make_reader(f).iter_metadata() if m.name == "scenario"), None)
-                    stopped = dict(meta.metadata) if meta is not None else None
+                    note = dict(meta.metadata) if meta is not None else {}
+        stopped = note if "stopped" in note else None
         return {
             "start_ns": stats.message_start_time,
             "end_ns": stats.message_end_time,
@@ -650,6 +655,7 @@ def read_summary(path: Path) -> dict[str, Any]:
             "topics": topics,
             "cut": False,
             "stopped": stopped,  # why the recording ended early, when it says so (a full disk)
+            "ended": note.get("ended"),  # how the run ended: completed, interrupted, terminated...
         }
 
 

@@ -326,21 +326,35 @@ def _min_below_max(v: float | None, info: Any, unit: str) -> float | None:
 
 
 class Reach(_AssertionBase):
-    """A robot's base comes within `tolerance` of `point` (or inside `region`) by sim time `by`."""
+    """A robot's base comes within `tolerance` of `point` (or inside `region`) between sim times `after`
+    and `by`; with `leave`, only once it has first gone that far from where it was at `after` (so "leave
+    the start by 1 m, then come back within 0.3 m" is one assertion)."""
 
     type: Literal["reach"] = Field(description="Assertion kind.")
     robot: str = Field(description="Robot name.")
     point: Vec2 | None = Field(None, description="Goal point [x, y].")
     tolerance: PositiveFloat = Field(0.25, description="How close to `point` counts, metres.")
     region: Region | None = Field(None, description="Goal region, instead of a point.")
+    after: NonNegativeFloat = Field(
+        0.0, description="Sim seconds before which poses do not count (the start of the window)."
+    )
     by: PositiveFloat | None = Field(
         None, description="Deadline in sim seconds (default: the end of the run)."
+    )
+    leave: PositiveFloat | None = Field(
+        None,
+        description="Reaching counts only after the robot has gone this far (metres) from where it was "
+        "when the window opened.",
     )
 
     @model_validator(mode="after")
     def _goal(self) -> Reach:
         if (self.point is None) == (self.region is None):
             raise ValueError("a reach assertion has either `point: [x, y]` or `region:`")
+        if self.by is not None and self.by <= self.after:
+            raise ValueError(
+                f"the deadline (by: {self.by:g}) is not after the window opens (after: {self.after:g})"
+            )
         return self
 
 
@@ -363,8 +377,8 @@ class NoCollision(_AssertionBase, _Window):
     )
 
 
-class TopicRate(_AssertionBase):
-    """A topic's rate in sim time stays within bounds after a warm-up."""
+class TopicRate(_AssertionBase, _Window):
+    """A topic's rate in sim time stays within bounds after a warm-up (over the window)."""
 
     type: Literal["topic_rate"] = Field(description="Assertion kind.")
     topic: str = Field(description="Topic inside the run, e.g. `r1/scan`.")
@@ -406,9 +420,9 @@ class MaxTilt(_AssertionBase, _Window):
     max: PositiveFloat = Field(description="Tilt bound (angle from upright), radians.")
 
 
-class DistanceTraveled(_AssertionBase):
+class DistanceTraveled(_AssertionBase, _Window):
     type: Literal["distance_traveled"] = Field(
-        description="Assertion kind: the length of a robot's path over the run is within bounds."
+        description="Assertion kind: the length of a robot's path over the window is within bounds."
     )
     robot: str = Field(description="Robot name.")
     min: NonNegativeFloat | None = Field(None, description="Shortest acceptable path, metres.")

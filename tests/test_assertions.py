@@ -251,7 +251,7 @@ def test_live_and_recorded_judgements_agree_on_every_example(example: str, tmp_p
             live.feed(key, stamp[1], msgs.decode(payload, type_name))  # type: ignore[index]
     rec.close()
     on = live.finish(plan.duration_ns)
-    off, _ = judge_recording(plan, tmp_path / "x.mcap")
+    off, _, _ = judge_recording(plan, tmp_path / "x.mcap")
     assert [r.to_json() for r in on] == [r.to_json() for r in off]
     assert all(r.passed for r in on), [r for r in on if not r.passed]
 

@@ -27,7 +27,7 @@ STYLE = """
 body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;margin:2em auto;max-width:1000px;
 color:#222;padding:0 1em}h1{margin-bottom:.1em}.sub{color:#666;margin-top:0}table{border-collapse:collapse;
 margin:.5em 0 1.5em}td,th{border-bottom:1px solid #ddd;padding:.25em .8em;text-align:left;font-size:.92em}
-th{background:#f4f4f6}.pass{color:#1a7f37;font-weight:600}.fail{color:#cf222e;font-weight:600}
+th{background:#f4f4f6}.pass{color:#1a7f37;font-weight:600}.fail{color:#cf222e;font-weight:600}.undecided{color:#9a6700;font-weight:600}
 .badge{display:inline-block;padding:.2em .7em;border-radius:1em;color:#fff;font-weight:600}
 .ok{background:#1a7f37}.ko{background:#cf222e}figure{margin:0 0 1.5em}figcaption{color:#555;font-size:.9em}
 .frames img{max-width:32%;margin-right:1%}svg{background:#fcfcfd;border:1px solid #e4e4e8}
@@ -247,15 +247,22 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
         for t in summary["topics"]
         if "/_" not in t["topic"]
     )
-    results_rows = "".join(
-        f'<tr><td>{h(r.name)}</td><td>{h(r.type)}</td><td class="{"pass" if r.passed else "fail"}">'
-        f"{'pass' if r.passed else 'FAIL'}</td><td>{'' if r.t is None else f'{r.t:.2f}'}</td>"
-        f"<td>{h(str(r.value or ''))}</td><td>{h(str(r.bound or ''))}</td></tr>"
-        for r in results
-    )
+    label = {"pass": "pass", "fail": "FAIL", "undecided": "not decided"}
+
+    def result_row(r: Any) -> str:
+        why = f"<br><small>{h(r.message)}</small>" if r.undecided else ""  # (why it was not decided)
+        at = "" if r.t is None else f"{r.t:.2f}"
+        return (
+            f'<tr><td>{h(r.name)}</td><td>{h(r.type)}</td><td class="{r.status}">{label[r.status]}</td>'
+            f"<td>{at}</td><td>{h(str(r.value or ''))}</td><td>{h(str(r.bound or ''))}{why}</td></tr>"
+        )
+
+    results_rows = "".join(result_row(r) for r in results)
+    undecided = sum(r.undecided for r in results)
     verdict = (
         f'<span class="badge {"ok" if passed == len(results) else "ko"}">'
-        f"{passed} of {len(results)} assertions pass</span>"
+        f"{passed} of {len(results)} assertions pass"
+        f"{f', {undecided} not decided' if undecided else ''}</span>"
         if results
         else '<span class="badge ok">no assertions</span>'
     )

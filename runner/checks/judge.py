@@ -51,15 +51,26 @@ def judged_types(plan: Any) -> dict[str, str]:
     return types
 
 
+PASS, FAIL, UNDECIDED = "pass", "fail", "undecided"
+
+
 @dataclass
 class Result:
     name: str
     type: str
-    passed: bool
+    status: str  # PASS, FAIL or UNDECIDED (the run never showed enough to decide; `message` says why)
     t_ns: int | None  # when it was decided (the failure's time), if it was
     value: str  # what was measured
     bound: str  # what it was held to
     message: str
+
+    @property
+    def passed(self) -> bool:
+        return self.status == PASS
+
+    @property
+    def undecided(self) -> bool:
+        return self.status == UNDECIDED
 
     @property
     def t(self) -> float | None:
@@ -69,12 +80,28 @@ class Result:
         return {
             "name": self.name,
             "type": self.type,
+            "status": self.status,
             "passed": self.passed,
             "t": self.t,
             "value": self.value,
             "bound": self.bound,
             "message": self.message,
         }
+
+
+@dataclass(frozen=True)
+class Span:
+    """What the run covered, for the checks deciding at its end: sim time up to `end_ns`, all of it
+    (`complete`: the run reached its planned end) or not (`why`: "the run was interrupted at t=6.800 s")."""
+
+    end_ns: int
+    complete: bool = True
+    why: str = ""
+
+    @property
+    def ended(self) -> str:
+        """How the run ended, to say why a window it did not reach was not seen."""
+        return self.why if not self.complete else f"after the run's end at t={self.end_ns / 1e9:.3f} s"
 
 
 @dataclass
@@ -90,18 +117,54 @@ class _Check:
 
     def decide(self, passed: bool, t_ns: int | None, value: str, bound: str, message: str) -> None:
         if self.result is None:
-            self.result = Result(self.spec.name, self.spec.type, passed, t_ns, value, bound, message)
+            self.result = Result(
+                self.spec.name, self.spec.type, PASS if passed else FAIL, t_ns, value, bound, message
+            )
 
-    def in_window(self, t_ns: int) -> bool:
+    def undecided(self, span: Span, value: str, bound: str, why: str) -> None:
+        if self.result is None:
+            self.result = Result(self.spec.name, self.spec.type, UNDECIDED, span.end_ns, value, bound, why)
+
+    def window_ns(self) -> tuple[int, int | None]:
+        """The window [after, until] in sim ns; None: to the end of the run."""
         after = getattr(self.spec, "after", 0.0) or 0.0
         until = getattr(self.spec, "until", None)
-        return t_ns >= after * 1e9 and (until is None or t_ns <= until * 1e9)
+        if until is None:
+            until = getattr(self.spec, "by", None)  # reach: its deadline
+        return round(after * 1e9), None if until is None else round(until * 1e9)
+
+    def in_window(self, t_ns: int) -> bool:
+        a, u = self.window_ns()
+        return t_ns >= a and (u is None or t_ns <= u)
+
+    def unseen(self, span: Span) -> str | None:
+        """Why the run did not show the whole window (then nothing that needs all of it can be decided)."""
+        a, u = self.window_ns()
+        end = span.end_ns
+        if a > end:
+            return f"the window opens at t={a / 1e9:g} s, {span.ended}"
+        if u is None:
+            return None if span.complete else span.why
+        if u > end:
+            return f"the window runs to t={u / 1e9:g} s, {span.ended}"
+        return None
 
     def feed(self, t_ns: int, msg: Any) -> None:  # overridden
         raise NotImplementedError
 
-    def finish(self, end_ns: int) -> None:  # undecided at the end: most checks pass
-        self.decide(True, None, self.extra.get("value", ""), self.extra.get("bound", ""), "held")
+    def finish(self, span: Span) -> None:  # overridden
+        raise NotImplementedError
+
+    def hold(self, span: Span, value: str, bound: str, *, data: bool = True, nothing: str = "") -> None:
+        """The end of a check that fails only on something seen (`always`, `never`, a bound): it passed if
+        the whole window was seen and held data (`data`); else it is not decided, saying why."""
+        why = self.unseen(span)
+        if why is None and not data:
+            why = nothing
+        if why is not None:
+            self.undecided(span, value, bound, why)
+        else:
+            self.decide(True, None, value, bound, "held")
 
 
 def _xy(msg: Any) -> tuple[float, float]:
@@ -112,9 +175,17 @@ def _xy(msg: Any) -> tuple[float, float]:
 class _Reach(_Check):
     def feed(self, t_ns: int, msg: Any) -> None:
         s: Reach = self.spec
-        if self.decided or (s.by is not None and t_ns > s.by * 1e9):
+        if self.decided or not self.in_window(t_ns):
             return
         x, y = _xy(msg)
+        if s.leave is not None and not self.extra.get("left"):
+            start = self.extra.setdefault("start", (x, y))
+            away = math.hypot(x - start[0], y - start[1])
+            self.extra["farthest"] = max(self.extra.get("farthest", 0.0), away)
+            if away < s.leave:
+                self.extra["last"] = (x, y, t_ns)
+                return
+            self.extra["left"] = t_ns
         if s.region is not None:
             inside = s.region.contains(x, y)
             dist = 0.0 if inside else math.nan
@@ -132,22 +203,31 @@ class _Reach(_Check):
     def _bound(self) -> str:
         s: Reach = self.spec
         by = f" by t={s.by:g} s" if s.by is not None else ""
+        after = f" after t={s.after:g} s" if s.after else ""
+        leave = f", having left the start by {s.leave:g} m" if s.leave is not None else ""
         if s.region is not None:
-            return "inside the region" + by
-        return f"within {s.tolerance:g} m of ({s.point[0]:g}, {s.point[1]:g})" + by  # type: ignore[index]
+            return "inside the region" + after + by + leave
+        return f"within {s.tolerance:g} m of ({s.point[0]:g}, {s.point[1]:g})" + after + by + leave  # type: ignore[index]
 
-    def finish(self, end_ns: int) -> None:
+    def finish(self, span: Span) -> None:
         s: Reach = self.spec
-        deadline = round(s.by * 1e9) if s.by is not None else end_ns
         best = self.extra.get("best")
         last = self.extra.get("last")
-        if best is not None:
+        if s.leave is not None and not self.extra.get("left") and last is not None:
+            value = f"never left the start by {s.leave:g} m (at most {self.extra.get('farthest', 0.0):.3f} m)"
+        elif best is not None:
             value = f"closest {best[0]:.3f} m at t={best[3] / 1e9:.3f} s, at ({best[1]:.3f}, {best[2]:.3f})"
         elif last is not None:
             value = f"last at ({last[0]:.3f}, {last[1]:.3f})"
         else:
             value = "no pose received"
-        self.decide(False, min(deadline, end_ns), value, self._bound(), "not reached")
+        why = self.unseen(span)
+        if why is not None:
+            self.undecided(span, value, self._bound(), why)
+            return
+        _, deadline = self.window_ns()
+        at = min(deadline, span.end_ns) if deadline is not None else span.end_ns
+        self.decide(False, at, value, self._bound(), "not reached")
 
 
 class _StayWithin(_Check):
@@ -155,6 +235,7 @@ class _StayWithin(_Check):
         s: StayWithin = self.spec
         if self.decided or not self.in_window(t_ns):
             return
+        self.extra["seen"] = True
         x, y = _xy(msg)
         if s.region.contains(x, y) != s.inside:
             where = "outside" if s.inside else "inside"
@@ -163,8 +244,10 @@ class _StayWithin(_Check):
     def _bound(self) -> str:
         return "inside the region" if self.spec.inside else "outside the region"
 
-    def finish(self, end_ns: int) -> None:
-        self.decide(True, None, "", self._bound(), "held")
+    def finish(self, span: Span) -> None:
+        self.hold(
+            span, "", self._bound(), data=self.extra.get("seen", False), nothing="no pose in the window"
+        )
 
 
 class _NoCollision(_Check):
@@ -172,6 +255,7 @@ class _NoCollision(_Check):
         s: NoCollision = self.spec
         if self.decided or not self.in_window(t_ns):
             return
+        self.extra["seen"] = True
         named = set(s.between)
         for st in msg.states:
             a, b = st.collision1_name, st.collision2_name
@@ -184,19 +268,21 @@ class _NoCollision(_Check):
                 self.decide(False, t_ns, f"{a} touched {b}", "no contact", f"{a} touched {b}")
                 return
 
-    def finish(self, end_ns: int) -> None:
-        self.decide(True, None, "no contact", "no contact", "held")
+    def finish(self, span: Span) -> None:
+        # the world publishes the contacts at 100 Hz, none or some: no message at all is no evidence
+        seen = self.extra.get("seen", False)
+        self.hold(span, "no contact", "no contact", data=seen, nothing="no contact report in the window")
 
 
 class _TopicRate(_Check):
     def feed(self, t_ns: int, msg: Any) -> None:
-        if t_ns < self.spec.after * 1e9:
+        if not self.in_window(t_ns):
             return
         self.extra["n"] = self.extra.get("n", 0) + 1
         self.extra.setdefault("first", t_ns)
         self.extra["last"] = t_ns
 
-    def finish(self, end_ns: int) -> None:
+    def finish(self, span: Span) -> None:
         s: TopicRate = self.spec
         n = self.extra.get("n", 0)
         first, last = self.extra.get("first"), self.extra.get("last")
@@ -204,14 +290,15 @@ class _TopicRate(_Check):
         lo = s.min if s.min is not None else 0.0
         hi = s.max if s.max is not None else math.inf
         bound = f"{lo:g}..{hi:g} Hz" if s.max is not None else f">= {lo:g} Hz"
+        value = f"{rate:.2f} Hz ({n} messages)"
+        why = self.unseen(span)
+        if why is None and n == 0 and not lo:
+            why = f"no message on {s.topic} in the window"  # a bound on nothing: vacuous
+        if why is not None:
+            self.undecided(span, value, bound, why)
+            return
         ok = lo <= rate <= hi
-        self.decide(
-            ok,
-            None if ok else end_ns,
-            f"{rate:.2f} Hz ({n} messages)",
-            bound,
-            "held" if ok else "rate out of bounds",
-        )
+        self.decide(ok, None if ok else span.end_ns, value, bound, "held" if ok else "rate out of bounds")
 
 
 class _Message(_Check):
@@ -237,16 +324,21 @@ class _Message(_Check):
         elif s.mode == "eventually" and value:
             self.decide(True, t_ns, "true", f"eventually {s.expr}", f"true at t={t_ns / 1e9:.3f} s")
 
-    def finish(self, end_ns: int) -> None:
+    def finish(self, span: Span) -> None:
         s: MessageCheck = self.spec
-        if s.mode == "eventually":
-            self.decide(False, end_ns, "never true", f"eventually {s.expr}", f"`{s.expr}` never held")
-        elif not self.extra.get("seen"):
-            self.decide(
-                False, end_ns, "no message", f"{s.mode} {s.expr}", f"no message on {s.topic} in the window"
-            )
+        seen = self.extra.get("seen", False)
+        bound = f"{s.mode} {s.expr}"
+        nothing = f"no message on {s.topic} in the window"
+        if s.mode != "eventually":
+            self.hold(span, "held" if seen else "no message", bound, data=seen, nothing=nothing)
+            return
+        why = self.unseen(span)
+        if why is None and not seen:
+            why = nothing
+        if why is not None:
+            self.undecided(span, "never true" if seen else "no message", bound, why)
         else:
-            self.decide(True, None, "held", f"{s.mode} {s.expr}", "held")
+            self.decide(False, span.end_ns, "never true", bound, f"`{s.expr}` never held")
 
 
 class _MaxSpeed(_Check):
@@ -260,9 +352,14 @@ class _MaxSpeed(_Check):
         if speed > s.max:
             self.decide(False, t_ns, f"{speed:.3f} m/s", f"<= {s.max:g} m/s", "too fast")
 
-    def finish(self, end_ns: int) -> None:
-        self.decide(
-            True, None, f"peak {self.extra.get('peak', 0.0):.3f} m/s", f"<= {self.spec.max:g} m/s", "held"
+    def finish(self, span: Span) -> None:
+        peak = self.extra.get("peak")
+        self.hold(
+            span,
+            f"peak {peak or 0.0:.3f} m/s",
+            f"<= {self.spec.max:g} m/s",
+            data=peak is not None,
+            nothing="no pose in the window",
         )
 
 
@@ -279,29 +376,53 @@ class _MaxTilt(_Check):
         if tilt > s.max:
             self.decide(False, t_ns, f"{tilt:.3f} rad", f"<= {s.max:g} rad", "tilted too far")
 
-    def finish(self, end_ns: int) -> None:
-        self.decide(
-            True, None, f"peak {self.extra.get('peak', 0.0):.3f} rad", f"<= {self.spec.max:g} rad", "held"
+    def finish(self, span: Span) -> None:
+        peak = self.extra.get("peak")
+        self.hold(
+            span,
+            f"peak {peak or 0.0:.3f} rad",
+            f"<= {self.spec.max:g} rad",
+            data=peak is not None,
+            nothing="no pose in the window",
         )
 
 
 class _Distance(_Check):
     def feed(self, t_ns: int, msg: Any) -> None:
+        if not self.in_window(t_ns):
+            return
         x, y = _xy(msg)
         last = self.extra.get("last")
         if last is not None:
             self.extra["d"] = self.extra.get("d", 0.0) + math.hypot(x - last[0], y - last[1])
         self.extra["last"] = (x, y)
+        s: DistanceTraveled = self.spec
+        if s.max is not None and self.extra.get("d", 0.0) > s.max:  # a path only grows: decided now
+            self.decide(False, t_ns, f"{self.extra['d']:.3f} m", self._bound(), "path length out of bounds")
 
-    def finish(self, end_ns: int) -> None:
+    def _bound(self) -> str:
+        s: DistanceTraveled = self.spec
+        lo = s.min if s.min is not None else 0.0
+        return f"{lo:g}..{s.max:g} m" if s.max is not None else f">= {lo:g} m"
+
+    def finish(self, span: Span) -> None:
         s: DistanceTraveled = self.spec
         d = self.extra.get("d", 0.0)
+        value = f"{d:.3f} m"
+        why = self.unseen(span)
+        if why is None and "last" not in self.extra:
+            why = "no pose in the window"
+        if why is not None:
+            self.undecided(span, value, self._bound(), why)
+            return
         lo = s.min if s.min is not None else 0.0
-        hi = s.max if s.max is not None else math.inf
-        ok = lo <= d <= hi
-        bound = f"{lo:g}..{hi:g} m" if s.max is not None else f">= {lo:g} m"
+        ok = d >= lo
         self.decide(
-            ok, None if ok else end_ns, f"{d:.3f} m", bound, "held" if ok else "path length out of bounds"
+            ok,
+            None if ok else span.end_ns,
+            value,
+            self._bound(),
+            "held" if ok else "path length out of bounds",
         )
 
 
@@ -340,7 +461,7 @@ class Judge:
 
     def feed(self, key: str, t_ns: int, msg: Any) -> None:
         for c in self._by_key.get(key, ()):
-            if not c.decided:  # topic_rate and distance_traveled are decided only by finish()
+            if not c.decided:  # topic_rate is decided only by finish()
                 c.feed(t_ns, msg)
 
     def failed(self) -> bool:
@@ -349,8 +470,12 @@ class Judge:
     def all_decided(self) -> bool:
         return all(c.decided for c in self.checks)
 
-    def finish(self, end_ns: int) -> list[Result]:
+    def finish(self, end_ns: int, *, complete: bool = True, why: str = "") -> list[Result]:
+        """Decide what is left, at the run's end: sim time `end_ns`, reached as planned (`complete`) or
+        not (`why`, e.g. "the run was interrupted at t=6.800 s"). A check whose window the run did not
+        show whole is not decided (UNDECIDED), never passed or failed by default."""
+        span = Span(end_ns, complete, why)
         for c in self.checks:
             if not c.decided:
-                c.finish(end_ns)
+                c.finish(span)
         return [c.result for c in self.checks if c.result is not None]

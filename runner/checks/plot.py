@@ -117,7 +117,7 @@ def trajectory_plot(plan: Any, mcap: Path, results: list[Result], out: Path) -> 
     by_name = {r.name: r for r in results}
     for s in specs:
         ok = by_name.get(s.name)
-        colour = RED if ok is not None and not ok.passed else GREY
+        colour = RED if ok is not None and ok.status == "fail" else GREY
         region = getattr(s, "region", None)
         if region is not None and region.center is not None:
             canvas.circle(tuple(region.center), region.radius or 0.0, colour)
@@ -132,7 +132,7 @@ def trajectory_plot(plan: Any, mcap: Path, results: list[Result], out: Path) -> 
         canvas.dot(*canvas.px(path[0][1], path[0][2]), colour, 4)  # start
     for s in specs:
         r = by_name.get(s.name)
-        if r is None or r.passed or r.t_ns is None or s.type not in POSE_KINDS:
+        if r is None or r.status != "fail" or r.t_ns is None or s.type not in POSE_KINDS:
             continue
         path = paths.get(s.robot)
         if path:
