@@ -58,10 +58,34 @@ def _parse_rate(value: str | None) -> str | float | None:
     return f
 
 
+StrictValidate = Annotated[
+    bool,
+    typer.Option(
+        "--strict",
+        help="Warnings about the scenario itself (an assertion window past its end, a timeline topic "
+        "nothing subscribes to...) are errors: exit 1 (for CI).",
+    ),
+]
+
+
+def _strict_failure(plan: Any) -> None:
+    """With --strict: the scenario's own warnings are errors (exit 1)."""
+    if plan.scenario_warnings:
+        for text in plan.scenario_warnings:
+            err.print("error: " + text, markup=False, style="red")
+        err.print(
+            f"--strict: {len(plan.scenario_warnings)} warning(s) about the scenario are errors",
+            markup=False,
+            style="red",
+        )
+        raise typer.Exit(1)
+
+
 @app.command()
 def validate(
     file: Annotated[Path, typer.Argument(help="Scenario YAML file.")],
     as_json: Annotated[bool, typer.Option("--json", help="Print the compiled plan as JSON.")] = False,
+    strict: StrictValidate = False,
 ) -> None:
     """Check a scenario and print what would run: robots, plugins, topics with types and rates.
 
@@ -150,6 +174,9 @@ def validate(
         )
     out.print(f"record: {plan.record.path if plan.record.enabled else 'off'}")
     _print_notices(plan.notices, verbose=True)
+    if strict:
+        for _, p in plans:
+            _strict_failure(p)
 
 
 def _shown_path(file: str) -> str:
@@ -178,11 +205,9 @@ def _print_notices(notices: list[str], verbose: bool) -> None:
     if not notices:
         return
     if not verbose:
-        err.print(
-            f"{len(notices)} warning(s) about the descriptions: `scenario validate` lists them", markup=False
-        )
+        err.print(f"{len(notices)} warning(s): `scenario validate` lists them", markup=False)
         return
-    err.print(f"{len(notices)} warning(s): read from the descriptions but not acted on", markup=False)
+    err.print(f"{len(notices)} warning(s):", markup=False)
     for text in notices:
         err.print("warning: " + text, markup=False, style="yellow")
 
@@ -230,7 +255,11 @@ def run(
     ] = False,
     strict: Annotated[
         bool,
-        typer.Option("--strict", help="Fail (exit 1) if any message published in the run was not recorded."),
+        typer.Option(
+            "--strict",
+            help="Fail (exit 1) on a warning about the scenario itself (before running) and if any message "
+            "published in the run was not recorded.",
+        ),
     ] = False,
     foxglove: Annotated[
         int | None,
@@ -274,6 +303,10 @@ def run(
     suites = []
     code = 0
     for i, (label, plan) in enumerate(plans):
+        if strict:
+            _strict_failure(plan)
+        if duration is not None:
+            _warn_windows(plan, duration, quiet)
         for part in plan.every_plan():  # the run and every world of it
             if duration is not None:
                 part.duration_ns = round(duration * 1e9)
@@ -316,6 +349,23 @@ def run(
         data = suites[0].to_json() if len(suites) == 1 else {"variants": [s.to_json() for s in suites]}
         results_json.write_text(json.dumps(data, indent=2))
     raise typer.Exit(143 if code == 130 and interrupts.terminated() else code)
+
+
+def _warn_windows(plan: Any, duration: float, quiet: bool) -> None:
+    """`run --duration` shorter than an assertion's window: it will not be decided; say so first."""
+    from runner.checks import specs_from_plan
+    from runner.compile import window_edge
+
+    for part in plan.worlds or [plan]:
+        for a in specs_from_plan(part.assertions):
+            edge = window_edge(a)
+            if edge is not None and edge[1] > duration and not quiet:
+                err.print(
+                    f"warning: assertion {a.name!r}: its window ({edge[0]}: {edge[1]:g} s) lies past "
+                    f"--duration {duration:g}: it will not be decided",
+                    markup=False,
+                    style="yellow",
+                )
 
 
 def _load_variants(file: Path, record: str | None, variant: int | None) -> list[tuple[str, Any]]:

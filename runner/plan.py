@@ -123,7 +123,9 @@ class RunPlan(BaseModel):
     robots: list[RobotPlan]
     timeline: list[TimelinePlan]
     record: RecordPlan
-    notices: list[str] = []  # warnings from compile: tags read but not acted on
+    notices: list[str] = []  # warnings from compile: tags read but not acted on, and the scenario's own
+    # warnings about the scenario file itself (a window past its end, a typo'd topic): errors with --strict
+    scenario_warnings: list[str] = []
     assertions: list[dict[str, Any]] = []  # the scenario's assertion models, as plain data
     assertion_keys: list[str] = []  # the key each assertion reads
     contact_watch: list[str] = []  # robot/model names whose contacts the world publishes on <run>/_contacts

@@ -302,3 +302,68 @@ def test_a_recording_is_judged_as_the_run_was(write_scenario, tmp_path: Path):
     failure = _junit_valid(junit).find(".//testcase[@name='late_window']/failure")
     assert failure is not None and "opens at t=40 s, after the run's end" in failure.get("message", "")
     assert run_cli("check", str(mcap), "--scenario", str(path), "--allow-undecided").returncode == 0
+
+
+VACUOUS = """
+name: vac
+duration: 10.0
+rate: max
+robots:
+  - name: r1
+    description: "{diffbot}"
+    pose: {xyz: [0, 0, 0.06]}
+    plugins: [{type: diff_drive}]
+  - name: r2
+    description: "{diffbot}"
+    pose: {xyz: [0, 2, 0.06]}
+    plugins: [{type: diff_drive}]
+bridges:
+  - {topic: r2/cmd_vl, key: outside/r2/cmd_vel, direction: ZENOH_TO_SIM, encoding: json,
+     type: geometry_msgs/msg/Twist}
+timeline:
+  - {t: 0.0, topic: r1/cmd_vel, type: geometry_msgs/msg/Twist, data: {linear: {x: 0.5}}}
+  - {t: 1.0, topic: r1/cmd_vell, type: geometry_msgs/msg/Twist, data: {}}
+assertions:
+  - {name: late, type: stay_within, robot: r1, after: 40, region: {center: [0, 0], radius: 9}}
+  - {name: already_there, type: reach, robot: r2, point: [0, 2]}
+  - {name: comes_back, type: reach, robot: r2, point: [0, 2], leave: 1}
+  - {name: due_later, type: reach, robot: r1, point: [3, 0], by: 12}
+  - {name: fine, type: max_speed, robot: r1, max: 1, until: 10}
+"""
+
+
+@pytest.mark.timeout(60)
+def test_validate_warns_of_what_would_decide_nothing_and_strict_makes_it_an_error(write_scenario):
+    """Each vacuous construct is a located warning with a hint (a did-you-mean for typo'd topics);
+    `--strict` makes them errors (exit 1); a clean scenario passes --strict."""
+    path = write_scenario(VACUOUS)
+    proc = run_cli("validate", str(path))
+    assert proc.returncode == 0, proc.stderr
+    text = " ".join(proc.stderr.split())  # (rich wraps long lines)
+    lines = path.read_text().splitlines()
+
+    def line_of(words: str) -> int:
+        return next(i + 1 for i, line in enumerate(lines) if words in line)
+
+    expected = [
+        (line_of("cmd_vl"), "bridge 0 publishes on 'r2/cmd_vl', which nothing in the run subscribes to",
+         "did you mean 'r2/cmd_vel'?"),
+        (line_of("r1/cmd_vell"), "timeline[1] publishes on 'r1/cmd_vell', which nothing in the run "
+         "subscribes to", "did you mean 'r1/cmd_vel'?"),
+        (line_of("name: late"), "assertions[0] 'late': its window (after: 40 s) lies past the run's end "
+         "(duration: 10 s)", "make duration at least 40"),
+        (line_of("already_there"), "assertions[1] 'already_there': robot 'r2' starts at its goal (0, 2)",
+         "add `leave: 1.0`"),
+        (line_of("due_later"), "assertions[3] 'due_later': its window (by: 12 s) lies past the run's end",
+         "make duration at least 12"),
+    ]  # fmt: skip
+    for line, message, hint in expected:
+        assert f"{path}:{line}: {message}" in text, message
+        assert hint in text.split(f"{path}:{line}: {message}")[1].split("warning:")[0], hint
+    assert text.count(f"warning: {path}:") == len(expected)  # comes_back, fine, r1/cmd_vel: no warning
+
+    strict = run_cli("validate", str(path), "--strict")
+    assert strict.returncode == 1
+    assert f"--strict: {len(expected)} warning(s) about the scenario are errors" in strict.stderr
+    assert "Traceback" not in strict.stderr
+    assert run_cli("validate", str(REPO / "scenarios" / "two_robots.yaml"), "--strict").returncode == 0

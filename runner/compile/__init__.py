@@ -86,7 +86,89 @@ def compile_plan(
 
         attach_bridges(plan, sc, doc)
     _check_record_patterns(plan, sc, doc, notices)
+    _check_vacuous(plan, sc, doc, notices)
+    plan.notices = [n.render() for n in notices]  # (with those of the checks over the whole run)
+    own = doc.file.resolve() if doc.file is not None else None
+    plan.scenario_warnings = [
+        n.render()
+        for n in notices
+        if own is not None and n.location.file is not None and Path(n.location.file).resolve() == own
+    ]
     return plan
+
+
+def window_edge(a: Any) -> tuple[str, float] | None:
+    """The latest edge of an assertion's window (`after`, `until`, `by`), as (field, sim s), if it has one
+    that a run's duration must reach for the assertion to be decided."""
+    edges = [(f, getattr(a, f, None)) for f in ("after", "until", "by")]
+    given = [(f, v) for f, v in edges if v]
+    return max(given, key=lambda fv: fv[1]) if given else None
+
+
+def _check_vacuous(plan: RunPlan, sc: Scenario, doc: Document, notices: Notices) -> None:
+    """What would make a verdict or a message mean nothing: an assertion window past the run's end, a
+    `reach` whose goal holds where the robot starts, a timeline entry or bridge that publishes where
+    nothing takes it (a typo: `r1/cmd_vell`)."""
+    import difflib
+
+    duration = sc.duration
+    for i, a in enumerate(sc.assertions):
+        edge = window_edge(a)
+        if edge is not None and edge[1] > duration:
+            where = doc.locate(("assertions", i, edge[0]))
+            notices.add(
+                f"assertions[{i}] {a.name!r}: its window ({edge[0]}: {edge[1]:g} s) lies past the run's end "
+                f"(duration: {duration:g} s): it will not be decided",
+                where.file,
+                where.line,
+                hint=f"make duration at least {edge[1]:g}, or move the window inside the run",
+            )
+        if a.type == "reach" and a.leave is None and not a.after:
+            robot = next((r for r in sc.robots if r.name == a.robot), None)
+            if robot is not None:
+                x, y = robot.pose.xyz[0], robot.pose.xyz[1]
+                at_goal = (
+                    a.region.contains(x, y)
+                    if a.region is not None
+                    else math.hypot(x - a.point[0], y - a.point[1]) <= a.tolerance
+                )
+                if at_goal:
+                    where = doc.locate(("assertions", i))
+                    notices.add(
+                        f"assertions[{i}] {a.name!r}: robot {a.robot!r} starts at its goal ({x:g}, {y:g}): "
+                        "it passes at t=0 without moving",
+                        where.file,
+                        where.line,
+                        hint="to mean 'leave, then come back', add `leave: 1.0` (metres) or `after: <s>`",
+                    )
+    taken: set[str] = set()
+    for part in plan.every_plan():
+        taken |= {t.key for r in part.robots for p in r.plugins for t in p.topics if t.direction == "sub"}
+    taken |= {b.sim_key for b in plan.bridges if b.direction != "ZENOH_TO_SIM"}
+    rel = sorted(k[len(plan.name) + 1 :] for k in taken)
+
+    def check(key: str, what: str, where_path: tuple[Any, ...], text: str) -> None:
+        if key in taken:
+            return
+        near = difflib.get_close_matches(text.lstrip("/"), rel, n=1, cutoff=0.7)
+        if plan.nodes and not near:
+            return  # a node may take it (its subscriptions are not declared)
+        where = doc.locate(where_path)
+        notices.add(
+            f"{what} publishes on {text!r}, which nothing in the run subscribes to"
+            + (" (no plugin; a node may)" if plan.nodes else ""),
+            where.file,
+            where.line,
+            hint=(f"did you mean {near[0]!r}? " if near else "")
+            + (f"topics taken in this run: {', '.join(rel[:8])}" if rel else "no plugin takes messages"),
+        )
+
+    for i, ev in enumerate(sc.timeline):
+        check(f"{sc.name}/{ev.topic.lstrip('/')}", f"timeline[{i}]", ("timeline", i, "topic"), ev.topic)
+    for i, b in enumerate(plan.bridges):
+        if b.direction != "SIM_TO_ZENOH":
+            text = b.sim_key[len(plan.name) + 1 :]
+            check(b.sim_key, f"bridge {i}", ("bridges", i), text)
 
 
 SHADOW_REACH_M = 25.0  # the sun's shadow map reaches this far (m) at least
