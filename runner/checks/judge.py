@@ -341,50 +341,51 @@ class _Message(_Check):
             self.decide(False, span.end_ns, "never true", bound, f"`{s.expr}` never held")
 
 
-class _MaxSpeed(_Check):
+class _Peak(_Check):
+    """A bound on a quantity of the robot's ground truth (speed, tilt): fails the moment it is exceeded,
+    passes if it never was over a whole window that carried poses."""
+
+    unit = ""
+    exceeded = ""
+
+    def measure(self, msg: Any) -> float:  # overridden
+        raise NotImplementedError
+
     def feed(self, t_ns: int, msg: Any) -> None:
-        s: MaxSpeed = self.spec
         if self.decided or not self.in_window(t_ns):
             return
-        v = msg.twist.twist.linear
-        speed = math.hypot(float(v.x), float(v.y))
-        self.extra["peak"] = max(self.extra.get("peak", 0.0), speed)
-        if speed > s.max:
-            self.decide(False, t_ns, f"{speed:.3f} m/s", f"<= {s.max:g} m/s", "too fast")
+        value = self.measure(msg)
+        self.extra["peak"] = max(self.extra.get("peak", 0.0), value)
+        bound = self.spec.max
+        if value > bound:
+            self.decide(False, t_ns, f"{value:.3f} {self.unit}", f"<= {bound:g} {self.unit}", self.exceeded)
 
     def finish(self, span: Span) -> None:
         peak = self.extra.get("peak")
         self.hold(
             span,
-            f"peak {peak or 0.0:.3f} m/s",
-            f"<= {self.spec.max:g} m/s",
+            f"peak {peak or 0.0:.3f} {self.unit}",
+            f"<= {self.spec.max:g} {self.unit}",
             data=peak is not None,
             nothing="no pose in the window",
         )
 
 
-class _MaxTilt(_Check):
-    def feed(self, t_ns: int, msg: Any) -> None:
-        s: MaxTilt = self.spec
-        if self.decided or not self.in_window(t_ns):
-            return
+class _MaxSpeed(_Peak):
+    unit, exceeded = "m/s", "too fast"
+
+    def measure(self, msg: Any) -> float:
+        v = msg.twist.twist.linear
+        return math.hypot(float(v.x), float(v.y))
+
+
+class _MaxTilt(_Peak):
+    unit, exceeded = "rad", "tilted too far"
+
+    def measure(self, msg: Any) -> float:
         q = msg.pose.pose.orientation
         # angle between the body's z axis and the world's: cos = 1 - 2 (x² + y²)
-        c = max(-1.0, min(1.0, 1.0 - 2.0 * (float(q.x) ** 2 + float(q.y) ** 2)))
-        tilt = math.acos(c)
-        self.extra["peak"] = max(self.extra.get("peak", 0.0), tilt)
-        if tilt > s.max:
-            self.decide(False, t_ns, f"{tilt:.3f} rad", f"<= {s.max:g} rad", "tilted too far")
-
-    def finish(self, span: Span) -> None:
-        peak = self.extra.get("peak")
-        self.hold(
-            span,
-            f"peak {peak or 0.0:.3f} rad",
-            f"<= {self.spec.max:g} rad",
-            data=peak is not None,
-            nothing="no pose in the window",
-        )
+        return math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (float(q.x) ** 2 + float(q.y) ** 2))))
 
 
 class _Distance(_Check):
