@@ -399,6 +399,7 @@ def _run_one(
     foxglove: int | None = None,
     allow_undecided: bool = False,
 ) -> tuple[Any, int]:
+    from runner.checks.judge import ended_early
     from runner.checks.report import Suite, _now, judge_for
 
     started = _now()
@@ -458,7 +459,7 @@ def _run_one(
         if progress is not None:
             progress.stop()
 
-    ended = None if result.reason == "completed" else _ended(result.reason, result.sim_ns)
+    ended = ended_early(interrupts.ending(result.reason), result.sim_ns)
     results = (
         judge.finish(result.sim_ns, complete=ended is None, why=ended or "") if judge is not None else []
     )
@@ -504,16 +505,6 @@ def _plot(plan: Any, mcap: Path, results: list[Any]) -> None:
         return
     if png is not None:
         out.print(f"trajectory plot: {png}", markup=False)
-
-
-def _ended(reason: str, sim_ns: int) -> str:
-    """Why a run ended before its planned end, as a verdict's reason says it."""
-    how = {
-        "interrupted": "terminated (SIGTERM)" if interrupts.terminated() else "interrupted",
-        "stopped": "stopped early",
-        "failed": "stopped by an error",
-    }.get(reason, reason)
-    return f"the run was {how} at t={sim_ns / 1e9:.3f} s"
 
 
 MARKS = {"pass": "[green]pass[/]", "fail": "[bold red]FAIL[/]", "undecided": "[yellow]not decided[/]"}

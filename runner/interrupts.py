@@ -35,6 +35,11 @@ def terminated() -> bool:
     return _state["terminated"]
 
 
+def ending(reason: str) -> str:
+    """A run's ending as it is recorded and reported: `interrupted` is `terminated` when SIGTERM did it."""
+    return "terminated" if reason == "interrupted" and terminated() else reason
+
+
 def _on_term(*_: Any) -> None:
     _state["terminated"] = True
     raise KeyboardInterrupt

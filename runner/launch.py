@@ -27,7 +27,7 @@ import zenoh
 from runner import msgs
 from runner.errors import RunError
 from runner.graph import GraphTokens
-from runner.interrupts import interruptible, terminated
+from runner.interrupts import ending, interruptible
 from runner.nodes import NodeError, Nodes, OutputTail
 from runner.plan import NodePlan, RunPlan
 from runner.record import Recorder, TopicStats
@@ -260,6 +260,13 @@ def run_plan(
     reason = "completed"
     error: str | None = None
     wall0 = time.perf_counter()
+
+    def reached() -> int:
+        """The sim time the run reached: the least its worlds say they reached (one that said nothing,
+        having died: the latest time recorded or seen)."""
+        fallback = recorder.latest_ns if recorder else latest["ns"]
+        return min(int(p.end_info.get("sim_ns", fallback)) for p in parts)
+
     try:
         if plan.record.enabled:
             try:
@@ -461,11 +468,10 @@ def run_plan(
                 s.undeclare()
         if recorder is not None:
             # how the run ended, for judging the recording by itself later (`scenario check`)
-            how = "terminated" if reason == "interrupted" and terminated() else reason
+            how = ending(reason)
             if sys.exc_info()[0] is not None or (error is not None and how == "completed"):
                 how = "failed"  # (a start-up that timed out...: leaving through an exception)
-            ends = [int(p.end_info["sim_ns"]) for p in parts if "sim_ns" in p.end_info]
-            recorder.end_note(ended=how, sim_ns=str(min(ends, default=recorder.latest_ns)))
+            recorder.end_note(ended=how, sim_ns=str(reached()))
             recorder.close()
         if live is not None:
             live.close()
@@ -473,8 +479,7 @@ def run_plan(
         withdraw(announced)
 
     infos = [p.end_info for p in parts]
-    fallback = recorder.latest_ns if recorder else latest["ns"]
-    sim_ns = min(int(i.get("sim_ns", fallback)) for i in infos)
+    sim_ns = reached()
     walls = [float(i["wall_s"]) for i in infos if "wall_s" in i]
     published: dict[str, int] = {}
     rejected: dict[str, dict[str, int]] = {}

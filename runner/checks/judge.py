@@ -89,6 +89,23 @@ class Result:
         }
 
 
+# How a run that did not reach its planned end ended (runner.launch's reasons, runner.interrupts.ending)
+ENDINGS = {
+    "interrupted": "interrupted",
+    "terminated": "terminated (SIGTERM)",
+    "stopped": "stopped early",
+    "failed": "stopped by an error",
+}
+
+
+def ended_early(ending: str, sim_ns: int) -> str | None:
+    """Why the assertions left open were not decided, for a run that ended `ending` at `sim_ns`; None for
+    a run that completed."""
+    if ending == "completed":
+        return None
+    return f"the run was {ENDINGS.get(ending, ending)} at t={sim_ns / 1e9:.3f} s"
+
+
 @dataclass(frozen=True)
 class Span:
     """What the run covered, for the checks deciding at its end: sim time up to `end_ns`, all of it

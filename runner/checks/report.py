@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from runner.checks.judge import FAIL, PASS, UNDECIDED, Judge, Result, judged_types
+from runner.checks.judge import FAIL, PASS, UNDECIDED, Judge, Result, ended_early, judged_types
 
 
 def judge_for(plan: Any) -> Judge | None:
@@ -18,14 +18,6 @@ def judge_for(plan: Any) -> Judge | None:
     if not assertions:
         return None
     return Judge(specs_from_plan(assertions), [k for part in parts for k in part.assertion_keys])
-
-
-ENDINGS = {
-    "interrupted": "interrupted",
-    "terminated": "terminated (SIGTERM)",
-    "stopped": "stopped early",
-    "failed": "stopped by an error",
-}
 
 
 def judge_recording(plan: Any, mcap: Path) -> tuple[list[Result], int, str | None]:
@@ -51,10 +43,7 @@ def judge_recording(plan: Any, mcap: Path) -> tuple[list[Result], int, str | Non
             if channel.topic in wanted:
                 judge.feed(channel.topic, message.log_time, msgs.decode(message.data, types[channel.topic]))
         try:
-            f.seek(0)
-            meta = next(
-                (dict(m.metadata) for m in make_reader(f).iter_metadata() if m.name == "scenario"), {}
-            )
+            meta = next((dict(m.metadata) for m in reader.iter_metadata() if m.name == "scenario"), {})
         except Exception:  # no summary (a cut file): no metadata to go by
             meta = {}
     at = f" at t={end_ns / 1e9:.3f} s"
@@ -62,7 +51,7 @@ def judge_recording(plan: Any, mcap: Path) -> tuple[list[Result], int, str | Non
     if "stopped" in meta:  # the recording itself stopped early (a full disk, a killed runner)
         why: str | None = f"the recording stopped early{at} ({meta['stopped']})"
     elif ended is not None:
-        why = None if ended == "completed" else f"the run was {ENDINGS.get(ended, ended)}{at}"
+        why = ended_early(ended, end_ns)
     elif end_ns + 20_000_000 >= plan.duration_ns:  # (20 ms: the last clock before the planned end)
         why = None
     else:
