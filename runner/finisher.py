@@ -158,8 +158,10 @@ class Guard:
         if self.proc is None:
             return
         data = pickle.dumps(item, protocol=pickle.HIGHEST_PROTOCOL)
+        frame = memoryview(_FRAME.pack(len(data)) + data)
         try:
-            os.write(self._write, _FRAME.pack(len(data)) + data)  # < 64 kB: one atomic pipe write
+            while frame:  # (a large schema may take more than one write)
+                frame = frame[os.write(self._write, frame) :]
         except OSError:  # the guard is gone: recording goes on, unguarded
             self._drop()
 

@@ -120,13 +120,13 @@ class _McapFile:
         self._zstd = zstandard.ZstdCompressor(level=ZSTD_LEVEL)
         self._tail = Tail()  # the summary's records, as chunks are written
         self._by_id: dict[int, _Channel] = {}
-        self._chunk_indexes: list[ChunkIndex] = []
         self.flushed_at = time.monotonic()
         self._pos = 0
         self.guard = guard
-        self._write_trailed(MAGIC + _record_bytes(Header(profile=profile, library=library)))
+        self._write_trailed(bytearray(MAGIC + _record_bytes(Header(profile=profile, library=library))))
         self._good = self._pos  # the end of the last chunk written whole
-        self._chunk_counts: list[dict[int, int]] = []  # messages per channel of each chunk written
+        # each chunk written: where it starts, its last message's time, its messages per channel
+        self._written: list[tuple[int, int, dict[int, int]]] = []
         self.note: dict[str, str] = {}  # written as a metadata record `scenario` by `finish`
         if guard is not None:
             guard.send(("header", self._good))
@@ -251,8 +251,7 @@ class _McapFile:
         # up to its last chunk, which the guard then completes with its summary.
         self._write_trailed(out)
         index_record = _record_bytes(index)
-        self._chunk_counts.append(counts)
-        self._chunk_indexes.append(index)
+        self._written.append((chunk_start, end, counts))
         tail = self._tail
         tail.chunk_indexes.append(index_record)
         for cid, n in counts.items():
@@ -264,10 +263,12 @@ class _McapFile:
         if self.guard is not None:
             self.guard.send(("chunk", index_record, counts, start, end, self._good))
 
-    def _write_trailed(self, data: bytes | bytearray) -> None:
-        """Write `data` followed by `TRAILER` (an MCAP end without a summary), the file position staying
-        at the end of `data`: until the next write the file is complete, only without an index."""
-        self._write(data + TRAILER)
+    def _write_trailed(self, data: bytearray) -> None:
+        """Write `data` followed by `TRAILER` (an MCAP end without a summary; appended to `data` in place),
+        the file position staying at the end of `data`: until the next write the file is complete, only
+        without an index."""
+        data += TRAILER
+        self._write(data)
         self._stream.seek(-len(TRAILER), os.SEEK_CUR)
         self._pos -= len(TRAILER)
 
@@ -281,17 +282,17 @@ class _McapFile:
                 self.finish()
                 return given_up
             except OSError:
-                if not self._chunk_indexes:
+                if not self._written:
                     raise
-            last = self._chunk_indexes.pop()
+            start, _end, counts = self._written.pop()
             tail = self._tail
             tail.chunk_indexes.pop()
-            for cid, n in self._chunk_counts.pop().items():
+            for cid, n in counts.items():
                 self._by_id[cid].stats.count -= n
                 tail.counts[cid] -= n
-            self._good = last.chunk_start_offset
+            self._good = start
             self.cut_back()
-            tail.end_ns = max((c.message_end_time for c in self._chunk_indexes), default=0)
+            tail.end_ns = max((end for _, end, _ in self._written), default=0)
             given_up += 1
 
     def finish(self) -> None:
