@@ -71,6 +71,24 @@ def test_two_worlds_run_apart_and_are_recorded_together(write_scenario, tmp_path
 
 
 @pytest.mark.timeout(60)
+def test_warnings_over_the_whole_run_are_said_once_with_the_users_index(write_scenario) -> None:
+    """Checks that span the run (assertion windows, timeline topics) run once over all worlds, not once
+    per world too (then each said twice, with the world's own index)."""
+    from tests.helpers import compile_with_notices
+
+    text = TWO.format(duration=2.0, rate="max").replace(
+        "topic: b/r2/odom, min: 45", "topic: b/r2/odom, after: 40, min: 45"
+    )
+    text = text.replace("topic: b/r2/cmd_vel", "topic: b/r2/cmd_vell")
+    _plan, warnings = compile_with_notices(write_scenario(text))
+    assert warnings.count("lies past the run's end") == 1, warnings
+    assert "assertions[1] 'b_clock': its window (after: 40 s)" in warnings
+    assert warnings.count("which nothing in the run subscribes to") == 1, warnings
+    assert (
+        "timeline[1] publishes on 'b/r2/cmd_vell'" in warnings and "did you mean 'b/r2/cmd_vel'?" in warnings
+    )
+
+
 def test_world_mistakes_point_at_the_users_lines(write_scenario) -> None:
     text = TWO.format(duration=1.0, rate="max")
     cases = {

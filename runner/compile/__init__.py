@@ -62,6 +62,9 @@ _INTEGRATOR = {
 def compile_plan(
     sc: Scenario, doc: Document, *, record_path: str | None = None, notices: Notices | None = None
 ) -> RunPlan:
+    """The whole run: its world (or each of `worlds:`, compiled on its own), then what spans the run,
+    once: the QoS, Foxglove and Zenoh settings every part carries, the bridges, and the checks over all
+    of the run's topics and assertions."""
     notices = notices if notices is not None else Notices()
     if sc.worlds:
         from runner.compile.worlds import compile_worlds
@@ -69,18 +72,20 @@ def compile_plan(
         plan = compile_worlds(sc, doc, record_path, notices)
     else:
         plan = _compile_world(sc, doc, record_path, notices)
+    drop = None
     if sc.qos:
         drop = [_full_expr(sc.name, q.topics) for q in sc.qos if q.reliability == "best_effort"]
         for i, q in enumerate(sc.qos):
             _check_expr(_full_expr(sc.name, q.topics), doc, ("qos", i, "topics"), q.topics)
-        for part in plan.every_plan():
-            part.best_effort = drop
     fox = FoxglovePlan(**sc.foxglove.model_dump())
+    zenoh = _zenoh_settings(sc, doc) if sc.zenoh is not None else None
     for part in plan.every_plan():
+        if drop is not None:
+            part.best_effort = drop
         part.foxglove = fox
-    if sc.zenoh is not None:
-        plan.zenoh = _zenoh_settings(sc, doc)
-        plan.listen = list(sc.zenoh.listen)
+        if sc.zenoh is not None:
+            part.zenoh = zenoh
+            part.listen = list(sc.zenoh.listen)
     if sc.bridges or sc.ros2 is not None:
         from runner.compile.bridges import attach_bridges
 

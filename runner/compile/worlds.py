@@ -46,7 +46,7 @@ def _split_topic(topic: str) -> tuple[str, str]:
 
 
 def compile_worlds(sc: Scenario, doc: Document, record_path: str | None, notices: Notices) -> RunPlan:
-    from runner.compile import _nodes, _record_plan, compile_plan
+    from runner.compile import _compile_world, _nodes, _record_plan
 
     problems: list[Problem] = []
     names = [w.name for w in sc.worlds]
@@ -184,7 +184,8 @@ def compile_worlds(sc: Scenario, doc: Document, record_path: str | None, notices
             maps={"robots": r_idx, "timeline": t_idx, "assertions": a_idx},
         )
         try:
-            plan = compile_plan(sub, view, record_path=record_path, notices=notices)
+            # the world alone: what spans the run (settings, bridges, checks) is compile_plan's, once
+            plan = _compile_world(sub, view, record_path, notices)
         except ScenarioError as e:
             for p in e.problems:
                 p.path = view.map_path(p.path)
