@@ -219,20 +219,6 @@ def test_ctrl_c_exits_fast_and_leaves_a_readable_recording(tmp_path: Path):
     assert abs(len(scans) - (clock[-1] / 1e8 + 1)) <= 2
 
 
-def _children(pid: int) -> list[int]:
-    out = []
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                status = (entry / "status").read_text()
-            except OSError:
-                continue
-            ppid = next((ln.split()[1] for ln in status.splitlines() if ln.startswith("PPid:")), None)
-            if ppid == str(pid):
-                out.append(int(entry.name))
-    return out
-
-
 @pytest.mark.timeout(60)
 def test_a_dead_world_process_fails_the_run_and_keeps_the_recording(tmp_path: Path):
     mcap = tmp_path / "crash.mcap"
@@ -265,15 +251,15 @@ def test_unwritable_recording_is_a_clear_error(tmp_path: Path):
 
 
 def _kill_outright(proc: subprocess.Popen[str], *, guard_too: bool = False) -> list[int]:
-    """kill -9 the runner (and its recording's guard, with `guard_too`); returns the runner's children."""
-    children = _children(proc.pid)
-    guards = [c for c in children if b"runner/finisher.py" in Path(f"/proc/{c}/cmdline").read_bytes()]
+    """kill -9 the runner (and its recording's guard, with `guard_too`); returns its world processes."""
+    worlds = processes_of(proc.pid, r"runner\.sim /", direct=True)
+    guards = processes_of(proc.pid, r"runner/finisher\.py", direct=True)
     assert len(guards) == 1, "a recording run has one guard"
     if guard_too:
         os.kill(guards[0], signal.SIGKILL)
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait(timeout=10)
-    return [c for c in children if c not in guards]
+    return worlds
 
 
 def _gone(pids: list[int], within: float = 5.0) -> bool:
