@@ -36,7 +36,38 @@ from runner.transport import free_port, make_config, meta_key, unpack_attachment
 
 STOP_GRACE_S = 1.2  # after SIGINT, how long the world gets before SIGKILL
 DRAIN_TIMEOUT_S = 3.0  # how long the recorder waits for messages still in flight at the end
-START_TIMEOUT_S = 30.0
+# How long the parts of this host may take to start (compile, load MuJoCo, connect) before the run gives up:
+# a guard against a hang, with room for a machine loaded by other runs.
+START_TIMEOUT_S = 60.0
+# How long the main host waits for the other hosts' runners (`scenario run FILE --host NAME`, started by
+# hand or by another tool) to join. The worlds wait longer for the word to start (runner.sim).
+HOST_JOIN_TIMEOUT_S = 180.0
+HOST_WAIT_NOTICE_S = 5.0  # when the run says which hosts it waits for
+
+
+def _check_start(parts: Sequence[_WorldPart], waited_s: float, waiting: set[str]) -> None:
+    """While the parts start: say which other hosts the run waits for (once, after a few seconds), and give
+    up on a part of this host after START_TIMEOUT_S, on another host's after HOST_JOIN_TIMEOUT_S."""
+    late = [p for p in parts if not p.ready.is_set()]
+    hosts = sorted({p.remote_host for p in late if p.remote_host is not None} - waiting)
+    if hosts and waited_s > HOST_WAIT_NOTICE_S:
+        waiting.update(hosts)
+        names = ("hosts " if len(hosts) > 1 else "host ") + ", ".join(repr(h) for h in hosts)
+        print(
+            f"waiting for {names} to join (run `scenario run FILE --host NAME` there)",
+            file=sys.stderr,
+            flush=True,
+        )
+    here = [p.label for p in late if p.remote_host is None]
+    if here and waited_s > START_TIMEOUT_S:
+        raise RunError(f"not every part started within {START_TIMEOUT_S:.0f} s: {', '.join(here)}")
+    far = [f"{p.label} on host {p.remote_host!r}" for p in late if p.remote_host is not None]
+    if far and waited_s > HOST_JOIN_TIMEOUT_S:
+        raise RunError(
+            f"not every host joined within {HOST_JOIN_TIMEOUT_S:.0f} s: {', '.join(far)}\n"
+            "  hint:     start `scenario run FILE --host NAME` on each of them; the main host's endpoint in "
+            "`hosts:` must be reachable from there"
+        )
 
 
 def _keys(plan: RunPlan) -> tuple[dict[str, str], set[str]]:
@@ -358,6 +389,7 @@ def run_plan(
                 part.start(endpoint)
         wall0 = time.perf_counter()
         interrupted = False
+        waiting: set[str] = set()  # the other hosts this run said it waits for
 
         go: dict[str, Any] = {}
 
@@ -427,12 +459,8 @@ def run_plan(
                 if on_progress is not None and all_ready:
                     sim_ns = recorder.latest_ns if recorder else latest["ns"]
                     on_progress(sim_ns, time.perf_counter() - started["at"])
-                if not all_ready and time.perf_counter() - wall0 > START_TIMEOUT_S:
-                    late = [p.label + (f" on host {p.remote_host!r}" if p.remote_host else "") for p in parts]
-                    late = [w for w, p in zip(late, parts, strict=True) if not p.ready.is_set()]
-                    raise RunError(
-                        f"not every part started within {START_TIMEOUT_S:.0f} s: {', '.join(late)}"
-                    )
+                if not all_ready:
+                    _check_start(parts, time.perf_counter() - wall0, waiting)
                 if stop_early.is_set() and reason == "completed":
                     reason = "stopped"
                     stop_all()
