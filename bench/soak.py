@@ -4,7 +4,8 @@
 resident memory of the runner (router, recorder, judge) and of the world process is sampled every 0.25 s;
 the report gives each one's RSS once warmed up (a quarter into the run: the Zenoh buffers and the
 recorder's queue fill in the first seconds), at the end and at its peak after warm-up, the growth from
-warm-up to each, and the messages recorded and lost (`--strict` makes any loss fail the run).
+warm-up to each, the end against the peak between warm-up and three quarters of the run (a leak makes
+the end the highest of all), and the messages recorded and lost (`--strict` makes any loss fail the run).
 """
 
 from __future__ import annotations
@@ -94,6 +95,11 @@ def soak(seconds: float = 600.0, scenario: Path = TWO_ROBOTS, extra: tuple[str, 
         doc[f"{name}_rss_growth_pct"] = round(100 * (end - warm) / warm, 1)
         later_peak = max(p[1] for p in points[len(points) // 4 :])
         doc[f"{name}_rss_peak_growth_pct"] = round(100 * (later_peak - warm) / warm, 1)
+        # a leak grows all along: the end stands above everything before it. A recorder that falls behind
+        # on a loaded machine lifts the memory for a while (Zenoh's buffers, the allocator's arenas) and
+        # lets it down again, anywhere in the run (seen: +20-35 MiB, for a few seconds to a third of it)
+        earlier = max(p[1] for p in points[len(points) // 4 : 3 * len(points) // 4])
+        doc[f"{name}_rss_end_vs_earlier_peak_pct"] = round(100 * (end - earlier) / earlier, 1)
         step = max(1, len(points) // 10)
         doc[f"{name}_rss_mib_series"] = [round(p[1] / 1024) for p in points[::step]]
     return doc

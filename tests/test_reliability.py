@@ -203,15 +203,13 @@ def test_a_long_run_keeps_its_memory_flat_and_loses_nothing() -> None:
     doc = soak(300.0)
     assert doc["lost"] == 0 and doc["messages_recorded"] > 240_000
     for process in ("runner", "world"):
-        # flat over the second half of the run: a leak grows all along, while a recorder that fell behind
-        # on a loaded machine settles on a higher plateau early (154 -> 180 MiB by 40 %, then flat) and
-        # the allocator keeps it
-        series = doc[f"{process}_rss_mib_series"]
-        middle, end = series[len(series) // 2], series[-1]
-        assert end <= middle * 1.10, (process, series)
-        # the peak on the way swings with how far the recorder falls behind on a loaded machine (Zenoh's
-        # buffers under BLOCK congestion, the allocator's arenas): +34 % was seen beside another suite. It
-        # must come back down (the end growth above: no leak) and never run away.
+        # no leak: a leak grows all along, so the end stands above every earlier sample. The memory is not
+        # flat sample by sample on a loaded machine (another suite beside this one): a recorder that falls
+        # behind lifts it by 20-35 MiB for a while and lets it down again (900 sim s beside another soak:
+        # 162 -> 194 -> 179, then flat to the end), so the end is held against the highest of the middle
+        # half of the run, not against one sample of it.
+        assert doc[f"{process}_rss_end_vs_earlier_peak_pct"] <= 10.0, (process, doc)
+        # the peak on the way swings with how far the recorder falls behind; it must never run away
         assert doc[f"{process}_rss_peak_growth_pct"] < 60.0, doc
     assert doc["assertions_passed"] == doc["assertions"] > 0
 
