@@ -370,10 +370,9 @@ def _warn_windows(plan: Any, duration: float, quiet: bool) -> None:
 
 def _load_variants(file: Path, record: str | None, variant: int | None) -> list[tuple[str, Any]]:
     """[(label, plan)] of the scenario's matrix variants (one, unlabelled, without a matrix)."""
-    from runner.compile import compile_plan
+    from runner.compile import load_plan
     from runner.loader import load_file
     from runner.matrix import variants
-    from runner.validate import validate_scenario
 
     found = variants(load_file(file))
     if variant is not None:
@@ -382,8 +381,7 @@ def _load_variants(file: Path, record: str | None, variant: int | None) -> list[
         found = [found[variant]]
     out = []
     for label, doc in found:
-        sc = validate_scenario(doc)
-        out.append((label, compile_plan(sc, doc, record_path=record)))
+        out.append((label, load_plan(doc, record_path=record)))
     return out
 
 

@@ -7,7 +7,8 @@ these and exits 1; any other exception is a bug and keeps its traceback.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -74,14 +75,80 @@ def _printable(text: str) -> str:
 class ScenarioError(Exception):
     """A user mistake in a scenario or in a file it refers to. Holds one or more problems."""
 
-    def __init__(self, problems: Problem | Iterable[Problem]):
+    def __init__(self, problems: Problem | Iterable[Problem], note: str | None = None):
         self.problems = [problems] if isinstance(problems, Problem) else list(problems)
+        self.note = note  # e.g. that the checks stopped early, and what was not looked at
         super().__init__(self.render())
 
     def render(self) -> str:
         n = len(self.problems)
         body = "\n".join(p.render() for p in self.problems)
-        return body if n == 1 else f"{n} problems:\n{body}"
+        body = body if n == 1 else f"{n} problems:\n{body}"
+        return body + (f"\n({self.note})" if self.note else "")
+
+
+class Problems:
+    """The problems of a pass over independent items (robots, plugins, timeline entries...): each item's
+    mistakes are kept and the pass goes on with the next, so that one `validate` reports them all.
+
+        problems = Problems(doc.file)
+        for i, robot in enumerate(sc.robots):
+            with problems.each():  # a ScenarioError inside is kept; the rest of this item is skipped
+                ...
+        problems.raise_all()  # in the file's order
+    """
+
+    def __init__(self, file: Path | None = None) -> None:
+        self.file = file
+        # one per mistake: a problem in another file (a xacro's line) with the one after it that names
+        # the scenario's line ("while loading robot 'r1'")
+        self.groups: list[list[Problem]] = []
+
+    def __bool__(self) -> bool:
+        return bool(self.groups)
+
+    def __len__(self) -> int:
+        return sum(len(g) for g in self.groups)
+
+    def _here(self, p: Problem) -> bool:
+        at = p.location
+        return at.line is not None and (self.file is None or at.file == self.file)
+
+    def add(self, problems: Problem | Iterable[Problem]) -> None:
+        """Problems of one error; one said already (the same settings checked by each world) is not
+        said again."""
+        pending: list[Problem] = []
+        for p in [problems] if isinstance(problems, Problem) else problems:
+            pending.append(p)
+            if self._here(p):
+                self._keep(pending)
+                pending = []
+        if pending:
+            self._keep(pending)
+
+    def _keep(self, group: list[Problem]) -> None:
+        text = [p.render() for p in group]
+        if all([p.render() for p in g] != text for g in self.groups):
+            self.groups.append(group)
+
+    @contextmanager
+    def each(self) -> Iterator[None]:
+        try:
+            yield
+        except ScenarioError as e:
+            self.add(e.problems)
+
+    def ordered(self) -> list[Problem]:
+        def first(group: list[Problem]) -> tuple[float, float]:
+            lines = [(p.location.line or 0, p.location.column or 0) for p in group if self._here(p)]
+            return min(lines) if lines else (float("inf"), 0)
+
+        order = sorted(range(len(self.groups)), key=lambda k: (first(self.groups[k]), k))
+        return [p for k in order for p in self.groups[k]]
+
+    def raise_all(self, note: str | None = None) -> None:
+        if self.groups:
+            raise ScenarioError(self.ordered(), note)
 
 
 @dataclass(frozen=True)

@@ -39,6 +39,8 @@ class Document:
         return self.file.parent if self.file else Path.cwd()
 
 
+UNREAD = "nothing else is checked until the file reads as YAML"
+
 # Limits checked before anything expensive: a scenario is a few kilobytes of hand-written YAML.
 MAX_BYTES = 4_000_000
 MAX_DEPTH = 64  # mappings and lists inside each other
@@ -238,9 +240,11 @@ def load_text(text: str, file: Path | None = None) -> Document:
         _check_limits(text, file)
         node = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.MarkedYAMLError as e:
-        raise ScenarioError(_yaml_problem(e, text, file)) from None
+        raise ScenarioError(_yaml_problem(e, text, file), note=UNREAD) from None
     except yaml.YAMLError as e:
-        raise ScenarioError(Problem(f"this is not valid YAML: {e}", Location(file, 1, 1))) from None
+        raise ScenarioError(
+            Problem(f"this is not valid YAML: {e}", Location(file, 1, 1)), note=UNREAD
+        ) from None
     except RecursionError:
         raise ScenarioError(Problem("this YAML is nested too deeply to read", Location(file, 1, 1))) from None
     if node is None:

@@ -6,10 +6,11 @@ Used for the scenario itself and for every plugin's `Params` (with a path prefix
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import difflib
 import re
-from typing import Any, TypeVar, get_args, get_origin
+from typing import Annotated, Any, TypeVar, get_args, get_origin
 
 from pydantic import BaseModel, ValidationError
 
@@ -133,6 +134,8 @@ def _type_at(root: type[BaseModel], path: PathKey, data: Any = None) -> Any:
 def _tuple_len(tp: Any) -> int | None:
     """The number of items of a fixed-length tuple type (also inside `| None`)."""
     for arg in [tp, *get_args(tp)]:
+        while get_origin(arg) is Annotated:
+            arg = get_args(arg)[0]
         if get_origin(arg) is tuple:
             args = get_args(arg)
             if args and Ellipsis not in args:
@@ -436,6 +439,16 @@ def validate_model(model: type[M], data: Any, doc: Document, prefix: PathKey = (
 
 
 def validate_scenario(doc: Document) -> Scenario:
+    """The scenario model of a document, or a ScenarioError (schema and cross-field rules). To find every
+    mistake of a file at once, compile included, use `runner.compile.load_plan`."""
+    check_document(doc)
+    sc = validate_model(Scenario, doc.data, doc)
+    check_consistency(sc, doc)
+    return sc
+
+
+def check_document(doc: Document) -> None:
+    """What must hold before anything else can be read: a mapping, and no NUL in any text."""
     if not isinstance(doc.data, dict):
         raise ScenarioError(
             Problem(
@@ -446,9 +459,6 @@ def validate_scenario(doc: Document) -> Scenario:
             )
         )
     _check_text(doc.data, doc, ())
-    sc = validate_model(Scenario, doc.data, doc)
-    check_consistency(sc, doc)
-    return sc
 
 
 def _check_text(value: Any, doc: Document, path: PathKey) -> None:
@@ -475,6 +485,12 @@ def _check_text(value: Any, doc: Document, path: PathKey) -> None:
 
 def check_consistency(sc: Scenario, doc: Document) -> None:
     """Rules that span several fields: unique names and namespaces, timeline within the run."""
+    problems = consistency_problems(sc, doc)
+    if problems:
+        raise ScenarioError(problems)
+
+
+def consistency_problems(sc: Scenario, doc: Document) -> list[Problem]:
     problems: list[Problem] = []
     seen_names: dict[str, int] = {}
     seen_ns: dict[str, int] = {}
@@ -546,5 +562,75 @@ def check_consistency(sc: Scenario, doc: Document) -> None:
                     hint="raise `duration:` or move the entry earlier",
                 )
             )
-    if problems:
-        raise ScenarioError(problems)
+    return problems
+
+
+@dataclasses.dataclass
+class Pruned:
+    """A scenario's data with what the schema refused taken out, so that the rest can still be checked in
+    the same pass (`runner.compile.load_plan`): unknown keys and refused values are dropped (a default
+    takes their place); an item of a list that still does not validate is removed whole. `removed` lists
+    those removals, to map the paths of later problems back to the user's file, and `names` the names
+    of removed items (robots, nodes...): a problem that names one of them is a consequence, not news."""
+
+    data: Any
+    removed: list[tuple[PathKey, int]] = dataclasses.field(default_factory=list)  # (list, index), in order
+    names: set[str] = dataclasses.field(default_factory=set)
+
+    def original(self, path: PathKey) -> PathKey:
+        """A path in the pruned data -> the same place in the user's file."""
+        p = list(path)
+        for lpath, index in reversed(self.removed):
+            n = len(lpath)
+            if len(p) > n and tuple(p[:n]) == lpath and isinstance(p[n], int) and p[n] >= index:
+                p[n] += 1
+        return tuple(p)
+
+
+# lists whose items others name (a robot in an assertion, a node in `lockstep`, a world in `world:`)
+_REFERRED = ("robots", "nodes", "worlds", "models")
+
+
+def prune(model: type[BaseModel], data: Any, rounds: int = 6) -> tuple[BaseModel, Pruned] | None:
+    """`data` (which `model` refuses) with the refused parts taken out until it validates, or None when
+    that would take out more than list items and optional keys (a required top-level key, say)."""
+    pruned = Pruned(copy.deepcopy(data))
+    for _ in range(rounds):
+        try:
+            return model.model_validate(pruned.data), pruned
+        except ValidationError as err:
+            cut: dict[PathKey, str] = {}  # data path -> "key" (drop the key) or "item" (drop the list item)
+            for e in err.errors(include_url=False):
+                about_keys = e["type"] in ("missing", "extra_forbidden")
+                path, _value, missing = _resolve(pruned.data, tuple(e["loc"]), about_keys)
+                short = e["type"] == "missing" and isinstance(e["loc"][-1], int)  # a list too short
+                if (short or e["type"] != "missing") and path and not missing and isinstance(path[-1], str):
+                    cut[path] = "key"  # (a default, if the field has one; else "missing" next round)
+                    continue
+                items = [k for k, el in enumerate(path) if isinstance(el, int)]
+                if path == ("name",) and missing and isinstance(pruned.data, dict):
+                    pruned.data["name"] = "scenario"  # the run's name only labels what follows
+                    continue
+                if not items:
+                    return None
+                cut[path[: items[-1] + 1]] = "item"
+            # deepest first, and list items from the back, so that earlier cuts do not move later ones
+            order = sorted(cut, key=lambda p: (len(p), p[-1] if isinstance(p[-1], int) else 0), reverse=True)
+            for path in order:
+                if any(len(o) < len(path) and path[: len(o)] == o for o in cut):
+                    continue  # inside something that goes anyway
+                parent = pruned.data
+                for el in path[:-1]:
+                    parent = parent[el]
+                if cut[path] == "item":
+                    item = parent[path[-1]]
+                    name = item.get("name") if isinstance(item, dict) else None
+                    if isinstance(name, str) and path[-2] in _REFERRED:
+                        pruned.names.add(name)
+                        if isinstance(item.get("namespace"), str):
+                            pruned.names.add(item["namespace"])
+                    del parent[path[-1]]
+                    pruned.removed.append((path[:-1], int(path[-1])))
+                else:
+                    del parent[path[-1]]
+    return None

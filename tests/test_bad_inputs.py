@@ -124,3 +124,95 @@ def test_bad_description(
         assert result.exit_code == 1, output
     for piece in expect:
         assert piece in output, f"{piece!r} not in:\n{output}"
+
+
+# Seven independent mistakes of seven kinds, one per line, in an order the checks do not run in (the
+# schema's own first, then compile's): one `validate` says all seven, in the file's order.
+SEVEN = """\
+name: seven
+duration: 10
+nodes:
+  - {name: n1, cmd: "no_such_program_here --x"}
+robots:
+  - name: r1
+    description: "{diffbot}"
+    plugins:
+      - {type: diff_drvie}
+      - {type: lidar, params: {samples: many}}
+  - name: r2
+    description: "{diffbot}"
+    pose: {xyz: [1, 2], rpy: [0, 0, 0]}
+timeline:
+  - {t: 1, topic: r1/cmd_vel, type: geometry_msgs/msg/Twist, data: {linear: {xx: 1}}}
+bridges:
+  - {ros_topic: /cmd, topic: r2/cmd_vel, type: geometry_msgs/msg/Twis, direction: ZENOH_TO_SIM}
+assertions:
+  - {name: a, type: reach, robot: r3, point: [1, 0], tolerance: 0.2, by: 8}
+  - {name: b, type: message, topic: r1/odom, expr: "pose.pose.position.x >> 1"}
+  - {name: c, type: reach, robot: r2, point: [1, 0], tolerance: 0.2, by: 8}
+"""
+
+
+@pytest.mark.timeout(60)
+def test_every_independent_mistake_is_said_in_one_pass_in_line_order(write_scenario) -> None:
+    path = write_scenario(SEVEN)
+    proc = run_cli("validate", str(path))
+    assert proc.returncode == 1 and "Traceback" not in proc.stderr, proc.stderr
+    said = [ln for ln in proc.stderr.splitlines() if ln.startswith(f"{path}:")]
+    expected = [
+        (4, "nodes[0].cmd: command 'no_such_program_here' not found"),
+        (9, "robots[0].plugins[0].type: unknown plugin type 'diff_drvie'"),
+        (10, "robots[0].plugins[1].params.samples: wrong value"),
+        (13, "robots[1].pose.xyz: expected 3 items, found 2"),
+        (15, "timeline[0].data.linear.xx: geometry_msgs/msg/Vector3 has no field 'xx'"),
+        (17, "bridges[0].type: unknown message type 'geometry_msgs/msg/Twis'"),
+        (19, "assertions[0].robot: no robot named 'r3'"),
+        (20, "assertions[1].expr: in `pose.pose.position.x >> 1` (column 22): the operator '>>'"),
+    ]
+    assert len(said) == len(expected), proc.stderr
+    for (line, text), got in zip(expected, said, strict=True):
+        assert got.startswith(f"{path}:{line}:") and text in got, (line, text, got)
+    assert proc.stderr.startswith(f"error: {len(expected)} problems:"), proc.stderr
+
+
+@pytest.mark.timeout(60)
+def test_what_follows_from_a_refused_robot_is_not_reported(write_scenario) -> None:
+    """A robot the schema refuses is taken out for the rest of the checks: an assertion or bridge on it is
+    not reported as naming an unknown robot or topic, while a later item's mistake still is, at its own
+    path (indexes past the refused item map back to the file)."""
+    path = write_scenario(
+        """
+        name: refused
+        duration: 5
+        robots:
+          - {name: r0, descripton: "{diffbot}"}
+          - {name: r1, description: "{diffbot}", plugins: [{type: lidar, params: {samples: many}}]}
+        bridges:
+          - {topic: r0/cmd_vel, type: geometry_msgs/msg/Twist, direction: ZENOH_TO_SIM}
+        assertions:
+          - {name: a, type: reach, robot: r0, point: [1, 0], tolerance: 0.2}
+          - {name: b, type: topic_rate, topic: r0/odom, min: 5}
+        """
+    )
+    proc = run_cli("validate", str(path))
+    assert proc.returncode == 1 and "Traceback" not in proc.stderr, proc.stderr
+    said = [ln for ln in proc.stderr.splitlines() if ln.startswith(f"{path}:")]
+    assert len(said) == 2, proc.stderr
+    assert said[0].startswith(f"{path}:4:") and "robots[0].descripton: unknown key" in said[0]
+    assert said[1].startswith(f"{path}:5:") and "robots[1].plugins[0].params.samples" in said[1]
+
+
+@pytest.mark.timeout(60)
+def test_checks_that_stop_early_say_so(write_scenario) -> None:
+    """A mistake that makes later checks meaningless stops them, and the message says what waits."""
+    cases = {
+        "name: x\nrobots: [\n": "(nothing else is checked until the file reads as YAML)",
+        "name: x\nrobots:\n  - {name: r1, description: a.urdf}\n  - {name: r1, description: a.urdf}\n": (
+            "(robots, plugins, the timeline and the rest are checked once these are fixed)"
+        ),
+    }
+    for k, (text, note) in enumerate(cases.items()):
+        path = write_scenario(text, name=f"case{k}.yaml")
+        proc = run_cli("validate", str(path))
+        assert proc.returncode == 1 and "Traceback" not in proc.stderr, proc.stderr
+        assert proc.stderr.rstrip().endswith(note), proc.stderr

@@ -7,6 +7,7 @@ scenario that caused it: xacro, URDF, plugin parameters, message data in the tim
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -24,7 +25,7 @@ from runner.compile.sdf import load_sdf_world
 from runner.compile.urdf import RobotModel, urdf_to_model
 from runner.compile.wheels import anisotropic_wheels, check_geometry, wheel_links
 from runner.compile.xacro_expand import expand
-from runner.errors import Location, Notices, Problem, ScenarioError, SourceError
+from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError
 from runner.geometry import rpy_to_quat
 from runner.loader import Document, PathKey
 from runner.plan import (
@@ -59,6 +60,74 @@ _INTEGRATOR = {
 }
 
 
+def load_plan(doc: Document, *, record_path: str | None = None, notices: Notices | None = None) -> RunPlan:
+    """A document checked and compiled in one pass that reports every independent mistake at once, in the
+    file's order: the schema's, the cross-field rules', and compile's (robots, plugins and their
+    parameters, timeline data, expressions, bridges, nodes...). Where the schema refuses part of the
+    file, that part is taken out (`runner.validate.prune`) and the rest is checked all the same; what
+    follows from the part taken out (a reference to a robot that was taken out) is not reported."""
+    from pydantic import ValidationError
+
+    from runner.validate import check_document, problems_from_validation, prune
+
+    check_document(doc)
+    problems = Problems(doc.file)
+    stopped: str | None = None  # why the checks stopped early, if they did
+    try:
+        sc = Scenario.model_validate(doc.data)
+    except ValidationError as err:
+        problems.add(problems_from_validation(err, doc.data, doc, Scenario))
+        found = prune(Scenario, doc.data)
+        if found is None:
+            stopped = "the rest of the file is checked once these are fixed"
+        else:
+            rest, pruned = found
+            view = _PrunedView(data=pruned.data, file=doc.file, positions=doc.positions, pruned=pruned)
+            later = Problems(doc.file)
+            _, stopped = _check_and_compile(rest, view, later, record_path, notices)  # type: ignore[arg-type]
+            # a name in the messages' own quoting: 'r2', 'r2/odom', r2/odom, a/r2/b
+            names = [re.compile(rf"(?:^|['/ ]){re.escape(n)}(?:$|['/])") for n in pruned.names]
+            for group in later.groups:
+                if any(n.search(p.message) for p in group for n in names):
+                    continue  # about something taken out (a robot the schema refused)
+                for p in group:
+                    p.path = pruned.original(p.path)
+                problems.add(group)
+        plan = None
+    else:
+        plan, stopped = _check_and_compile(sc, doc, problems, record_path, notices)
+    problems.raise_all(stopped)
+    assert plan is not None  # (no problems: it compiled)
+    return plan
+
+
+@dataclass
+class _PrunedView(Document):
+    """The document as the second look at a file the schema refused sees it: the data with the refused
+    parts taken out, located in the user's file."""
+
+    pruned: Any = None
+
+    def locate(self, path: PathKey) -> Location:
+        return super().locate(self.pruned.original(path))
+
+
+def _check_and_compile(
+    sc: Scenario, doc: Document, problems: Problems, record_path: str | None, notices: Notices | None
+) -> tuple[RunPlan | None, str | None]:
+    """(the plan or None, why the checks stopped early or None); the problems found go to `problems`.
+    Two robots or models of one name stop them before compile: compiling those would only add noise."""
+    from runner.validate import consistency_problems
+
+    rules = consistency_problems(sc, doc)
+    problems.add(rules)
+    if any(p.path[:1] in (("robots",), ("world",), ("worlds",)) for p in rules):
+        return None, "robots, plugins, the timeline and the rest are checked once these are fixed"
+    with problems.each():
+        return compile_plan(sc, doc, record_path=record_path, notices=notices), None
+    return None, None
+
+
 def compile_plan(
     sc: Scenario, doc: Document, *, record_path: str | None = None, notices: Notices | None = None
 ) -> RunPlan:
@@ -66,19 +135,24 @@ def compile_plan(
     once: the QoS, Foxglove and Zenoh settings every part carries, the bridges, and the checks over all
     of the run's topics and assertions."""
     notices = notices if notices is not None else Notices()
+    problems = Problems(doc.file)
+    unloaded: list[str] = []  # key prefixes of robots that did not load: their topics are not checked
     if sc.worlds:
         from runner.compile.worlds import compile_worlds
 
-        plan = compile_worlds(sc, doc, record_path, notices)
+        plan = compile_worlds(sc, doc, record_path, notices, problems, unloaded)
     else:
-        plan = _compile_world(sc, doc, record_path, notices)
+        plan = _compile_world(sc, doc, record_path, notices, problems, unloaded)
     drop = None
     if sc.qos:
         drop = [_full_expr(sc.name, q.topics) for q in sc.qos if q.reliability == "best_effort"]
         for i, q in enumerate(sc.qos):
-            _check_expr(_full_expr(sc.name, q.topics), doc, ("qos", i, "topics"), q.topics)
+            with problems.each():
+                _check_expr(_full_expr(sc.name, q.topics), doc, ("qos", i, "topics"), q.topics)
     fox = FoxglovePlan(**sc.foxglove.model_dump())
-    zenoh = _zenoh_settings(sc, doc) if sc.zenoh is not None else None
+    zenoh = None
+    with problems.each():
+        zenoh = _zenoh_settings(sc, doc) if sc.zenoh is not None else None
     for part in plan.every_plan():
         if drop is not None:
             part.best_effort = drop
@@ -89,7 +163,9 @@ def compile_plan(
     if sc.bridges or sc.ros2 is not None:
         from runner.compile.bridges import attach_bridges
 
-        attach_bridges(plan, sc, doc)
+        with problems.each():
+            attach_bridges(plan, sc, doc, unchecked=unloaded)
+    problems.raise_all()  # every mistake found, in the order of the file
     _check_record_patterns(plan, sc, doc, notices)
     _check_vacuous(plan, sc, doc, notices)
     plan.notices = [n.render() for n in notices]  # (with those of the checks over the whole run)
@@ -274,13 +350,26 @@ def _check_record_patterns(plan: RunPlan, sc: Scenario, doc: Document, notices: 
             )
 
 
-def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices: Notices) -> RunPlan:
+def _compile_world(
+    sc: Scenario,
+    doc: Document,
+    record_path: str | None,
+    notices: Notices,
+    problems: Problems,
+    unloaded: list[str],
+) -> RunPlan:
+    """One world and its robots, timeline, assertions, recording and nodes. Each independent item (a
+    package folder, a robot, a plugin, a timeline entry...) is checked on its own: its mistakes go to
+    `problems` and the pass goes on, so that one `validate` finds them all. The plan returned is then
+    partial (robots that did not load are left out, their key prefixes added to `unloaded` so that later
+    checks do not report their topics as missing, and there is no model): the caller raises `problems`
+    before anything uses it."""
     base = doc.base_dir
     packages = PackageMap.for_scenario(base, {k: (base / v) for k, v in sc.packages.items()})
     packages.allowed = [base / p for p in sc.allow_paths]
     for name, folder in packages.explicit.items():
         if not folder.is_dir():
-            raise ScenarioError(
+            problems.add(
                 Problem(
                     f"package folder {str(folder)!r} does not exist",
                     doc.locate(("packages", name)),
@@ -289,8 +378,11 @@ def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices
                 )
             )
 
-    world, sdf_rate = _world_spec(sc, doc, packages, notices)
-    check_names(sc, doc, {m.name for m in sc.world.models}, bool(sc.world.sdf))
+    world, sdf_rate = mujoco.MjSpec(), None
+    with problems.each():
+        world, sdf_rate = _world_spec(sc, doc, packages, notices)
+    with problems.each():
+        check_names(sc, doc, {m.name for m in sc.world.models}, bool(sc.world.sdf))
     watched = truth_robots(sc)
     robots: list[RobotPlan] = []
     for i, robot in enumerate(sc.robots):
@@ -301,35 +393,104 @@ def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices
             )
             robot = robot.model_copy(update={"plugins": [*robot.plugins, extra]})
         before = len(notices)
-        model = _robot_model(robot, i, doc, packages, notices, sc.world.physics.timestep)
-        plugins = _build_plugins(sc, robot, i, model, doc)
-        _add_transmissions(model, notices)
-        parity = summarize(model, plugins, notices.items[before:], f"{sc.name}/{robot.ns}/")
-        pos = robot.pose.xyz
-        frame = world.worldbody.add_frame(pos=list(pos), quat=list(rpy_to_quat(robot.pose.rpy)))
-        prefix = f"{robot.ns}/"
-        wheels = wheel_links(plugins, model.spec)
-        world.attach(model.spec, prefix=prefix, frame=frame)
-        anisotropic_wheels(world, prefix, wheels, model.gazebo, notices)
-        # a robot's camera may have grown its framebuffer: the world's is the one cameras render into
-        g, rg = world.visual.global_, model.spec.visual.global_
-        g.offwidth, g.offheight = max(g.offwidth, rg.offwidth), max(g.offheight, rg.offheight)
-        robots.append(
-            RobotPlan(
-                name=robot.name,
-                namespace=robot.ns,
-                prefix=prefix,
-                root=model.root,
-                fixed=robot.fixed,
-                description_file=str(_description_path(robot, base)),
-                links=model.links,
-                joints=model.joints,
-                plugins=plugins,
-                urdf=model.urdf,
-                gazebo=parity,
+        unloaded.append(f"{sc.name}/{robot.ns}/")  # until it has loaded
+        with problems.each():
+            model = _robot_model(robot, i, doc, packages, notices, sc.world.physics.timestep)
+            unloaded.pop()
+            found = len(problems)
+            plugins = _build_plugins(sc, robot, i, model, doc, problems)
+            if len(problems) > found:  # a plugin left out: which topics the robot has is not known
+                unloaded.append(f"{sc.name}/{robot.ns}/")
+            _add_transmissions(model, notices)
+            parity = summarize(model, plugins, notices.items[before:], f"{sc.name}/{robot.ns}/")
+            pos = robot.pose.xyz
+            frame = world.worldbody.add_frame(pos=list(pos), quat=list(rpy_to_quat(robot.pose.rpy)))
+            prefix = f"{robot.ns}/"
+            wheels = wheel_links(plugins, model.spec)
+            world.attach(model.spec, prefix=prefix, frame=frame)
+            anisotropic_wheels(world, prefix, wheels, model.gazebo, notices)
+            # a robot's camera may have grown its framebuffer: the world's is the one cameras render into
+            g, rg = world.visual.global_, model.spec.visual.global_
+            g.offwidth, g.offheight = max(g.offwidth, rg.offwidth), max(g.offheight, rg.offheight)
+            robots.append(
+                RobotPlan(
+                    name=robot.name,
+                    namespace=robot.ns,
+                    prefix=prefix,
+                    root=model.root,
+                    fixed=robot.fixed,
+                    description_file=str(_description_path(robot, base)),
+                    links=model.links,
+                    joints=model.joints,
+                    plugins=plugins,
+                    urdf=model.urdf,
+                    gazebo=parity,
+                )
             )
-        )
 
+    mjcf, step = "", sc.world.physics.timestep
+    if not problems:  # a world with a robot missing, or one that failed, would only add noise
+        with problems.each():
+            mjcf = _compile_model(world, robots, sc, doc, notices)
+            step = world.option.timestep
+
+    timeline: list[TimelinePlan] = []
+    ordered: list[tuple[int, TimelinePlan]] = []
+    for i in range(len(sc.timeline)):
+        with problems.each():
+            ordered.append((i, _timeline_entry(sc, i, doc)))
+    with problems.each():
+        _check_timeline_types(ordered, robots, sc, doc)
+    timeline = sorted((ev for _, ev in ordered), key=lambda ev: ev.t_ns)
+
+    record = RecordPlan(enabled=False, path="", include=[], exclude=[])
+    with problems.each():
+        record = _record_plan(sc, doc, record_path)
+
+    published = {t.key: t.type for r in robots for p in r.plugins for t in p.topics if t.direction == "pub"}
+    published.update({f"{sc.name}/{ev.topic.strip('/')}": msgs.normalize_type(ev.type) for ev in sc.timeline})
+    keys: list[str] = []
+    with problems.each():
+        keys = assertion_keys(sc, doc, published, unchecked=unloaded)
+    contact_watch = sorted({n for a in sc.assertions if isinstance(a, NoCollision) for n in a.between})
+    rate = sc.rate
+    if sdf_rate and "rate" not in sc.model_fields_set:
+        rate = sdf_rate  # the world file's <real_time_factor>, unless the scenario sets `rate:`
+    nodes: list[NodePlan] = []
+    with problems.each():
+        nodes = _nodes(sc, doc, base)
+    host = None
+    with problems.each():
+        host = _host(sc, doc, sc.world.host, ("world", "host"))
+    return RunPlan(
+        name=sc.name,
+        scenario_file=str(doc.file) if doc.file else None,
+        duration_ns=round(sc.duration * 1e9),
+        rate=rate,
+        seed=sc.seed,
+        step_ns=round(step * 1e9),
+        clock_rate=sc.world.clock_rate,
+        mjcf=mjcf,
+        robots=robots,
+        timeline=timeline,
+        record=record,
+        notices=[n.render() for n in notices],
+        assertions=[a.model_dump(mode="json") for a in sc.assertions],
+        assertion_keys=keys,
+        contact_watch=contact_watch,
+        stop_on=sc.stop_on,
+        renderers=sc.renderers,
+        nodes=nodes,
+        lockstep=list(sc.lockstep),
+        hosts={name: h.endpoint for name, h in sc.hosts.items()},
+        host=host,
+    )
+
+
+def _compile_model(
+    world: mujoco.MjSpec, robots: list[RobotPlan], sc: Scenario, doc: Document, notices: Notices
+) -> str:
+    """The world with its robots compiled by MuJoCo and checked (start overlaps, wheels): its MJCF."""
     try:
         compiled = world.compile()
     except ValueError as e:
@@ -351,44 +512,7 @@ def _compile_world(sc: Scenario, doc: Document, record_path: str | None, notices
     extent = float(compiled.stat.extent)
     if extent > 0:
         world.visual.map.shadowclip = max(float(world.visual.map.shadowclip), SHADOW_REACH_M / extent)
-    mjcf = world.to_xml()
-
-    timeline = [_timeline_entry(sc, i, doc) for i in range(len(sc.timeline))]
-    _check_timeline_types(timeline, robots, sc, doc)
-    timeline.sort(key=lambda ev: ev.t_ns)
-
-    record = _record_plan(sc, doc, record_path)
-
-    published = {t.key: t.type for r in robots for p in r.plugins for t in p.topics if t.direction == "pub"}
-    published.update({f"{sc.name}/{ev.topic.strip('/')}": msgs.normalize_type(ev.type) for ev in sc.timeline})
-    keys = assertion_keys(sc, doc, published)
-    contact_watch = sorted({n for a in sc.assertions if isinstance(a, NoCollision) for n in a.between})
-    rate = sc.rate
-    if sdf_rate and "rate" not in sc.model_fields_set:
-        rate = sdf_rate  # the world file's <real_time_factor>, unless the scenario sets `rate:`
-    return RunPlan(
-        name=sc.name,
-        scenario_file=str(doc.file) if doc.file else None,
-        duration_ns=round(sc.duration * 1e9),
-        rate=rate,
-        seed=sc.seed,
-        step_ns=round(world.option.timestep * 1e9),
-        clock_rate=sc.world.clock_rate,
-        mjcf=mjcf,
-        robots=robots,
-        timeline=timeline,
-        record=record,
-        notices=[n.render() for n in notices],
-        assertions=[a.model_dump(mode="json") for a in sc.assertions],
-        assertion_keys=keys,
-        contact_watch=contact_watch,
-        stop_on=sc.stop_on,
-        renderers=sc.renderers,
-        nodes=_nodes(sc, doc, base),
-        lockstep=list(sc.lockstep),
-        hosts={name: h.endpoint for name, h in sc.hosts.items()},
-        host=_host(sc, doc, sc.world.host, ("world", "host")),
-    )
+    return str(world.to_xml())
 
 
 def _compile_problem(e: ValueError, sc: Scenario, doc: Document, world: mujoco.MjSpec) -> Problem:
@@ -796,63 +920,69 @@ def _plugin_entries(robot: Robot, model: RobotModel) -> list[_Entry]:
     return entries
 
 
-def _build_plugins(sc: Scenario, robot: Robot, i: int, model: RobotModel, doc: Document) -> list[PluginPlan]:
+def _build_plugins(
+    sc: Scenario, robot: Robot, i: int, model: RobotModel, doc: Document, problems: Problems
+) -> list[PluginPlan]:
+    """The robot's plugins, built; each one's mistakes go to `problems` and it is left out."""
     plans: list[PluginPlan] = []
     ctx = BuildContext(spec=model.spec, robot=robot.name, namespace=robot.ns, root=model.root)
     names: set[str] = set()
     for entry in _plugin_entries(robot, model):
         here: PathKey = ("robots", i, "plugins", entry.scenario_index or 0)
         src = entry.source
+        with problems.each():
 
-        def fail(message: str, param: str | None, hint: str | None, entry: _Entry = entry) -> ScenarioError:
-            return _plugin_error(entry, here, doc, robot, i, message, param, hint)  # noqa: B023
+            def fail(
+                message: str, param: str | None, hint: str | None, entry: _Entry = entry
+            ) -> ScenarioError:
+                return _plugin_error(entry, here, doc, robot, i, message, param, hint)  # noqa: B023
 
-        if entry.name in names:
-            raise fail(f"two plugins named {entry.name!r}", None, "give one of them another `name:`")
-        names.add(entry.name)
-        try:
-            cls = load(entry.type)
-        except PluginLookupError as e:
-            if entry.scenario_index is not None and entry.source is None:
-                where = (*here, "type")
-                raise ScenarioError(Problem(str(e), doc.locate(where), where, hint=e.hint)) from None
-            raise fail(str(e), None, e.hint) from None
-        _check_finite(entry, doc, here, fail)
-        if src is None or entry.scenario_keys >= set(entry.params):
-            params = validate_model(cls.Params, entry.params, doc, (*here, "params"))
-        else:
+            if entry.name in names:
+                raise fail(f"two plugins named {entry.name!r}", None, "give one of them another `name:`")
+            names.add(entry.name)
             try:
-                params = cls.Params.model_validate(entry.params)
-            except ValidationError as e:
-                err = e.errors(include_url=False)[0]
-                param = ".".join(str(x) for x in err["loc"]) or None
-                raise fail(f"{err['msg']} (found {err.get('input')!r})", param, None) from None
-        try:
-            topics = cls.build(params, ctx, entry.name)
-        except PluginConfigError as e:
-            raise fail(str(e), e.param, e.hint) from None
-        rate = cls.rate_of(params)
-        plans.append(
-            PluginPlan(
-                type=entry.type,
-                name=entry.name,
-                params=params.model_dump(mode="json"),
-                rate=rate,
-                control_rate=cls.control_rate_of(params),
-                source_file=str(src.file) if src is not None and src.file else None,
-                source_line=src.line if src is not None else None,
-                topics=[
-                    TopicPlan(
-                        key=topic_key(sc.name, robot.ns, t.name),
-                        type=t.type,
-                        rate=t.rate,
-                        direction=t.direction,
-                        owner=f"{robot.ns}/{entry.name}",
-                    )
-                    for t in topics
-                ],
+                cls = load(entry.type)
+            except PluginLookupError as e:
+                if entry.scenario_index is not None and entry.source is None:
+                    where = (*here, "type")
+                    raise ScenarioError(Problem(str(e), doc.locate(where), where, hint=e.hint)) from None
+                raise fail(str(e), None, e.hint) from None
+            _check_finite(entry, doc, here, fail)
+            if src is None or entry.scenario_keys >= set(entry.params):
+                params = validate_model(cls.Params, entry.params, doc, (*here, "params"))
+            else:
+                try:
+                    params = cls.Params.model_validate(entry.params)
+                except ValidationError as e:
+                    err = e.errors(include_url=False)[0]
+                    param = ".".join(str(x) for x in err["loc"]) or None
+                    raise fail(f"{err['msg']} (found {err.get('input')!r})", param, None) from None
+            try:
+                topics = cls.build(params, ctx, entry.name)
+            except PluginConfigError as e:
+                raise fail(str(e), e.param, e.hint) from None
+            rate = cls.rate_of(params)
+            plans.append(
+                PluginPlan(
+                    type=entry.type,
+                    name=entry.name,
+                    params=params.model_dump(mode="json"),
+                    rate=rate,
+                    control_rate=cls.control_rate_of(params),
+                    source_file=str(src.file) if src is not None and src.file else None,
+                    source_line=src.line if src is not None else None,
+                    topics=[
+                        TopicPlan(
+                            key=topic_key(sc.name, robot.ns, t.name),
+                            type=t.type,
+                            rate=t.rate,
+                            direction=t.direction,
+                            owner=f"{robot.ns}/{entry.name}",
+                        )
+                        for t in topics
+                    ],
+                )
             )
-        )
     return plans
 
 
@@ -976,7 +1106,7 @@ def _timeline_entry(sc: Scenario, i: int, doc: Document) -> TimelinePlan:
 
 
 def _check_timeline_types(
-    timeline: list[TimelinePlan], robots: list[RobotPlan], sc: Scenario, doc: Document
+    timeline: list[tuple[int, TimelinePlan]], robots: list[RobotPlan], sc: Scenario, doc: Document
 ) -> None:
     """A timeline entry must carry the type its topic's subscriber takes: a `std_msgs/msg/String` on a
     drive's `cmd_vel` would reach the world (and a ROS client) as garbage."""
@@ -988,7 +1118,7 @@ def _check_timeline_types(
         if t.direction == "sub"
     }
     problems = []
-    for i, ev in enumerate(timeline):  # still in the scenario's order
+    for i, ev in timeline:  # (the index in the scenario, the entry)
         wanted = takes.get(ev.key)
         if wanted is not None and msgs.normalize_type(wanted[0]) != ev.type:
             where: PathKey = ("timeline", i, "type")

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -113,18 +114,28 @@ def _qualify(name: str, namespace: str | None) -> str:
     return "/" + "/".join(p for p in ((namespace or "").strip("/"), name.strip("/")) if p)
 
 
-def attach_bridges(plan: RunPlan, sc: Scenario, doc: Document) -> None:
-    """Resolve `bridges:` (and `ros2:`) into `plan.bridges`, and add the bridge process to the nodes."""
+def attach_bridges(plan: RunPlan, sc: Scenario, doc: Document, unchecked: Sequence[str] = ()) -> None:
+    """Resolve `bridges:` (and `ros2:`) into `plan.bridges`, and add the bridge process to the nodes.
+    A bridge on a robot that did not load whole (its key prefix in `unchecked`, its mistakes reported)
+    has only its type checked: the robot's topics are not known."""
     topics = _Topics(plan)
     problems: list[Problem] = []
     out: list[BridgePlan] = []
     robots = {r.name: r.ns for r in sc.robots}
+    lost = {p.rstrip("/").rsplit("/", 1)[-1] for p in unchecked}  # the namespaces of those robots
     for i, b in enumerate(sc.bridges):
         where: PathKey = (
             ("bridges", i)
             if len(sc.bridges) > 1 or isinstance(doc.data.get("bridges"), list)
             else ("bridges",)
         )
+        on = robots.get(b.robot or "") or next(
+            (ns for ns in lost if f"/{ns}/" in f"/{(b.topic or '').strip('/')}/"), None
+        )
+        if on in lost:  # only what does not depend on the robot's topics
+            if b.type is not None:
+                _check_type(b.type, None, doc, (*where, "type"), problems)
+            continue
         ros2 = _ros2_plan(b.ros2, sc.ros2, sc.name)
         if b.robot is not None and b.robot not in robots:
             at = (*where, "robot")

@@ -11,9 +11,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from runner.errors import Location, Notices, Problem, ScenarioError
+from runner.errors import Location, Notices, Problem, Problems, ScenarioError
 from runner.loader import Document, PathKey
-from runner.plan import RunPlan
+from runner.plan import NodePlan, RunPlan
 from runner.schema import NoCollision, Scenario, World
 
 _ROBOT_KINDS = ("reach", "stay_within", "max_speed", "max_tilt", "distance_traveled")
@@ -45,7 +45,16 @@ def _split_topic(topic: str) -> tuple[str, str]:
     return first, rest
 
 
-def compile_worlds(sc: Scenario, doc: Document, record_path: str | None, notices: Notices) -> RunPlan:
+def compile_worlds(
+    sc: Scenario,
+    doc: Document,
+    record_path: str | None,
+    notices: Notices,
+    problems_out: Problems,
+    unloaded: list[str],
+) -> RunPlan:
+    """Each of `worlds:` compiled on its own (`_compile_world`), joined into one plan; the mistakes of
+    each go to `problems_out` (with the paths of the user's file), like those of a single world."""
     from runner.compile import _compile_world, _nodes, _record_plan
 
     problems: list[Problem] = []
@@ -150,7 +159,9 @@ def compile_worlds(sc: Scenario, doc: Document, record_path: str | None, notices
     if problems:
         raise ScenarioError(problems)
 
-    nodes = _nodes(sc, doc, doc.base_dir)  # checks the nodes and `lockstep` names
+    nodes: list[NodePlan] = []
+    with problems_out.each():
+        nodes = _nodes(sc, doc, doc.base_dir)  # checks the nodes and `lockstep` names
     for n in nodes:
         n.world = node_world[n.name]
     plans: list[RunPlan] = []
@@ -183,17 +194,20 @@ def compile_worlds(sc: Scenario, doc: Document, record_path: str | None, notices
             world_index=k,
             maps={"robots": r_idx, "timeline": t_idx, "assertions": a_idx},
         )
-        try:
-            # the world alone: what spans the run (settings, bridges, checks) is compile_plan's, once
-            plan = _compile_world(sub, view, record_path, notices)
-        except ScenarioError as e:
-            for p in e.problems:
+        # the world alone: what spans the run (settings, bridges, checks) is compile_plan's, once
+        own = Problems(doc.file)
+        plan = _compile_world(sub, view, record_path, notices, own, unloaded)
+        for group in own.groups:
+            for p in group:
                 p.path = view.map_path(p.path)
-            raise ScenarioError(e.problems) from None
+            problems_out.add(group)
         plan.lockstep = [n for n in sc.lockstep if node_world.get(n) == world.name]
         plans.append(plan)
 
     first = plans[0]
+    record = first.record
+    with problems_out.each():  # (said once: each world's compile checked the same settings)
+        record = _record_plan(sc, doc, record_path)
     return RunPlan(
         name=sc.name,
         scenario_file=str(doc.file) if doc.file else None,
@@ -205,7 +219,7 @@ def compile_worlds(sc: Scenario, doc: Document, record_path: str | None, notices
         mjcf="",
         robots=[],
         timeline=[],
-        record=_record_plan(sc, doc, record_path),
+        record=record,
         notices=[n.render() for n in notices],
         stop_on=sc.stop_on,
         renderers=sc.renderers,
