@@ -2,7 +2,9 @@
 
 Every key of the run becomes a channel the first time it carries a message: ROS 2 messages as `cdr` with
 their `ros2msg` schema, the scene as `protobuf`; each message is logged with its sim time. Open Foxglove,
-connect to `ws://127.0.0.1:PORT` and the 3D view, plots and images follow the run as it goes. The server
+connect to `ws://127.0.0.1:PORT` and the 3D view, plots and images follow the run as it goes; the server
+advertises the `time` capability and sends the sim time, so the viewer's clock is the sim clock. The port
+takes both names of the protocol (`foxglove.websocket.v1`, `foxglove.sdk.v1`: runner.live_gate). The server
 listens on loopback unless a host is given.
 """
 
@@ -10,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import threading
+import time
 import warnings
 from typing import Any
 
@@ -19,21 +22,39 @@ from runner import msgs
 from runner.errors import RunError
 from runner.transport import type_from_encoding, unpack_attachment
 
+TIME_PERIOD_S = 0.02  # how often viewers are told the sim time, at most (wall)
+
 
 class LiveView:
     def __init__(self, session: zenoh.Session, run: str, port: int, host: str = "127.0.0.1"):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DeprecationWarning)
             import foxglove
+        from foxglove.websocket import Capability
+
+        from runner.live_gate import SubprotocolGate
+
         self._fox = foxglove
         self.context = foxglove.Context()
         try:
+            # the SDK's server on a loopback port of its own, behind the gate on the user's port, which
+            # takes every name clients give the protocol (foxglove.websocket.v1 as well as foxglove.sdk.v1)
             self.server = foxglove.start_server(
-                name=f"scenario {run}", host=host, port=port, context=self.context
+                name=f"scenario {run}",
+                host="127.0.0.1",
+                port=0,
+                context=self.context,
+                capabilities=[Capability.Time],  # the viewer's clock is the sim clock
             )
-        except Exception as e:  # the port is taken, say
-            raise RunError(f"cannot serve Foxglove on {host}:{port}: {e}") from None
-        self.port = self.server.port
+        except Exception as e:
+            raise RunError(f"cannot serve Foxglove: {e}") from None
+        try:
+            self.gate = SubprotocolGate(self.server.port, host=host, port=port)
+        except OSError as e:  # the port is taken, say
+            self.server.stop()
+            raise RunError(f"cannot serve Foxglove on {host}:{port}: {e.strerror or e}") from None
+        self.port = self.gate.port
+        self._told = 0.0  # when sim time was last sent to viewers (wall, monotonic)
         self._channels: dict[str, Any] = {}
         self._lock = threading.Lock()
         self._latest = 0
@@ -65,8 +86,13 @@ class LiveView:
                 return
             ch = self._channel(key, type_name)
         att = unpack_attachment(sample.attachment.to_bytes()) if sample.attachment is not None else None
-        if att is not None:
-            self._latest = max(self._latest, att[1])
+        if att is not None and att[1] > self._latest:
+            self._latest = att[1]
+            now = time.monotonic()
+            if now - self._told >= TIME_PERIOD_S:  # (at rate: max, thousands of sim steps a second)
+                self._told = now
+                with contextlib.suppress(Exception):
+                    self.server.broadcast_time(self._latest)
         stamp = att[1] if att is not None else self._latest
         with contextlib.suppress(Exception):  # a viewer's trouble never stops the run
             ch.log(sample.payload.to_bytes(), log_time=stamp)
@@ -74,5 +100,6 @@ class LiveView:
     def close(self) -> None:
         with contextlib.suppress(Exception):
             self._sub.undeclare()
+        self.gate.close()
         with contextlib.suppress(Exception):
             self.server.stop()

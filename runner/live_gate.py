@@ -1,0 +1,127 @@
+"""The door in front of the live Foxglove server: it takes every name of Foxglove's WebSocket protocol.
+
+foxglove-sdk's server accepts the subprotocol `foxglove.sdk.v1` only; Lichtblick, the `@foxglove/ws-protocol`
+client library and older Foxglove apps offer `foxglove.websocket.v1`, and got HTTP 400. The two names are one
+protocol (Foxglove's own statement; Lichtblick and Flora accept both). The gate listens on the port the user
+asked for, passes each connection to the server on a loopback port of its own, with the handshake's
+`Sec-WebSocket-Protocol` offer read as the server's name and its answer given back in the client's, and
+then relays the bytes as they are. It costs one copy per frame in each direction (a thread pair per client).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import re
+import socket
+import threading
+
+SERVER_NAME = "foxglove.sdk.v1"
+ALSO = ("foxglove.websocket.v1",)  # the same protocol under its older name
+_MAX_HEAD = 64 * 1024  # an HTTP upgrade request is a few hundred bytes
+_OFFER = re.compile(rb"^sec-websocket-protocol:[ \t]*(.*?)\r\n", re.IGNORECASE | re.MULTILINE)
+
+
+class SubprotocolGate:
+    def __init__(self, upstream_port: int, host: str = "127.0.0.1", port: int = 0):
+        self.upstream = ("127.0.0.1", upstream_port)
+        self._listener = socket.create_server((host, port))
+        self.port = int(self._listener.getsockname()[1])
+        self._closed = threading.Event()
+        self._socks: set[socket.socket] = set()
+        self._lock = threading.Lock()
+        threading.Thread(target=self._accept, name="foxglove-gate", daemon=True).start()
+
+    def _accept(self) -> None:
+        while not self._closed.is_set():
+            try:
+                client, _ = self._listener.accept()
+            except OSError:
+                return
+            threading.Thread(target=self._serve, args=(client,), daemon=True).start()
+
+    def _serve(self, client: socket.socket) -> None:
+        upstream = None
+        try:
+            head = _read_head(client)
+            if head is None:
+                return
+            head, rest = head
+            offered = _offers(head)
+            asked = next((n for n in offered if n == SERVER_NAME), None) or next(
+                (n for n in offered if n in ALSO), None
+            )
+            if asked is not None and asked != SERVER_NAME:
+                head = _OFFER.sub(b"Sec-WebSocket-Protocol: " + SERVER_NAME.encode() + b"\r\n", head, count=1)
+            upstream = socket.create_connection(self.upstream, timeout=10)
+            upstream.settimeout(None)
+            self._track(client, upstream)
+            upstream.sendall(head + rest)
+            answer = _read_head(upstream)
+            if answer is None:
+                return
+            reply, more = answer
+            if asked is not None and asked != SERVER_NAME:
+                reply = _OFFER.sub(b"Sec-WebSocket-Protocol: " + asked.encode() + b"\r\n", reply, count=1)
+            client.sendall(reply + more)
+            pump = threading.Thread(target=_relay, args=(upstream, client), daemon=True)
+            pump.start()
+            _relay(client, upstream)
+            pump.join()
+        except OSError:
+            pass
+        finally:
+            for s in (client, upstream):
+                if s is not None:
+                    with contextlib.suppress(OSError):
+                        s.close()
+                    with self._lock:
+                        self._socks.discard(s)
+
+    def _track(self, *socks: socket.socket) -> None:
+        with self._lock:
+            self._socks.update(socks)
+
+    def close(self) -> None:
+        self._closed.set()
+        with contextlib.suppress(OSError):
+            self._listener.close()
+        with self._lock:
+            socks = list(self._socks)
+        for s in socks:
+            with contextlib.suppress(OSError):
+                s.shutdown(socket.SHUT_RDWR)
+
+
+def _read_head(sock: socket.socket) -> tuple[bytes, bytes] | None:
+    """An HTTP head (through its blank line) and whatever came after it, or None if the peer left."""
+    data = b""
+    while b"\r\n\r\n" not in data:
+        if len(data) > _MAX_HEAD:
+            return None
+        chunk = sock.recv(4096)
+        if not chunk:
+            return None
+        data += chunk
+    end = data.index(b"\r\n\r\n") + 4
+    return data[:end], data[end:]
+
+
+def _offers(head: bytes) -> list[str]:
+    """The subprotocols a handshake offers."""
+    found = _OFFER.search(head)
+    if found is None:
+        return []
+    return [n.strip() for n in found.group(1).decode("latin-1").split(",") if n.strip()]
+
+
+def _relay(src: socket.socket, dst: socket.socket) -> None:
+    try:
+        while True:
+            data = src.recv(1 << 16)
+            if not data:
+                break
+            dst.sendall(data)
+    except OSError:
+        pass
+    with contextlib.suppress(OSError):
+        dst.shutdown(socket.SHUT_WR)
