@@ -71,6 +71,19 @@ def scenario_cmd(*args: str) -> list[str]:
     return [sys.executable, "-m", "runner.cli", *args]
 
 
+def start_cli(*args: str) -> subprocess.Popen[str]:
+    """`scenario ARGS` started in the background, its output unbuffered (read it line by line as it
+    comes); the caller waits with a timeout and kills it if it is still there."""
+    return subprocess.Popen(
+        scenario_cmd(*args),
+        cwd=REPO,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=dict(os.environ, PYTHONUNBUFFERED="1"),
+    )
+
+
 def run_cli(*args: str, timeout: float = 60, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     return subprocess.run(

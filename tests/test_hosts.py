@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from tests.conftest import REPO, processes_of, scenario_cmd
+from tests.conftest import REPO, processes_of, scenario_cmd, start_cli
 
 SCENE = """
 name: spread
@@ -261,14 +261,7 @@ def test_the_main_host_says_which_host_it_waits_for(write_scenario) -> None:
     a, b = free_port(), free_port()
     text = SCENE.format(a="127.0.0.1", b="127.0.0.1", diffbot="{diffbot}")
     path = write_scenario(text.replace(":7447", f":{a}").replace(":7448", f":{b}"))
-    proc = subprocess.Popen(
-        scenario_cmd("run", str(path), "--no-judge"),
-        cwd=REPO,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=dict(os.environ, PYTHONUNBUFFERED="1"),
-    )
+    proc = start_cli("run", str(path), "--no-judge")
     try:
         assert proc.stderr is not None
         lines: list[str] = []

@@ -4,9 +4,7 @@ tested; interrupted runs exit 130/143; JUnit that CI servers' schema accepts."""
 from __future__ import annotations
 
 import json
-import os
 import signal
-import subprocess
 import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -17,7 +15,7 @@ from runner import msgs
 from runner.checks.report import judge_for
 from runner.sim.world import World
 from runner.transport import MemoryBus, unpack_attachment
-from tests.conftest import REPO, run_cli, scenario_cmd
+from tests.conftest import REPO, run_cli, start_cli
 from tests.helpers import plan_of
 
 # r1 drives +x at 0.5 m/s for 3 s, then back: it leaves its start (0, 0) by 1.5 m and returns by t=6.
@@ -255,14 +253,7 @@ def test_an_interrupted_run_exits_130_or_143_and_decides_nothing_it_did_not_see(
     the end is not decided either (the rest of the run was never seen), and the exit code is the shell's."""
     path = write_scenario(LONG)
     junit = tmp_path / "j.xml"
-    proc = subprocess.Popen(
-        scenario_cmd("run", str(path), "--no-record", "--junit", str(junit)),
-        cwd=REPO,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=dict(os.environ, PYTHONUNBUFFERED="1"),
-    )
+    proc = start_cli("run", str(path), "--no-record", "--junit", str(junit))
     try:
         deadline = time.monotonic() + 60
         assert proc.stderr is not None
