@@ -1020,9 +1020,10 @@ def echo(
                         f" at {stamp / 1e9:.3f} s" if stamp is not None else ""
                     )
                     out.print(head, markup=False)
-                    out.print(
-                        yaml.safe_dump(data, sort_keys=False, default_flow_style=None).rstrip(), markup=False
-                    )
+                    text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
+                    # a lone value (`--field pose.pose.position.x`) comes with YAML's document end, `...`:
+                    # the `---` below already ends each message
+                    out.print(text.removesuffix("\n...\n").rstrip(), markup=False)
                     out.print("---", markup=False)
                     count += 1
             except KeyboardInterrupt:

@@ -71,6 +71,7 @@ def test_echo_pub_and_topics_work_on_a_live_run(live_run: str) -> None:
     def x() -> float:
         got = run_cli("echo", "r1/odom", "-n", "1", "--field", "pose.pose.position.x", timeout=30)
         assert got.returncode == 0, got.stderr
+        assert "..." not in got.stdout, got.stdout  # (YAML's document end after a lone value)
         return float(_docs(got.stdout)[0])
 
     start = x()
