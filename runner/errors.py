@@ -103,6 +103,7 @@ class Problems:
         # one per mistake: a problem in another file (a xacro's line) with the one after it that names
         # the scenario's line ("while loading robot 'r1'")
         self.groups: list[list[Problem]] = []
+        self._said: set[tuple[str, ...]] = set()  # each group as rendered: one said once is not said again
 
     def __bool__(self) -> bool:
         return bool(self.groups)
@@ -127,8 +128,9 @@ class Problems:
             self._keep(pending)
 
     def _keep(self, group: list[Problem]) -> None:
-        text = [p.render() for p in group]
-        if all([p.render() for p in g] != text for g in self.groups):
+        text = tuple(p.render() for p in group)
+        if text not in self._said:
+            self._said.add(text)
             self.groups.append(group)
 
     @contextmanager

@@ -39,6 +39,19 @@ class Document:
         return self.file.parent if self.file else Path.cwd()
 
 
+@dataclass
+class MappedDocument(Document):
+    """The document as a pass over a derived copy of its data sees it (one world of several, the data
+    with what the schema refused taken out): `map_path` takes a path in that copy to the same place in
+    the user's file, where it is located."""
+
+    def map_path(self, path: PathKey) -> PathKey:
+        return tuple(path)
+
+    def locate(self, path: PathKey) -> Location:
+        return super().locate(self.map_path(path))
+
+
 UNREAD = "nothing else is checked until the file reads as YAML"
 
 # Limits checked before anything expensive: a scenario is a few kilobytes of hand-written YAML.

@@ -27,7 +27,7 @@ from runner.compile.wheels import anisotropic_wheels, check_geometry, wheel_link
 from runner.compile.xacro_expand import expand
 from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError
 from runner.geometry import rpy_to_quat
-from runner.loader import Document, PathKey
+from runner.loader import Document, MappedDocument, PathKey
 from runner.plan import (
     FoxglovePlan,
     NodePlan,
@@ -91,7 +91,7 @@ def load_plan(doc: Document, *, record_path: str | None = None, notices: Notices
                 if any(n.search(p.message) for p in group for n in names):
                     continue  # about something taken out (a robot the schema refused)
                 for p in group:
-                    p.path = pruned.original(p.path)
+                    p.path = view.map_path(p.path)
                 problems.add(group)
         plan = None
     else:
@@ -102,14 +102,14 @@ def load_plan(doc: Document, *, record_path: str | None = None, notices: Notices
 
 
 @dataclass
-class _PrunedView(Document):
+class _PrunedView(MappedDocument):
     """The document as the second look at a file the schema refused sees it: the data with the refused
     parts taken out, located in the user's file."""
 
     pruned: Any = None
 
-    def locate(self, path: PathKey) -> Location:
-        return super().locate(self.pruned.original(path))
+    def map_path(self, path: PathKey) -> PathKey:
+        return self.pruned.original(path)  # type: ignore[no-any-return]
 
 
 def _check_and_compile(
@@ -392,15 +392,10 @@ def _compile_world(
                 type="ground_truth", name="_truth", params={"topic": TRUTH_TOPIC, "rate": TRUTH_RATE}
             )
             robot = robot.model_copy(update={"plugins": [*robot.plugins, extra]})
-        before = len(notices)
-        unloaded.append(f"{sc.name}/{robot.ns}/")  # until it has loaded
+        before, found = len(notices), len(problems)
         with problems.each():
             model = _robot_model(robot, i, doc, packages, notices, sc.world.physics.timestep)
-            unloaded.pop()
-            found = len(problems)
             plugins = _build_plugins(sc, robot, i, model, doc, problems)
-            if len(problems) > found:  # a plugin left out: which topics the robot has is not known
-                unloaded.append(f"{sc.name}/{robot.ns}/")
             _add_transmissions(model, notices)
             parity = summarize(model, plugins, notices.items[before:], f"{sc.name}/{robot.ns}/")
             pos = robot.pose.xyz
@@ -427,6 +422,8 @@ def _compile_world(
                     gazebo=parity,
                 )
             )
+        if len(problems) > found:  # not loaded, or a plugin left out: which topics it has is not known
+            unloaded.append(f"{sc.name}/{robot.ns}/")
 
     mjcf, step = "", sc.world.physics.timestep
     if not problems:  # a world with a robot missing, or one that failed, would only add noise
@@ -434,7 +431,6 @@ def _compile_world(
             mjcf = _compile_model(world, robots, sc, doc, notices)
             step = world.option.timestep
 
-    timeline: list[TimelinePlan] = []
     ordered: list[tuple[int, TimelinePlan]] = []
     for i in range(len(sc.timeline)):
         with problems.each():

@@ -11,8 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from runner.errors import Location, Notices, Problem, Problems, ScenarioError
-from runner.loader import Document, PathKey
+from runner.errors import Notices, Problem, Problems, ScenarioError
+from runner.loader import Document, MappedDocument, PathKey
 from runner.plan import NodePlan, RunPlan
 from runner.schema import NoCollision, Scenario, World
 
@@ -21,7 +21,7 @@ _TOPIC_KINDS = ("topic_rate", "message")
 
 
 @dataclass
-class _WorldView(Document):
+class _WorldView(MappedDocument):
     """The document as one world's compile sees it: its indexes mapped to the scenario's."""
 
     world_index: int = 0
@@ -34,9 +34,6 @@ class _WorldView(Document):
         if len(p) >= 2 and p[0] in self.maps and isinstance(p[1], int) and p[1] < len(self.maps[str(p[0])]):
             return (p[0], self.maps[str(p[0])][p[1]], *p[2:])
         return p
-
-    def locate(self, path: PathKey) -> Location:
-        return super().locate(self.map_path(path))
 
 
 def _split_topic(topic: str) -> tuple[str, str]:
