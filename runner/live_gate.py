@@ -47,10 +47,9 @@ class SubprotocolGate:
                 return
             head, rest = head
             offered = _offers(head)
-            asked = next((n for n in offered if n == SERVER_NAME), None) or next(
-                (n for n in offered if n in ALSO), None
-            )
-            if asked is not None and asked != SERVER_NAME:
+            # the older name, when the client does not offer the server's own: asked for in the server's
+            renamed = None if SERVER_NAME in offered else next((n for n in offered if n in ALSO), None)
+            if renamed is not None:
                 head = _OFFER.sub(b"Sec-WebSocket-Protocol: " + SERVER_NAME.encode() + b"\r\n", head, count=1)
             upstream = socket.create_connection(self.upstream, timeout=10)
             upstream.settimeout(None)
@@ -60,8 +59,8 @@ class SubprotocolGate:
             if answer is None:
                 return
             reply, more = answer
-            if asked is not None and asked != SERVER_NAME:
-                reply = _OFFER.sub(b"Sec-WebSocket-Protocol: " + asked.encode() + b"\r\n", reply, count=1)
+            if renamed is not None:  # answered in the client's name
+                reply = _OFFER.sub(b"Sec-WebSocket-Protocol: " + renamed.encode() + b"\r\n", reply, count=1)
             client.sendall(reply + more)
             pump = threading.Thread(target=_relay, args=(upstream, client), daemon=True)
             pump.start()

@@ -24,32 +24,8 @@ def test_a_foxglove_client_sees_the_channels_and_receives_scans() -> None:
     from websockets.sync.client import connect
 
     port = free_port()
-    run = subprocess.Popen(
-        scenario_cmd(
-            "run",
-            str(SCENARIOS / "two_robots.yaml"),
-            "--rate",
-            "realtime",
-            "--no-record",
-            "--no-judge",
-            "-q",
-            "--foxglove",
-            str(port),
-        ),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    run = _serving(port, within=30)
     try:
-        deadline = time.monotonic() + 30
-        while True:  # the server is up once its port takes connections
-            try:
-                socket.create_connection(("127.0.0.1", port), timeout=1).close()
-                break
-            except OSError:
-                if time.monotonic() > deadline or run.poll() is not None:
-                    raise
-                time.sleep(0.2)
         with connect(
             f"ws://127.0.0.1:{port}", subprotocols=["foxglove.sdk.v1", "foxglove.websocket.v1"]
         ) as ws:
@@ -96,8 +72,9 @@ def _scans(ws: Any) -> list[tuple[int, Any]]:
 CLIENTS = Path(__file__).parent / "clients"
 
 
-def _serving(port: int) -> subprocess.Popen[str]:
-    """two_robots at real time, served live on `port`; returns once the port takes connections."""
+def _serving(port: int, within: float = 60) -> subprocess.Popen[str]:
+    """two_robots at real time, served live on `port`; returns once the port takes connections (within
+    `within` s, or it fails)."""
     run = subprocess.Popen(
         scenario_cmd(
             "run", str(SCENARIOS / "two_robots.yaml"), "--rate", "realtime", "--no-record", "--no-judge", "-q",
@@ -107,8 +84,8 @@ def _serving(port: int) -> subprocess.Popen[str]:
         stderr=subprocess.PIPE,
         text=True,
     )  # fmt: skip
-    deadline = time.monotonic() + 60
-    while True:
+    deadline = time.monotonic() + within
+    while True:  # the server is up once its port takes connections
         try:
             socket.create_connection(("127.0.0.1", port), timeout=1).close()
             return run
