@@ -524,7 +524,9 @@ class Foxglove(Strict):
     scene: bool = Field(
         True,
         description="Publish `scene` (foxglove.SceneUpdate: boxes, cylinders, spheres, meshes of every "
-        "body), `tf_static`/`tf` (every link, from `world`) and `<ns>/robot_description` (URDF).",
+        "body), `tf_static`/`tf` (every link, from `world`: a `robot_state_publisher` `tf` plugin is added "
+        "to each robot without a `tf` plugin) and `<ns>/robot_description` (URDF, links named "
+        "`<ns>/<link>`).",
     )
     rate: PositiveFloat = Field(
         1.0, description="How often (per sim second) the scene, static transforms and URDFs are sent again."

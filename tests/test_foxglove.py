@@ -107,7 +107,10 @@ def test_each_robot_has_its_urdf_on_robot_description(demo: Any) -> None:
         assert texts, robot.name
         urdf = ET.fromstring(texts[-1])
         assert urdf.tag == "robot"
-        assert {link.get("name") for link in urdf.iter("link")} == set(robot.links)
+        # named as the transforms name them (robot_state_publisher's frame_prefix)
+        assert {link.get("name") for link in urdf.iter("link")} == {
+            f"{robot.namespace}/{link}" for link in robot.links
+        }
 
 
 def test_meshes_capsules_and_planes_become_foxglove_primitives() -> None:

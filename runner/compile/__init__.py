@@ -41,7 +41,7 @@ from runner.plan import (
     topic_key,
 )
 from runner.plugin import BuildContext, PluginConfigError
-from runner.registry import PluginLookupError, load
+from runner.registry import PluginLookupError, drive_frames, load
 from runner.schema import NoCollision, PluginEntry, Record, Robot, Scenario, WorldModel
 from runner.transport import zenoh_reason
 from runner.validate import validate_model
@@ -916,6 +916,29 @@ def _plugin_entries(robot: Robot, model: RobotModel) -> list[_Entry]:
     return entries
 
 
+STATE_PUBLISHER = "robot_state_publisher"
+
+
+def _state_publisher(sc: Scenario, robot: Robot, model: RobotModel) -> list[_Entry]:
+    """With `foxglove.scene` (the default), a robot whose scenario and description have no `tf` plugin gets
+    one, as a launch file starts robot_state_publisher beside a Gazebo robot: every link's transform on
+    the robot's `tf` (moving) and `tf_static` (fixed, sent again every `1/foxglove.rate` s: the transport
+    does not latch, and a viewer seeking into a recording needs them near where it lands). A robot whose
+    drive says where it is (odom -> base) is joined to it; any other from `world`."""
+    entries = _plugin_entries(robot, model)
+    if not sc.foxglove.scene or any(e.type == "tf" for e in entries):
+        return []
+    driven = any(drive_frames(e.type, e.params) for e in entries)
+    taken = {e.name for e in entries}
+    name = next(n for n in (STATE_PUBLISHER, f"_{STATE_PUBLISHER}", "_tf") if n not in taken)
+    params = {
+        "rate": sc.foxglove.tf_rate,
+        "static_period": 1.0 / sc.foxglove.rate,
+        "include_root": not driven,
+    }
+    return [_Entry("tf", name, params)]
+
+
 def _build_plugins(
     sc: Scenario, robot: Robot, i: int, model: RobotModel, doc: Document, problems: Problems
 ) -> list[PluginPlan]:
@@ -923,7 +946,7 @@ def _build_plugins(
     plans: list[PluginPlan] = []
     ctx = BuildContext(spec=model.spec, robot=robot.name, namespace=robot.ns, root=model.root)
     names: set[str] = set()
-    for entry in _plugin_entries(robot, model):
+    for entry in _plugin_entries(robot, model) + _state_publisher(sc, robot, model):
         here: PathKey = ("robots", i, "plugins", entry.scenario_index or 0)
         src = entry.source
         with problems.each():

@@ -7,10 +7,10 @@ opens in Foxglove showing the world and the robots moving, with no set-up.
 - `<run>/tf_static` and `<run>/tf`: `world` -> each robot's odometry frame (where the robot started, for a
   robot whose drive publishes odom -> base), and `world` -> each body of the world's own models (moving
   ones at `tf_rate`);
-- `<run>/<ns>/scene/tf` and `<ns>/scene/tf_static`: every link of a robot relative to its parent (the
-  `tf` plugin's work, run here for a robot whose scenario has no `tf` plugin), from `world` for a robot
-  whose drive does not say where it is;
-- `<run>/<ns>/robot_description`: the robot's URDF (std_msgs/String);
+- `<run>/<ns>/tf` and `<ns>/tf_static`: every link of a robot relative to its parent, beside its drive's
+  odom -> base (the `tf` plugin that compilation adds as `robot_state_publisher` to a robot with none);
+- `<run>/<ns>/robot_description`: the robot's URDF (std_msgs/String), its link names prefixed with the
+  namespace as the transforms name them (`r1/base_link`: robot_state_publisher's `frame_prefix`);
 - `<run>/_model` (once, the compiled MJCF) and `<run>/_state` (qpos and mocap poses, at `tf_rate`): what
   `scenario render` replays a recording from.
 
@@ -28,6 +28,7 @@ import numpy as np
 
 from plugins._common import tf_transforms
 from runner import msgs
+from runner.frames import prefixed_urdf
 from runner.registry import drive_frames
 
 if TYPE_CHECKING:
@@ -140,22 +141,6 @@ def _add_geom(fm: Any, m: mujoco.MjModel, g: int, rgba: Any, prims: dict[str, li
         prims["triangles"].append(fm.TriangleListPrimitive(pose=pose, points=points, color=color))
 
 
-def link_transforms(robot: Any, fox: Any, ctx: Any) -> Any:
-    """A `tf` plugin for a robot's links on `scene/tf` and `scene/tf_static` (out of the way of the
-    robot's own `tf` topic, which its drive publishes on)."""
-    from plugins.tf import Tf, TfParams
-
-    driven = any(drive_frames(p.type, p.params) for p in robot.plugins)
-    params = TfParams(
-        rate=fox.tf_rate,
-        topic="scene/tf",
-        static_topic="scene/tf_static",
-        static_period=1.0 / fox.rate,
-        include_root=not driven,
-    )
-    return Tf(params, ctx, "scene_tf")
-
-
 class SceneFeed:
     """The world's hooks for the 3D view (see the module docstring)."""
 
@@ -169,7 +154,10 @@ class SceneFeed:
         self.scene_out = make(f"{plan.name}/scene", "foxglove.SceneUpdate")
         self.scene_bytes = scene_update(m, 0)
         self.descriptions = [
-            (make(f"{plan.name}/{r.namespace}/robot_description", "std_msgs/msg/String"), r.urdf)
+            (
+                make(f"{plan.name}/{r.namespace}/robot_description", "std_msgs/msg/String"),
+                prefixed_urdf(r.urdf, r.namespace),
+            )
             for r in plan.robots
             if r.urdf
         ]

@@ -37,6 +37,7 @@ import numpy as np
 
 from runner import msgs
 from runner.cdr import Layout
+from runner.frames import frame_id
 from runner.plan import RobotPlan, RunPlan, topic_key
 from runner.plugin import Plugin, Publisher, RuntimeContext, overrides
 from runner.registry import load
@@ -91,7 +92,7 @@ class RobotHandle:
     def frame(self, link: str) -> str:
         """The TF frame id of a link: `<ns>/<link>` (a link already named `<ns>/...`, as xacro
         `tf_prefix` descriptions do, is not prefixed twice)."""
-        return link if link.startswith(self.namespace + "/") else f"{self.namespace}/{link}"
+        return frame_id(self.namespace, link)
 
 
 @dataclass
@@ -206,14 +207,8 @@ class World:
                 if overrides(plugin, "after_step"):
                     self._after.append(_Hook(plugin.after_step, period, forward=plugin.needs_forward))
         if role == "world" and plan.foxglove.scene:
-            from runner.sim.scene import SceneFeed, link_transforms
+            from runner.sim.scene import SceneFeed
 
-            for handle in self.robots:
-                # every link's transform (robot_state_publisher's job), for a robot without a `tf` plugin
-                if not any(pp.type == "tf" for pp in handle.plan.plugins):
-                    tf = link_transforms(handle.plan, plan.foxglove, self._context(handle, 2**31))
-                    self.plugins.append(tf)
-                    self._after.append(_Hook(tf.after_step, round(1e9 / plan.foxglove.tf_rate)))
             for fn, period in SceneFeed(self).hooks():
                 self._after.append(_Hook(fn, period))
         if role == "renderer":
