@@ -31,6 +31,7 @@ import time
 from typing import Any
 
 import zenoh
+import zenoh.ext
 
 from runner import msgs, ros2
 from runner.graph import GraphTokens
@@ -40,6 +41,7 @@ from runner.transport import encoding_for, make_config, meta_key, pack_attachmen
 REMOTE = zenoh.Locality.REMOTE
 LINGER_QUIET_S = 0.2  # on stop, leave once nothing was forwarded for this long...
 LINGER_MAX_S = 0.8  # ...or after this (within the runner's STOP_GRACE_S)
+TF = "tf2_msgs/msg/TFMessage"
 
 
 def _json_default(value: Any) -> Any:
@@ -76,7 +78,7 @@ class _RosNode:
             ros2.node_token(plan.domain, self.zid, node_id, "/", plan.node)
         )
 
-    def entity(self, kind: str, topic: str, type_name: str) -> tuple[Any, bytes]:
+    def entity(self, kind: str, topic: str, type_name: str, qos: ros2.Qos) -> tuple[Any, bytes]:
         """A publisher ("MP") or subscription ("MS") token; returns it and the entity's GID."""
         key = ros2.entity_token(
             self.plan.domain,
@@ -88,9 +90,34 @@ class _RosNode:
             self.plan.node,
             topic,
             type_name,
+            qos,
         )
         self.next_id += 1
         return self.session.liveliness().declare_token(key), ros2.gid(key)
+
+
+class _RosOut:
+    """One ROS 2 publisher of the bridge's node: every mapping to its topic goes out through it (one
+    entity per topic, as a node has), numbered in one sequence. On a TRANSIENT_LOCAL TFMessage topic
+    (`/tf_static`), what it sends is the whole static tree received so far, each frame's latest transform,
+    as tf2_ros' StaticTransformBroadcaster does: the one message a late subscriber gets from the cache
+    holds every frame, whichever robot or world sent it."""
+
+    def __init__(self, pub: Any, gid: bytes, merge_tf: bool):
+        self.pub = pub
+        self.gid = gid
+        self.seq = 0
+        self.lock = threading.Lock()
+        self.tree: dict[str, Any] | None = {} if merge_tf else None
+
+    def put(self, payload: bytes) -> None:
+        with self.lock:
+            if self.tree is not None:
+                for t in msgs.decode(payload, TF).transforms:
+                    self.tree[t.child_frame_id] = t
+                payload = msgs.encode(msgs.T[TF](transforms=list(self.tree.values())), TF)
+            self.seq += 1  # rmw_zenoh numbers each publisher's messages from 1
+            self.pub.put(payload, attachment=ros2.pack_attachment(self.seq, time.time_ns(), self.gid))
 
 
 class Bridge:
@@ -102,6 +129,7 @@ class Bridge:
         self.graph = GraphTokens(session, run, os.environ.get("SCENARIO_NODE", "bridge"), "bridge")
         self._keep: list[Any] = []
         self._ros_nodes: dict[tuple[int, str, str | None], _RosNode] = {}
+        self._ros_outs: dict[str, _RosOut] = {}  # ROS 2 key -> its one publisher
         self.forwarded: dict[str, int] = {}
         self.last_forward = 0.0  # time.monotonic() of the last message forwarded, either way
         for clock in clocks:
@@ -167,21 +195,51 @@ class Bridge:
             self._keep.append(node.token)
         return node
 
-    def _ros_entity(self, p: BridgePlan, kind: str) -> tuple[str, bytes]:
-        """The rmw_zenoh key of a mapping's ROS 2 side, with its entity announced ("MP"/"MS"); its GID."""
+    def _ros_entity(self, p: BridgePlan, kind: str, qos: ros2.Qos | None = None) -> tuple[str, bytes]:
+        """The rmw_zenoh key of a mapping's ROS 2 side, with its entity announced ("MP"/"MS") with `qos`
+        (the default QoS if None); its GID."""
         assert p.ros2 is not None and p.ros_topic is not None
-        token, gid = self._ros_node(p.ros2).entity(kind, p.ros_topic, p.type)
+        token, gid = self._ros_node(p.ros2).entity(kind, p.ros_topic, p.type, qos or ros2.Qos())
         self._keep.append(token)
         return ros2.topic_key(p.ros2.domain, p.ros_topic, p.type), gid
+
+    def _ros_out(self, p: BridgePlan) -> _RosOut:
+        """The ROS 2 publisher of a mapping's topic, made by the first mapping to it."""
+        assert p.ros2 is not None and p.ros_topic is not None
+        key = ros2.topic_key(p.ros2.domain, p.ros_topic, p.type)
+        out = self._ros_outs.get(key)
+        if out is not None:
+            return out
+        qos = ros2.topic_qos(p.ros_topic)
+        key, gid = self._ros_entity(p, "MP", qos)
+        # as rmw_zenoh does for the KEEP_LAST history its tokens announce: drop rather than block
+        drop = zenoh.CongestionControl.DROP
+        latched = qos.durability == "transient_local"
+        if latched:
+            # as rmw_zenoh does for TRANSIENT_LOCAL: zenoh-ext's advanced publisher keeps the last `depth`
+            # messages in a cache (a queryable under `<key>/@adv/pub/<zid>/...`) that a late subscriber
+            # queries, and announces itself for publisher detection
+            pub: Any = zenoh.ext.declare_advanced_publisher(
+                self.session,
+                key,
+                congestion_control=drop,
+                cache=zenoh.ext.CacheConfig(max_samples=qos.depth),
+                publisher_detection=True,
+            )
+        else:
+            pub = self.session.declare_publisher(key, congestion_control=drop)
+        self._keep.append(pub)
+        self.graph.publisher(key, p.type)
+        out = self._ros_outs[key] = _RosOut(pub, gid, merge_tf=latched and p.type == TF)
+        return out
 
     # ---------------------------------------------------------------------------------- sim -> outside
     def _outbound(self, p: BridgePlan) -> None:
         session, type_name = self.session, p.type
-        gid = b""
+        ros_out: _RosOut | None = None
         if p.ros2 is not None:
-            key, gid = self._ros_entity(p, "MP")
-            # as rmw_zenoh does for the KEEP_LAST history its tokens announce: drop rather than block
-            pub = session.declare_publisher(key, congestion_control=zenoh.CongestionControl.DROP)
+            ros_out = self._ros_out(p)
+            pub: Any = ros_out.pub
         else:
             assert p.key is not None
             key = p.key
@@ -200,8 +258,8 @@ class Bridge:
                 else zenoh.CongestionControl.BLOCK,
                 reliability=zenoh.Reliability.BEST_EFFORT if p.best_effort else zenoh.Reliability.RELIABLE,
             )
-        self._keep.append(pub)
-        self.graph.publisher(key, type_name)
+            self._keep.append(pub)
+            self.graph.publisher(key, type_name)
         period_ns = round(1e9 / p.rate) if p.rate else 0
         state = {"seq": 0, "last": None, "sub": None}
         as_json = p.encoding == "json" and p.ros2 is None
@@ -221,12 +279,15 @@ class Bridge:
                     self.complain(p.where, f"a message on {p.sim_key} does not decode as {type_name}: {e}")
                     return
                 payload = json.dumps(data, default=_json_default, separators=(",", ":")).encode()
-            state["seq"] += 1
-            if p.ros2 is not None:
-                attachment = ros2.pack_attachment(state["seq"], time.time_ns(), gid)
+            if ros_out is not None:
+                try:
+                    ros_out.put(payload)
+                except Exception as e:  # (a TFMessage that does not decode, on a merged topic)
+                    self.complain(p.where, f"a message on {p.sim_key} does not decode as {type_name}: {e}")
+                    return
             else:
-                attachment = pack_attachment(state["seq"] - 1, stamp)
-            pub.put(payload, attachment=attachment)
+                state["seq"] += 1
+                pub.put(payload, attachment=pack_attachment(state["seq"] - 1, stamp))
             self.forwarded[p.where] = self.forwarded.get(p.where, 0) + 1
             self.last_forward = time.monotonic()
 
@@ -242,7 +303,8 @@ class Bridge:
                 with contextlib.suppress(Exception):
                     sub.undeclare()
 
-        if p.lazy:
+        # a cache that late subscribers read is kept filled: a TRANSIENT_LOCAL topic is never lazy
+        if p.lazy and not isinstance(pub, zenoh.ext.AdvancedPublisher):
             lock = threading.Lock()
 
             def on_matching(status: Any) -> None:
@@ -330,6 +392,10 @@ def main() -> int:
     parent = os.getppid()
     # a peer joins several routers (the run's and a ROS 2 one); a client only the first it reaches
     conf = make_config("peer" if routers else "client", connect=[endpoint, *routers])
+    if any(p.ros2 is not None for p in plans) or spec.get("mirror_nodes"):
+        # zenoh-ext's advanced publisher (TRANSIENT_LOCAL topics) stamps its samples, as rmw_zenoh's
+        # sessions do (its default config enables timestamping)
+        conf.insert_json5("timestamping/enabled", "true")
     with zenoh.open(conf) as session:
         bridge = Bridge(session, spec["run"], list(spec["clocks"]), plans)
         if spec.get("mirror_nodes"):

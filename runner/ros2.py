@@ -222,6 +222,24 @@ def parse_qos_chunk(text: str) -> Qos | None:
     return Qos(reliability=reliability, durability=durability, history=history, depth=depth)
 
 
+# Topics ROS 2 publishes with TRANSIENT_LOCAL durability, depth 1: tf2_ros' static broadcaster
+# (`/tf_static`) and robot_state_publisher (`robot_description`); a late subscriber gets the last message.
+LATCHED_TOPICS = ("tf_static", "robot_description")
+TF_DEPTH = 100  # tf2_ros' TransformBroadcaster and TransformListener
+
+
+def topic_qos(fq_topic: str) -> Qos:
+    """The QoS a ROS 2 publisher of this topic uses: TRANSIENT_LOCAL depth 1 for `tf_static` and
+    `robot_description` (at any namespace), depth 100 for `tf`, the default (reliable, volatile, depth 10)
+    otherwise."""
+    last = fq_topic.rstrip("/").rsplit("/", 1)[-1]
+    if last in LATCHED_TOPICS:
+        return Qos(durability="transient_local", depth=1)
+    if last == "tf":
+        return Qos(depth=TF_DEPTH)
+    return Qos()
+
+
 # ---------------------------------------------------------------------------------------------- tokens
 def _check_domain(domain: int) -> None:
     if isinstance(domain, bool) or not isinstance(domain, int) or domain < 0:

@@ -24,7 +24,7 @@ import zenoh
 from runner import msgs
 from runner.errors import Problem, ScenarioError
 from runner.loader import Document, PathKey, load_file
-from runner.plan import BridgePlan, NodePlan, Ros2Plan, RunPlan, hidden_topic
+from runner.plan import BridgePlan, NodePlan, Ros2Plan, RunPlan, hidden_topic, topic_key
 from runner.schema import Bridge, Ros2, Scenario
 
 _GZ_DIRECTIONS = {"GZ_TO_ROS": "SIM_TO_ZENOH", "ROS_TO_GZ": "ZENOH_TO_SIM", "BIDIRECTIONAL": "BIDIRECTIONAL"}
@@ -156,7 +156,7 @@ def attach_bridges(plan: RunPlan, sc: Scenario, doc: Document, unchecked: Sequen
         raise ScenarioError(problems)
     run_ros2 = _ros2_plan(sc.ros2, None, sc.name)
     if run_ros2 is not None and run_ros2.topics == "all":
-        out += _mirror_all(topics, run_ros2)
+        out += _mirror_all(topics, run_ros2, plan)
     if plan.best_effort:
         drop = [zenoh.KeyExpr(e) for e in plan.best_effort]
         for b in out:
@@ -479,10 +479,25 @@ def _file_entry(
     return BridgePlan(**common, key=other, encoding=b.encoding)
 
 
-def _mirror_all(topics: _Topics, ros2: Ros2Plan) -> list[BridgePlan]:
-    """`ros2: {topics: all}`: every sim topic as `/<ns>/<topic>`, in the directions the sim uses it."""
+TF = "tf2_msgs/msg/TFMessage"
+
+
+def _mirror_all(topics: _Topics, ros2: Ros2Plan, plan: RunPlan) -> list[BridgePlan]:
+    """`ros2: {topics: all}`: every sim topic as `/<ns>/<topic>`, in the directions the sim uses it; what
+    the world publishes for viewers (the world's `tf`/`tf_static`, each robot's `robot_description`); and
+    every robot's transforms on `/tf` and `/tf_static` too, where RViz, tf2 and `ros2 run tf2_ros
+    tf2_echo` look for them (frames are namespaced, `r1/base_link`, so the robots' trees do not clash)."""
+    table = dict(topics.table)
+    for part in plan.parts():
+        if part.foxglove.scene:
+            for name in ("tf", "tf_static"):
+                table.setdefault(f"{part.name}/{name}", (TF, {"pub"}))
+            for r in part.robots:
+                if r.urdf:
+                    key = topic_key(part.name, r.namespace, "robot_description")
+                    table.setdefault(key, ("std_msgs/msg/String", {"pub"}))
     out = []
-    for key, (type_name, directions) in sorted(topics.table.items()):
+    for key, (type_name, directions) in sorted(table.items()):
         rel = key[len(topics.run) + 1 :]
         if hidden_topic(rel) or not msgs.is_known(type_name):  # (the Foxglove scene is not a ROS 2 type)
             continue
@@ -501,4 +516,16 @@ def _mirror_all(topics: _Topics, ros2: Ros2Plan) -> list[BridgePlan]:
                 ros2=ros2,
             )
         )
+        last = rel.rsplit("/", 1)[-1]
+        if type_name == TF and "pub" in directions and last in ("tf", "tf_static") and rel != last:
+            out.append(
+                BridgePlan(
+                    where=f"ros2 ({rel} on /{last})",
+                    sim_key=key,
+                    type=TF,
+                    direction="SIM_TO_ZENOH",
+                    ros_topic="/" + last,
+                    ros2=ros2,
+                )
+            )
     return out
