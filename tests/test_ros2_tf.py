@@ -43,11 +43,19 @@ robots:
     plugins:
       - {type: diff_drive}
       - {type: tf, params: {rate: 20}}
+  - name: r4
+    description: "{diffbot}"
+    pose: {xyz: [-1, 1, 0.06]}
+    plugins:
+      - {type: tf}
 world:
   models:
     - {name: crate, shape: box, size: [0.3, 0.3, 0.3], pose: {xyz: [0, 2, 0.15]}}
     - {name: ball, shape: sphere, size: [0.1], pose: {xyz: [0, -2, 0.1]}, static: false, mass: 0.5}
 """
+
+
+ROBOTS = ("r1", "r2", "r3", "r4")
 
 
 def _tf_and_descriptions(mcap: Path) -> tuple[dict[str, set[str]], dict[str, str], set[str]]:
@@ -86,7 +94,8 @@ def _reachable(edges: dict[str, set[str]], root: str) -> set[str]:
 def test_every_link_of_every_robot_description_is_reachable_from_world_in_the_recording(
     write_scenario, tmp_path: Path
 ) -> None:
-    """A driven robot, one with no plugin at all and one with its own `tf` plugin, beside a fixed and a
+    """A driven robot, one with no plugin at all, a driven one with its own `tf` plugin and an undriven one
+    with its own `tf` plugin (which leaves the root out), beside a fixed and a
     moving world model: read back from the MCAP alone, every link named in each robot's
     `robot_description` is a frame that the recorded transforms join to `world`."""
     path = write_scenario(MIXED)
@@ -94,7 +103,7 @@ def test_every_link_of_every_robot_description_is_reachable_from_world_in_the_re
     proc = run_cli("run", str(path), "-q", "--record", str(mcap), "--rate", "max", timeout=150)
     assert proc.returncode == 0, proc.stderr
     edges, descriptions, tf_topics = _tf_and_descriptions(mcap)
-    assert sorted(descriptions) == [f"frames/{r}/robot_description" for r in ("r1", "r2", "r3")]
+    assert sorted(descriptions) == [f"frames/{r}/robot_description" for r in ROBOTS]
     reachable = _reachable(edges, "world")
     for topic, urdf in descriptions.items():
         ns = topic.split("/")[1]
@@ -110,11 +119,12 @@ def test_every_link_of_every_robot_description_is_reachable_from_world_in_the_re
     assert tf_topics == {
         "frames/tf",
         "frames/tf_static",
-        *(f"frames/{r}/{t}" for r in ("r1", "r2", "r3") for t in ("tf", "tf_static")),
+        *(f"frames/{r}/{t}" for r in ROBOTS for t in ("tf", "tf_static")),
     }
     assert "r1/odom" in edges["world"] and "r1/base_link" in edges["r1/odom"]  # the drive, joined
     assert "r2/base_link" in edges["world"]  # no drive: placed from the world
     assert "r3/base_link" in edges["r3/odom"]
+    assert "r4/base_link" in edges["world"]  # its own `tf` leaves the root out: the world places it
 
 
 @pytest.mark.timeout(60)

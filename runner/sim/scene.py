@@ -5,8 +5,9 @@ opens in Foxglove showing the world and the robots moving, with no set-up.
   geometry, in that body's frame (`world`, `r1/base_link`, `ball`), its geoms as cubes, spheres,
   cylinders and triangle meshes, with their colours; frame-locked, so they move with the transforms;
 - `<run>/tf_static` and `<run>/tf`: `world` -> each robot's odometry frame (where the robot started, for a
-  robot whose drive publishes odom -> base), and `world` -> each body of the world's own models (moving
-  ones at `tf_rate`);
+  robot whose drive publishes odom -> base), `world` -> the root of a robot that nothing else places (no
+  drive, its own `tf` plugin without `include_root`), and `world` -> each body of the world's own models
+  (moving ones at `tf_rate`);
 - `<run>/<ns>/tf` and `<ns>/tf_static`: every link of a robot relative to its parent, beside its drive's
   odom -> base (the `tf` plugin that compilation adds as `robot_state_publisher` to a robot with none);
 - `<run>/<ns>/robot_description`: the robot's URDF (std_msgs/String), its link names prefixed with the
@@ -164,6 +165,8 @@ class SceneFeed:
         robot_bodies = {b for h in world.robots for b in h.body_ids}
         # world -> odom of each driven robot: where its base started (odometry starts at zero there)
         self.static: list[tuple[str, str, np.ndarray, np.ndarray]] = []
+        self.moving: list[int] = []
+        self._frames: list[str] = []
         for h in world.robots:
             frames = next(
                 (f for p in h.plan.plugins if (f := drive_frames(p.type, p.params)) is not None), None
@@ -173,13 +176,23 @@ class SceneFeed:
                 self.static.append(
                     (WORLD, odom, np.array(d.xpos[h.root_body]), np.array(d.xquat[h.root_body]))
                 )
+            elif not any(p.type == "tf" and p.params.get("include_root") for p in h.plan.plugins):
+                # nobody says where this robot is (its own `tf` plugin leaves the root out): world -> root
+                root = h.frame(h.root_link)
+                if int(m.body_jntnum[h.root_body]) > 0:
+                    self.moving.append(h.root_body)
+                    self._frames.append(root)
+                else:
+                    self.static.append(
+                        (WORLD, root, np.array(d.xpos[h.root_body]), np.array(d.xquat[h.root_body]))
+                    )
         # the world's own models: moving (a free ball) or not
-        self.moving: list[int] = []
         for b in range(1, m.nbody):
             if b in robot_bodies or int(m.body_parentid[b]) != 0:
                 continue
             if int(m.body_jntnum[b]) > 0:
                 self.moving.append(b)
+                self._frames.append(_frame(m, b))
             else:
                 self.static.append((WORLD, _frame(m, b), np.array(d.xpos[b]), np.array(d.xquat[b])))
         # for `scenario render`: the model (MJCF) once, and the state (qpos, mocap poses) at tf_rate
@@ -188,7 +201,6 @@ class SceneFeed:
         self.state_out = make(f"{plan.name}/_state", STATE)
         self.static_out = make(f"{plan.name}/tf_static", TF) if self.static else None
         self.tf_out = make(f"{plan.name}/tf", TF) if self.moving else None
-        self._frames = [_frame(m, b) for b in self.moving]
         T = msgs.T
         self._layout = T["std_msgs/msg/MultiArrayLayout"](
             dim=[
