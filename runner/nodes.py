@@ -32,12 +32,37 @@ class OutputTail(threading.Thread):
         self.stream = stream
         self.prefix = prefix
         self.lines: collections.deque[str] = collections.deque(maxlen=30)
+        # set once the runner stops the process with SIGINT: a Python traceback that ends in
+        # `KeyboardInterrupt` is then the stop being obeyed (a script interrupted before it set up its own
+        # handling), not news, and is left out
+        self.stopping = False
+        self._held: list[str] = []
 
     def run(self) -> None:
         for raw in iter(self.stream.readline, b""):
-            line = raw.decode(errors="replace").rstrip()
-            self.lines.append(line)
-            print(f"{self.prefix}{line}", file=sys.stderr, flush=True)
+            self._line(raw.decode(errors="replace").rstrip())
+        self._flush()
+
+    def _line(self, line: str) -> None:
+        if self._held or (self.stopping and line.startswith("Traceback (most recent call last):")):
+            if line == "KeyboardInterrupt":
+                self._held.clear()
+                return
+            self._held.append(line)
+            if line.startswith((" ", "Traceback")):
+                return
+            self._flush()  # the traceback ended otherwise: shown whole
+            return
+        self._show(line)
+
+    def _flush(self) -> None:
+        held, self._held = self._held, []
+        for line in held:
+            self._show(line)
+
+    def _show(self, line: str) -> None:
+        self.lines.append(line)
+        print(f"{self.prefix}{line}", file=sys.stderr, flush=True)
 
 
 class NodeProcess:
@@ -142,6 +167,9 @@ class Nodes:
     def stop(self) -> None:
         """SIGINT to every node still running, then SIGKILL to those still there after a grace period."""
         running = [p.proc for p in self.procs if p.proc is not None and p.proc.poll() is None]
+        for p in self.procs:
+            if p.output is not None:
+                p.output.stopping = True
         for proc in running:
             with contextlib.suppress(ProcessLookupError):
                 proc.send_signal(signal.SIGINT)

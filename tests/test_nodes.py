@@ -239,3 +239,26 @@ def test_a_required_node_whose_script_is_missing_fails_the_run_without_a_traceba
     assert r.returncode == 1, r.stderr
     assert "required node 'driver' exited with code 2" in r.stderr and "missing_script.py" in r.stderr
     assert "Traceback" not in r.stderr and "KeyboardInterrupt" not in r.stderr, r.stderr
+
+
+def _tail_of(text: str, stopping: bool, capsys: pytest.CaptureFixture[str]) -> str:
+    import io
+
+    from runner.nodes import OutputTail
+
+    tail = OutputTail(io.BytesIO(text.encode()), "[n] ")
+    tail.stopping = stopping
+    tail.run()
+    return capsys.readouterr().err
+
+
+def test_a_keyboardinterrupt_traceback_from_the_runners_own_stop_is_left_out(capsys) -> None:
+    """A node stopped by the runner (SIGINT) before it set up its own handling prints Python's
+    KeyboardInterrupt traceback: that is the stop obeyed, not news. Any other traceback, or one before the
+    runner asked, is shown whole."""
+    interrupted = 'started\nTraceback (most recent call last):\n  File "n.py", line 3, in <module>\n    import x\nKeyboardInterrupt\nbye\n'
+    failed = 'Traceback (most recent call last):\n  File "n.py", line 3, in <module>\nValueError: bad\n'
+    assert _tail_of(interrupted, True, capsys) == "[n] started\n[n] bye\n"
+    assert "KeyboardInterrupt" in _tail_of(interrupted, False, capsys)
+    out = _tail_of(failed, True, capsys)
+    assert out.count("[n] ") == 3 and "ValueError: bad" in out
