@@ -27,6 +27,7 @@ class PluginPlan(BaseModel):
     topics: list[TopicPlan] = []
     source_file: str | None = None  # where the description declares it (a Gazebo <plugin> or <sensor>)
     source_line: int | None = None
+    added: str | None = None  # not declared, added by the runner, and why (`foxglove.scene`)
 
 
 class ParityLine(BaseModel):

@@ -69,3 +69,9 @@ def robot_scenario(
         f"    plugins: {plugins}\n" + (f"timeline:\n{timeline}" if timeline else "")
     )
     return path
+
+
+def declared(robot: Any) -> list[Any]:
+    """A robot plan's plugins that its scenario or description declares (not the runner's own additions,
+    such as the `robot_state_publisher` that `foxglove.scene` adds)."""
+    return [p for p in robot.plugins if p.added is None]

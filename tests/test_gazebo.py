@@ -12,7 +12,7 @@ from runner.compile import compile_plan
 from runner.errors import Notices
 from runner.loader import load_file
 from runner.validate import validate_scenario
-from tests.helpers import messages, simulate
+from tests.helpers import declared, messages, simulate
 
 DATA = Path(__file__).parent / "data" / "gazebo"
 
@@ -39,7 +39,7 @@ def _compile(path: Path):  # type: ignore[no-untyped-def]
 
 def test_classic_plugins_and_sensors_are_mapped(write_scenario):
     plan, _ = _compile(write_scenario(CLASSIC))
-    plugins = {p.name: p for p in plan.robots[0].plugins}
+    plugins = {p.name: p for p in declared(plan.robots[0])}
     assert set(plugins) == {
         "differential_drive_controller",
         "wheel_joint_states",
@@ -106,14 +106,14 @@ def test_scenario_plugins_override_and_extend_the_description(write_scenario):
         "\n      - {type: ground_truth}",
     )
     plan, _ = _compile(write_scenario(text))
-    plugins = {p.name: p for p in plan.robots[0].plugins}
+    plugins = {p.name: p for p in declared(plan.robots[0])}
     assert plugins["front_laser"].params["samples"] == 90  # merged by type: the scenario wins
     assert plugins["front_laser"].params["range_max"] == 8.0  # the rest comes from the description
     assert plugins["front_laser"].rate == 2
     assert "ground_truth" in plugins
     off = text.replace("    plugins:\n", "    plugins_from_description: false\n    plugins:\n")
     plan, _ = _compile(write_scenario(off, "off.yaml"))
-    assert sorted(p.type for p in plan.robots[0].plugins) == ["ground_truth", "lidar"]
+    assert sorted(p.type for p in declared(plan.robots[0])) == ["ground_truth", "lidar"]
 
 
 HARMONIC = """<?xml version="1.0"?>
@@ -180,7 +180,7 @@ def test_harmonic_systems_and_sensors(write_scenario, tmp_path: Path):
             "name: h\nrobots:\n  - name: h1\n    description: h.urdf\n    pose: {xyz: [0, 0, 0.1]}\n"
         )
     )
-    by_type = {p.type: p for p in plan.robots[0].plugins}
+    by_type = {p.type: p for p in declared(plan.robots[0])}
     assert by_type["diff_drive"].rate == 25 and by_type["diff_drive"].params["base_frame"] == "h1/base_link"
     assert by_type["lidar"].params["frame_id"] == "h1/lidar_link"
     assert by_type["lidar"].params["min_angle"] == -3.14
@@ -250,7 +250,7 @@ BUMPER = """<?xml version="1.0"?>
 def test_classic_bumper_becomes_a_contact_plugin(write_scenario, tmp_path: Path):
     (tmp_path / "b.urdf").write_text(BUMPER)
     plan, notices = _compile(write_scenario("name: b\nrobots:\n  - {name: b1, description: b.urdf}\n"))
-    (bumper,) = plan.robots[0].plugins
+    (bumper,) = declared(plan.robots[0])
     assert bumper.type == "contact" and bumper.rate == 15
     assert bumper.params["link"] == "base_link" and bumper.params["frame_id"] == "b1/base_link"
     assert {t.key for t in plan.topics()} >= {"b/b1/front_bumper"}

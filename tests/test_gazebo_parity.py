@@ -18,7 +18,7 @@ import pytest
 
 from runner.errors import ScenarioError
 from runner.geometry import quat_to_yaw
-from tests.helpers import compile_with_notices, messages, plan_of, simulate
+from tests.helpers import compile_with_notices, declared, messages, plan_of, simulate
 
 # ------------------------------------------------------------------------------------------ the robots
 _INERTIA = '<inertia ixx="{i}" iyy="{i}" izz="{i}" ixy="0" ixz="0" iyz="0"/>'
@@ -328,7 +328,7 @@ def test_blocks_naming_links_the_xacro_args_removed_are_dropped(tmp_path: Path, 
         f"args: {{use_imu: {str(use_imu).lower()}}}}}\n"
     )
     plan, text = compile_with_notices(tmp_path / "s.yaml")
-    types = [p.type for p in plan.robots[0].plugins]
+    types = [p.type for p in declared(plan.robots[0])]
     xacro = tmp_path / "robot.urdf.xacro"
     if use_imu:  # a fixed joint: Gazebo lumps it away, its joint state publisher finds no such joint either
         assert types == ["imu"], types
@@ -367,7 +367,7 @@ ROS2_PAIRS = """
 
 def test_every_declared_wheel_is_driven(tmp_path: Path):
     plan, text = compile_with_notices(_write(tmp_path, _four_wheels(ROS2_PAIRS), 1.0))
-    drive = next(p for p in plan.robots[0].plugins if p.name == "drive")
+    drive = next(p for p in declared(plan.robots[0]) if p.name == "drive")
     assert drive.type == "skid_steer"
     assert drive.params["left_joints"] == ["left_front_wheel_joint", "left_rear_wheel_joint"]
     assert drive.params["right_joints"] == ["right_front_wheel_joint", "right_rear_wheel_joint"]
@@ -390,21 +390,21 @@ def test_a_drive_controls_at_a_high_rate_whatever_it_publishes_at(tmp_path: Path
     assert abs(straight - 1.0) < 0.05, straight
     assert abs(turned - 1.5) < 0.15, turned
     plan = plan_of(tmp_path / "scenario.yaml")
-    drive = next(p for p in plan.robots[0].plugins if p.type == "diff_drive")
+    drive = next(p for p in declared(plan.robots[0]) if p.type == "diff_drive")
     assert drive.rate == 1 and drive.control_rate == 100
 
 
 # ------------------------------------------------------------------------------------- 6. topic names
 def test_gazebo_default_topic_names(tmp_path: Path):
     plan, _ = compile_with_notices(_write(tmp_path, diffbot(GZ_DRIVE), 1.0))
-    keys = {t.key for p in plan.robots[0].plugins for t in p.topics}
+    keys = {t.key for p in declared(plan.robots[0]) for t in p.topics}
     assert {"t/r1/model/r1/cmd_vel", "t/r1/model/r1/odometry", "t/r1/model/r1/tf"} <= keys, keys
     camera = """
   <link name="cam"/><joint name="cam_joint" type="fixed"><parent link="base_link"/><child link="cam"/></joint>
   <gazebo reference="cam"><sensor name="front" type="camera"><topic>front_camera</topic><update_rate>5</update_rate>
     <camera><image><width>64</width><height>48</height></image></camera></sensor></gazebo>"""
     plan, _ = compile_with_notices(_write(tmp_path, diffbot(GZ_DRIVE, extra=camera), 1.0))
-    cam = next(p for p in plan.robots[0].plugins if p.type == "camera")
+    cam = next(p for p in declared(plan.robots[0]) if p.type == "camera")
     assert {t.key for t in cam.topics} == {"t/r1/front_camera", "t/r1/camera_info"}
 
 
@@ -426,7 +426,7 @@ def test_harmonic_sensors_publish_where_gz_sensors_does(tmp_path: Path):
   </gazebo>
   <gazebo reference="imu_link"><sensor name="imu" type="imu"><update_rate>50</update_rate></sensor></gazebo>"""
     plan, _ = compile_with_notices(_write(tmp_path, diffbot(GZ_DRIVE, extra=sensors), 1.0))
-    topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in plan.robots[0].plugins}
+    topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in declared(plan.robots[0])}
     scoped = "world/default/model/r1/link/base_link/sensor"  # laser and imu_link are lumped into base_link
     assert topics["front"] == ["scan", "scan/points"], topics
     assert topics["rear"] == [f"{scoped}/rear/scan", f"{scoped}/rear/scan/points"], topics
@@ -436,7 +436,7 @@ def test_harmonic_sensors_publish_where_gz_sensors_does(tmp_path: Path):
     assert clouds and clouds[-1][1].width * clouds[-1][1].height == 90
     # the same sensors in a classic description (a gazebo_ros diff drive): no cloud, our short defaults
     plan, _ = compile_with_notices(_write(tmp_path, diffbot(extra=sensors.replace("gpu_lidar", "ray")), 1.0))
-    topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in plan.robots[0].plugins}
+    topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in declared(plan.robots[0])}
     assert topics["front"] == ["scan"] and topics["imu"] == ["imu"], topics
 
 
@@ -449,11 +449,13 @@ def test_classic_publish_wheel_tf(tmp_path: Path):
         ("r1/base_link", "r1/right_wheel"),
         ("r1/odom", "r1/base_link"),
     } <= frames
-    wheel = next(t for t in tfs[-1][1].transforms if t.child_frame_id == "r1/left_wheel")
+    # the drive's messages (robot_state_publisher's go on `tf` too)
+    drive = [m for _, m in tfs if any(t.child_frame_id == "r1/base_link" for t in m.transforms)]
+    wheel = next(t for t in drive[-1].transforms if t.child_frame_id == "r1/left_wheel")
     assert (
         abs(wheel.transform.translation.y - 0.17) < 1e-6 and abs(wheel.transform.translation.z + 0.05) < 1e-6
     )
-    assert len(tfs) == pytest.approx(0.5 * 50, abs=1)  # one message a cycle
+    assert len(drive) == pytest.approx(0.5 * 50, abs=1)  # the drive: one message a cycle
 
 
 # ------------------------------------------------------------------------------------ motion fidelity
@@ -564,7 +566,7 @@ def test_a_ros2_control_diff_drive_runs_from_its_controllers_file(tmp_path: Path
     )
     path = _write(tmp_path, urdf, 7.0, timeline)
     plan, text = compile_with_notices(path)
-    topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in plan.robots[0].plugins}
+    topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in declared(plan.robots[0])}
     assert topics["base_controller"] == ["base_controller/cmd_vel_unstamped", "base_controller/odom", "tf"]
     assert topics["joint_state_broadcaster"] == ["joint_states"]
     assert (
@@ -617,7 +619,7 @@ def test_ros1_gazebo_ros_control_runs_the_controllers_file_the_scenario_names(tm
     plan, said = compile_with_notices(path)
     assert "controllers are not run" not in said, said
     assert "launch argument(s) prefix taken as empty" in said  # roslaunch's subst_value, with no value
-    topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in plan.robots[0].plugins}
+    topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in declared(plan.robots[0])}
     assert topics["velocity_controller"] == ["velocity_controller/cmd_vel", "velocity_controller/odom"]
     assert topics["joint_publisher"] == ["joint_states"]
     _, bus = simulate(path)
@@ -675,5 +677,5 @@ def test_a_plugin_parameter_that_is_not_a_number_is_said_at_its_line(tmp_path: P
         in text
     ), text
     assert "robot.urdf:" in text and "write a plain number" in text
-    skid = next(p for p in plan.robots[0].plugins if p.type == "skid_steer")
+    skid = next(p for p in declared(plan.robots[0]) if p.type == "skid_steer")
     assert skid.params.get("wheel_separation") is None  # its default: measured from the model

@@ -19,7 +19,7 @@ import pytest
 
 from runner.plan import RunPlan
 from runner.transport import MemoryBus
-from tests.helpers import compile_with_notices, messages, robot_scenario, simulate
+from tests.helpers import compile_with_notices, declared, messages, robot_scenario, simulate
 
 IMAGE, INFO, POINTS = "sensor_msgs/msg/Image", "sensor_msgs/msg/CameraInfo", "sensor_msgs/msg/PointCloud2"
 
@@ -232,7 +232,7 @@ RATES = (
 @pytest.mark.timeout(120)
 def test_plugin_update_rate_throttles_the_sensor(tmp_path: Path):
     plan, notes = compile_with_notices(_write(tmp_path, RATES, duration=1.0))
-    rates = {p.name: p.rate for p in plan.robots[0].plugins}
+    rates = {p.name: p.rate for p in declared(plan.robots[0])}
     assert rates == {"r200": 30, "slow": 10, "odd": 15, "ros2": 20}
     assert "<updateRate> is not read by 'libgazebo_ros_camera.so' (ROS 2)" in notes
     _, bus = simulate(_write(tmp_path, RATES, duration=1.0))
@@ -322,7 +322,7 @@ def test_classic_imu_gaussian_noise(tmp_path: Path):
     path = _write(tmp_path, CLASSIC_IMU, duration=2.0, gravity="[0, 0, 0]")  # welded, no gravity: readings 0
     plan, notes = compile_with_notices(path)
     assert "<imu> is not a parameter of 'libgazebo_ros_imu.so': Gazebo ignores it too" in notes
-    assert {p.name: p.rate for p in plan.robots[0].plugins} == {"imu_plugin": 200, "imu_sensor": 50}
+    assert {p.name: p.rate for p in declared(plan.robots[0])} == {"imu_plugin": 200, "imu_sensor": 50}
     _, bus = simulate(path)
     model = _readings(bus, "bot/imu_model", lambda m: m.angular_velocity)
     assert len(model) == 401

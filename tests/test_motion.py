@@ -174,7 +174,11 @@ def test_planar_move_moves_passive_robot_sideways_and_forward(write_scenario):
     moving = _at(odom, 3.0)
     # the true twist, in the base frame (sliding wheels sideways chatters: about ±0.02 m/s)
     assert abs(moving.twist.twist.linear.y - 0.3) < 0.05 and abs(moving.twist.twist.linear.x) < 0.02
-    tf = messages(bus, "side/tf")[-1][1].transforms[0]
+    drive = [
+        t for _, m in messages(bus, "side/tf") for t in m.transforms if t.child_frame_id == "side/base_link"
+    ]
+    tf = drive[-1]
+    assert tf.header.frame_id == "side/odom"
     assert abs(tf.transform.translation.y - p_side.y) < 1e-6
 
 

@@ -27,8 +27,8 @@ DEMO_RATES = {
     "r2/imu": 100,
     "r1/odom": 50,
     "r2/odom": 50,
-    "r1/tf": 50,
-    "r2/tf": 50,
+    "r1/tf": 80,  # the drive's odom -> base (50 Hz) and robot_state_publisher's wheels (30 Hz)
+    "r2/tf": 80,
     "r1/joint_states": 50,
     "r2/joint_states": 50,
 }
@@ -52,6 +52,8 @@ def test_demo_runs_to_completion_and_records_every_topic(demo_run):
         key = f"two_robots/{suffix}"
         expected = rate * 20.0
         assert abs(counts[key] - expected) <= 0.02 * expected, (key, counts[key], expected)
+    # the fixed links at t = 0 and again every sim second (0..20 s)
+    assert counts["two_robots/r1/tf_static"] == counts["two_robots/r2/tf_static"] == 21
     types = {topic: t for topic, t, _, _ in messages}
     assert types["two_robots/r1/scan"] == "sensor_msgs/msg/LaserScan"
     assert types["two_robots/r2/tf"] == "tf2_msgs/msg/TFMessage"

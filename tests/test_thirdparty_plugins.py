@@ -12,7 +12,7 @@ import numpy as np
 
 from plugins.gps import earth_radii
 from runner.plan import RunPlan
-from tests.helpers import compile_with_notices, messages, robot_scenario, simulate
+from tests.helpers import compile_with_notices, declared, messages, robot_scenario, simulate
 
 ROBOT = """<?xml version="1.0"?>
 <robot name="t">
@@ -176,7 +176,13 @@ def _write(
 
 
 def _topics(plan: RunPlan) -> dict[str, str]:
-    return {t.key.removeprefix("g/bot/"): t.type for t in plan.topics() if t.key.startswith("g/bot/")}
+    """The robot's topics from its declared plugins (not robot_state_publisher's `tf`, `tf_static`)."""
+    return {
+        t.key.removeprefix("g/bot/"): t.type
+        for plugin in declared(plan.robots[0])
+        for t in plugin.topics
+        if t.key.startswith("g/bot/")
+    }
 
 
 def _vec(v: object) -> list[float]:

@@ -892,6 +892,7 @@ class _Entry:
     scenario_index: int | None = None  # index in robots[i].plugins, when the scenario names it
     scenario_keys: frozenset[str] = frozenset()  # params the scenario set (the rest came from the file)
     source: DescribedPlugin | None = None
+    added: str | None = None  # why the runner adds it, when neither the scenario nor the description has it
 
 
 def _plugin_entries(robot: Robot, model: RobotModel) -> list[_Entry]:
@@ -936,7 +937,7 @@ def _state_publisher(sc: Scenario, robot: Robot, model: RobotModel) -> list[_Ent
         "static_period": 1.0 / sc.foxglove.rate,
         "include_root": not driven,
     }
-    return [_Entry("tf", name, params)]
+    return [_Entry("tf", name, params, added="foxglove.scene")]
 
 
 def _build_plugins(
@@ -990,6 +991,7 @@ def _build_plugins(
                     control_rate=cls.control_rate_of(params),
                     source_file=str(src.file) if src is not None and src.file else None,
                     source_line=src.line if src is not None else None,
+                    added=entry.added,
                     topics=[
                         TopicPlan(
                             key=topic_key(sc.name, robot.ns, t.name),
