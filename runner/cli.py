@@ -828,17 +828,37 @@ def report(
 
 @app.command()
 def render(
-    mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="The video or picture: .mp4, .gif or .png.")],
+    mcap: Annotated[Path, typer.Argument(metavar="RUN.mcap", help="A recording (.mcap).")],
+    output: Annotated[
+        Path,
+        typer.Option("--output", "-o", metavar="FILE", help="The video or picture: .mp4, .gif or .png."),
+    ],
     camera: Annotated[
-        str, typer.Option(help="overview (the whole scene), chase:ROBOT (following it), or a model camera.")
+        str,
+        typer.Option(
+            metavar="CAMERA",
+            help="overview (the whole scene), chase:ROBOT (following it), or a model camera.",
+        ),
     ] = "overview",
-    fps: Annotated[float, typer.Option(help="Frames per sim second.", min=1, max=120)] = 15.0,
-    size: Annotated[str, typer.Option(help="WIDTHxHEIGHT in pixels.")] = "640x480",
-    world: Annotated[str | None, typer.Option(help="With several worlds: which one.")] = None,
+    fps: Annotated[
+        float,
+        typer.Option(
+            metavar="FPS",
+            help="Frames per sim second; it plays as long as the run took in sim time (a GIF: 50 at most).",
+            min=1,
+            max=120,
+        ),
+    ] = 15.0,
+    size: Annotated[
+        str, typer.Option(metavar="WxH", help="Width and height in pixels, e.g. 640x480.")
+    ] = "960x720",
+    world: Annotated[
+        str | None, typer.Option(metavar="WORLD", help="With several worlds: which one.")
+    ] = None,
 ) -> None:
     """Render a recorded run again (MuJoCo, offscreen, CPU where there is no GPU): the robots moving, their
-    paths drawn as they go. A .png is the last frame.
+    paths drawn as they go, each in the robot's colour (as in the trajectory plot and the report). A .png
+    is the run's last moment.
 
     Examples:
       scenario render runs/two_robots.mcap -o two_robots.mp4
@@ -848,6 +868,8 @@ def render(
 
     try:
         w, h = (int(v) for v in size.lower().split("x"))
+        if w < 16 or h < 16:
+            raise ValueError
     except ValueError:
         raise _fail(RunError(f"--size {size!r}: expected WIDTHxHEIGHT, e.g. 640x480")) from None
     if not mcap.is_file():
@@ -856,14 +878,23 @@ def render(
         rec = replay.load(mcap, world)
         notes: list[str] = []
         with _progress_bar("rendering") as bar:
-            n = replay.write(
+            got = replay.write(
                 rec, output, camera=camera, width=w, height=h, fps=fps, progress=bar, notes=notes
             )
     except RunError as e:
         raise _fail(e) from None
     for note in notes:
         err.print(f"note: {note}", markup=False, style="yellow")
-    out.print(f"{output}: {n} frames, {rec.times[-1] / 1e9:.1f} s sim, camera {camera}", markup=False)
+    sim = f"{rec.times[-1] / 1e9:.2f} s sim"
+    if output.suffix.lower() == ".png":
+        out.print(f"{output}: the run at {sim}, camera {camera}", markup=False)
+        return
+    merged = f" ({got.merged} unchanged frames shown on)" if got.merged else ""
+    out.print(
+        f"{output}: {got.frames} frames{merged}, plays {got.seconds:.2f} s at {got.fps:g} fps "
+        f"({sim}), camera {camera}",
+        markup=False,
+    )
 
 
 class _progress_bar:
