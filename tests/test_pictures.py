@@ -1,5 +1,6 @@
-"""The pictures of a run agree and can be read: one colour per robot; the overview frames the whole
-world; a video plays as long as the run and holds the frames it says."""
+"""The pictures of a run agree and can be read: one colour per robot in the trajectory plot, the report
+and `scenario render`; the overview frames the whole world; a video plays as long as the run and holds
+the frames it says."""
 
 from __future__ import annotations
 
@@ -73,6 +74,61 @@ def test_a_colour_too_light_for_paper_keeps_its_hue() -> None:
     yellow = assign_colours([("r", (1.0, 1.0, 0.0))])["r"]
     assert 0.2126 * yellow[0] + 0.7152 * yellow[1] + 0.0722 * yellow[2] <= MAX_LUMA + 1e-9
     assert colorsys.rgb_to_hsv(*yellow)[0] == pytest.approx(colorsys.rgb_to_hsv(1, 1, 0)[0])
+
+
+def _hue_mask(img: np.ndarray, rgb: tuple[float, float, float]) -> np.ndarray:
+    """Pixels of this colour under MuJoCo's lights: its hue, saturated, not dark."""
+    from PIL import Image
+
+    hsv = np.asarray(Image.fromarray(img).convert("HSV"), dtype=float)
+    hue = colorsys.rgb_to_hsv(*rgb)[0] * 255
+    near = np.minimum(np.abs(hsv[..., 0] - hue), 255 - np.abs(hsv[..., 0] - hue)) < 10
+    return near & (hsv[..., 1] > 100) & (hsv[..., 2] > 70)
+
+
+@pytest.mark.timeout(180)
+def test_each_robot_has_one_colour_in_the_plot_the_report_and_the_render(demo: Path, tmp_path: Path) -> None:
+    from PIL import Image
+
+    from runner import replay
+    from runner.checks.html import load_plan, write_report
+    from runner.checks.plot import trajectory_plot
+    from runner.pictures import hex_colour, rgb255, run_colours
+
+    plan = load_plan(demo)
+    colours = run_colours(plan)
+    # the robots' own colours, from the scenario's xacro arguments, as the compiled model has them
+    assert np.allclose(colours["r1"], (0.85, 0.2, 0.2), atol=1e-6)
+    assert np.allclose(colours["r2"], (0.2, 0.35, 0.9), atol=1e-6)
+
+    # the trajectory plot: each path drawn in exactly its robot's colour (the legend aside)
+    png = trajectory_plot(plan, demo, [], tmp_path / "t.png")
+    assert png is not None
+    plot = np.asarray(Image.open(png).convert("RGB")).astype(int)
+    paths = plot[:, : plot.shape[1] - 240]  # (the legend lies on the right)
+    for name in ("r1", "r2"):
+        exact = (np.abs(paths - rgb255(colours[name])).max(axis=2) == 0).sum()
+        assert exact > 150, (name, exact)
+
+    # the report: the speed plot's lines and labels
+    page = tmp_path / "report.html"
+    write_report(demo, page, plan)
+    speed = next(
+        svg for svg in re.findall(r"<svg.*?</svg>", page.read_text()) if "Speed of each robot" in svg
+    )
+    for name in ("r1", "r2"):
+        colour = hex_colour(colours[name])
+        assert re.search(rf'<polyline points="[^"]+" stroke="{colour}"', speed), (name, colour)
+        assert f'fill="{colour}">{name}</text>' in speed
+
+    # the render: the colours it draws the paths in, and the pixels of the paths
+    rec = replay.load(demo)
+    assert replay.colours(mujoco.MjModel.from_xml_string(rec.mjcf), rec) == colours
+    first = next(replay.frames(rec, width=960, height=720))
+    last = next(replay.frames(rec, width=960, height=720, last_only=True))
+    for name in ("r1", "r2"):
+        grown = int(_hue_mask(last, colours[name]).sum()) - int(_hue_mask(first, colours[name]).sum())
+        assert grown > 60, (name, grown)  # its path, in its colour (at t = 0 only the robot itself)
 
 
 # --- the overview ----------------------------------------------------------------------------------------

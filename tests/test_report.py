@@ -38,6 +38,10 @@ def test_the_report_shows_the_verdict_the_plots_and_the_topics(tmp_path: Path) -
     assert text.count("<svg") == 5 and 'src="data:image/png;base64,' in text
     assert "two_robots/r1/scan" in text and "_truth" not in text  # topics, helpers hidden
     assert not re.search(r'(src|href)="(https?:)?//', text)  # self-contained: nothing fetched
+    # a rate plot draws its assertion's bounds, dashed and labelled
+    rate = next(svg for svg in re.findall(r"<svg.*?</svg>", text) if "Rate of r1/scan" in svg)
+    assert rate.count('class="bound"') == 2 and 'stroke-dasharray="6,4"' in rate
+    assert "min 9.5 (lidar_at_10_hz)" in rate and "max 10.5 (lidar_at_10_hz)" in rate
 
     chromium = shutil.which("chromium") or shutil.which("chromium-browser")
     assert chromium, "headless Chromium is needed (Debian: apt-get install chromium; .ci/run installs it)"
@@ -49,9 +53,10 @@ def test_the_report_shows_the_verdict_the_plots_and_the_topics(tmp_path: Path) -
     )  # fmt: skip
     img = np.asarray(Image.open(shot).convert("RGB")).astype(int)
     r_, g_, b_ = img[..., 0], img[..., 1], img[..., 2]
-    # the speed plot's lines (#d62728 red, #1f77b4 blue) and the verdict badge (#1a7f37 green) are drawn
-    red = (abs(r_ - 0xD6) < 30) & (abs(g_ - 0x27) < 40) & (abs(b_ - 0x28) < 40)
-    blue = (abs(r_ - 0x1F) < 30) & (abs(g_ - 0x77) < 40) & (abs(b_ - 0xB4) < 40)
+    # the plots' lines in the robots' colours (r1 red, r2 blue: their own, from the scenario) and the
+    # verdict badge (#1a7f37 green) are drawn
+    red = (abs(r_ - 0xD9) < 30) & (abs(g_ - 0x33) < 40) & (abs(b_ - 0x33) < 40)
+    blue = (abs(r_ - 0x33) < 30) & (abs(g_ - 0x59) < 40) & (abs(b_ - 0xE6) < 40)
     green = (abs(r_ - 0x1A) < 20) & (abs(g_ - 0x7F) < 20) & (abs(b_ - 0x37) < 20)
     assert red.sum() > 200 and blue.sum() > 200 and green.sum() > 200, (red.sum(), blue.sum(), green.sum())
 
