@@ -212,6 +212,16 @@ def _print_notices(notices: list[str], verbose: bool) -> None:
         err.print("warning: " + text, markup=False, style="yellow")
 
 
+AllOpt = Annotated[
+    bool,
+    typer.Option(
+        "--all",
+        help="List the run's own helper topics too (`_truth`, `_contacts`, `_state`, `_model`, `_plan`: a "
+        "name part starting with `_`); hidden by default, and always recorded.",
+    ),
+]
+
+
 AllowUndecided = Annotated[
     bool,
     typer.Option(
@@ -272,6 +282,7 @@ def run(
         ),
     ] = None,
     allow_undecided: AllowUndecided = False,
+    show_all: AllOpt = False,
 ) -> None:
     """Validate, compile and run a scenario; record every message to MCAP; judge its assertions. With a
     `matrix:`, every variant runs and is judged on its own. With `hosts:`, this plays the first (main)
@@ -336,6 +347,7 @@ def run(
             strict,
             foxglove,
             allow_undecided=allow_undecided,
+            show_all=show_all,
         )
         suites.append(suite)
         code = max(code, rc)
@@ -396,6 +408,7 @@ def _run_one(
     strict: bool = False,
     foxglove: int | None = None,
     allow_undecided: bool = False,
+    show_all: bool = False,
 ) -> tuple[Any, int]:
     from runner.checks.judge import ended_early
     from runner.checks.report import Suite, _now, judge_for
@@ -462,7 +475,7 @@ def _run_one(
         judge.finish(result.sim_ns, complete=ended is None, why=ended or "") if judge is not None else []
     )
     if not quiet:
-        _print_summary(result)
+        _print_summary(result, show_all)
     if results:
         _print_results(results, allow_undecided)
     error = result.error
@@ -708,7 +721,9 @@ def test_cmd(
     raise typer.Exit(0 if ok == len(suites) else 1)
 
 
-def _print_summary(result: Any) -> None:
+def _print_summary(result: Any, show_all: bool = False) -> None:
+    from runner.plan import hidden_key
+
     table = Table(
         "topic",
         "type",
@@ -720,8 +735,12 @@ def _print_summary(result: Any) -> None:
         title_justify="left",
     )
     lost = result.lost
+    hidden = 0
     for t in result.topics:
         n_lost = lost.get(t.key, 0) + t.lost
+        if hidden_key(t.key) and not show_all and not n_lost:  # (a loss is never hidden)
+            hidden += 1
+            continue
         published = result.published.get(t.key)  # (the worlds' count; other publishers say theirs by seq)
         table.add_row(
             t.key,
@@ -731,6 +750,9 @@ def _print_summary(result: Any) -> None:
             f"{t.rate():.1f}",
             f"[red]{n_lost}[/red]" if n_lost else "0",
         )
+    if hidden:
+        table.caption = f"and {hidden} helper topic(s) (`_truth`, `_state`...): --all lists them"
+        table.caption_justify = "left"
     if result.topics:
         out.print(table)
     for key, whys in sorted(getattr(result, "rejected", {}).items()):
@@ -743,11 +765,15 @@ def _print_summary(result: Any) -> None:
 
 
 @app.command()
-def info(mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")]) -> None:
+def info(
+    mcap: Annotated[Path, typer.Argument(metavar="RUN.mcap", help="A recording (.mcap).")],
+    show_all: AllOpt = False,
+) -> None:
     """Topics, types, message counts and the sim-time span of a recording.
 
     Example: scenario info runs/two_robots.mcap
     """
+    from runner.plan import hidden_key
     from runner.record import read_summary, recording_live
 
     if not mcap.is_file():
@@ -759,13 +785,19 @@ def info(mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")]) -> 
     start, end = s["start_ns"], s["end_ns"]
     span = (end - start) / 1e9
     table = Table("topic", "type", "count", "rate (sim Hz)", title=str(mcap), title_justify="left")
+    hidden = [t for t in s["topics"] if hidden_key(t["topic"])]
     for t in s["topics"]:
+        if t in hidden and not show_all:
+            continue
         table.add_row(
             t["topic"],
             t["type"],
             str(t["count"]),
             f"{(t['count'] - 1) / span:.1f}" if span > 0 and t["count"] > 1 else "-",
         )
+    if hidden and not show_all:
+        table.caption = f"and {len(hidden)} helper topic(s) (`_truth`, `_state`...): --all lists them"
+        table.caption_justify = "left"
     out.print(table)
     out.print(f"{s['messages']} messages, sim time {start / 1e9:.3f} s .. {end / 1e9:.3f} s ({span:.3f} s)")
     stopped = s.get("stopped")
@@ -969,12 +1001,14 @@ def schema(
     out.print(f"wrote {output}", markup=False)
 
 
-RunOpt = Annotated[str | None, typer.Option("--run", help="The run to join (default: the one running here).")]
-AllOpt = Annotated[
-    bool, typer.Option("--all", help="Show the run's own helper topics too (`_truth`, `_contacts`).")
+RunOpt = Annotated[
+    str | None, typer.Option("--run", metavar="ID", help="The run to join (default: the one running here).")
 ]
 ConnectOpt = Annotated[
-    list[str] | None, typer.Option("--connect", help="Zenoh endpoint of the run (default: the local run's).")
+    list[str] | None,
+    typer.Option(
+        "--connect", metavar="ENDPOINT", help="Zenoh endpoint of the run (default: the local run's)."
+    ),
 ]
 
 
@@ -1165,7 +1199,7 @@ def topics(
     import time
 
     from runner.graph import query_graph
-    from runner.plan import hidden_topic
+    from runner.plan import hidden_key
     from runner.tools import find_run, joined
     from runner.transport import type_from_encoding, unpack_attachment
 
@@ -1203,8 +1237,10 @@ def topics(
         "rate (Hz, sim)",
         title=f"{name}: live topics",
     )
+    hidden = 0
     for key in sorted(seen):
-        if not show_all and hidden_topic(key.removeprefix(name + "/")):
+        if not show_all and hidden_key(key):
+            hidden += 1
             continue  # hidden, as `ros2 topic list` hides `_` topics
         e = seen[key]
         stamps = e["t"]
@@ -1222,6 +1258,9 @@ def topics(
             f"{e['n'] / seconds:.1f}",
             f"{sim:.1f}" if sim else "-",
         )
+    if hidden:
+        table.caption = f"and {hidden} helper topic(s) (`_truth`, `_state`...): --all lists them"
+        table.caption_justify = "left"
     out.print(table)
 
 
