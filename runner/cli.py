@@ -6,6 +6,7 @@ User mistakes (`ScenarioError`, `RunError`) are printed without a traceback and 
 
 from __future__ import annotations
 
+import inspect
 import json
 import math
 import re
@@ -22,12 +23,64 @@ from runner import interrupts
 from runner.errors import RunError, ScenarioError
 from runner.plan import RobotPlan
 
+
+def first_sentence(doc: str) -> str:
+    """A command's line in `scenario --help`: the first sentence of its docstring, on one line."""
+    one = " ".join(inspect.cleandoc(doc).split("\n\n")[0].split())
+    end = re.search(r"(?<=[.!?])\s+(?=[A-Z`(])", one)
+    return one[: end.start()] if end else one
+
+
+def _plain_help_option(option: Any) -> Any:
+    if option is not None:
+        option.metavar = ""  # (a flag: no `<bool>` beside it)
+    return option
+
+
+class _Command(typer.core.TyperCommand):
+    """A command whose help reads as a user's: a metavar for each value (FILE, SECONDS), none for a flag
+    (typer would print `<bool>`, `<str>`, `<float range>`), arguments by their metavar in the usage line
+    (`FILE`, not `{file}`), and a one-line, one-sentence short help for the command list (typer would keep
+    the docstring's hard line breaks)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        if not self.short_help and self.help:
+            self.short_help = first_sentence(self.help)
+        for param in self.params:
+            if isinstance(param, typer.core.TyperOption) and param.is_flag:
+                param.metavar = ""
+            elif param.metavar is None:
+                param.metavar = (param.name or "value").upper()
+            if isinstance(param, typer.core.TyperArgument):
+                # an argument's metavar names it; typer would add its type beside it
+                param.display_type_rich = lambda ctx: None  # type: ignore[method-assign]
+
+    def get_help_option(self, ctx: Any) -> Any:
+        return _plain_help_option(super().get_help_option(ctx))
+
+    def collect_usage_pieces(self, ctx: Any) -> list[str]:
+        pieces = [self.options_metavar] if self.options_metavar else []
+        for param in self.get_params(ctx):
+            if isinstance(param, typer.core.TyperArgument):
+                name = param.metavar or (param.name or "").upper()
+                name = name if param.required else f"[{name}]"
+                pieces.append(name + ("..." if param.nargs != 1 else ""))
+        return pieces
+
+
+class _Group(typer.core.TyperGroup):
+    def get_help_option(self, ctx: Any) -> Any:
+        return _plain_help_option(super().get_help_option(ctx))
+
+
 app = typer.Typer(
     name="scenario",
     help="Declarative robot-simulation scenarios: URDF/xacro robots, MuJoCo physics, Zenoh, MCAP.",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    cls=_Group,
 )
 # Wide tables when piped (CI logs): key names are long and worth reading whole.
 out = Console(highlight=False, emoji=False, width=None if sys.stdout.isatty() else 160)
@@ -235,30 +288,46 @@ AllowUndecided = Annotated[
 @app.command()
 def run(
     file: Annotated[Path, typer.Argument(help="Scenario YAML file.")],
-    duration: Annotated[float | None, typer.Option(help="Override the sim duration (s).", min=0.001)] = None,
-    rate: Annotated[str | None, typer.Option(help="realtime | max | a real-time factor.")] = None,
-    record: Annotated[str | None, typer.Option(help="MCAP file to write (overrides the scenario).")] = None,
+    duration: Annotated[
+        float | None, typer.Option(metavar="SECONDS", help="Override the sim duration (s).", min=0.001)
+    ] = None,
+    rate: Annotated[
+        str | None, typer.Option(metavar="RATE", help="realtime | max | a real-time factor.")
+    ] = None,
+    record: Annotated[
+        str | None, typer.Option(metavar="FILE", help="MCAP file to write (overrides the scenario).")
+    ] = None,
     no_record: Annotated[bool, typer.Option("--no-record", help="Do not record.")] = False,
     listen: Annotated[
         list[str] | None,
-        typer.Option(help="Zenoh endpoint to listen on, e.g. tcp/127.0.0.1:7447 (repeatable)."),
+        typer.Option(
+            metavar="ENDPOINT", help="Zenoh endpoint to listen on, e.g. tcp/127.0.0.1:7447 (repeatable)."
+        ),
     ] = None,
     connect: Annotated[
-        list[str] | None, typer.Option(help="Zenoh endpoint of another router to join (repeatable).")
+        list[str] | None,
+        typer.Option(metavar="ENDPOINT", help="Zenoh endpoint of another router to join (repeatable)."),
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress line and no table.")] = False,
-    junit: Annotated[Path | None, typer.Option(help="Write the assertions' results as JUnit XML.")] = None,
+    junit: Annotated[
+        Path | None, typer.Option(metavar="FILE", help="Write the assertions' results as JUnit XML.")
+    ] = None,
     no_judge: Annotated[
         bool,
         typer.Option("--no-judge", help="Do not judge the assertions (e.g. with a shortened --duration)."),
     ] = False,
-    results_json: Annotated[Path | None, typer.Option(help="Write the run's results as JSON.")] = None,
+    results_json: Annotated[
+        Path | None, typer.Option(metavar="FILE", help="Write the run's results as JSON.")
+    ] = None,
     variant: Annotated[
-        int | None, typer.Option(help="Run only this variant of the scenario's matrix (0-based).", min=0)
+        int | None,
+        typer.Option(metavar="N", help="Run only this variant of the scenario's matrix (0-based).", min=0),
     ] = None,
     host: Annotated[
         str | None,
-        typer.Option(help="With `hosts:` in the scenario: run this host's part and join the main host."),
+        typer.Option(
+            metavar="NAME", help="With `hosts:` in the scenario: run this host's part and join the main host."
+        ),
     ] = None,
     local: Annotated[
         bool, typer.Option("--local", help="Run every part on this machine, whatever `hosts:` says.")
@@ -553,13 +622,15 @@ def _print_results(results: list[Any], allow_undecided: bool = False) -> None:
 
 @app.command()
 def check(
-    mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")],
+    mcap: Annotated[Path, typer.Argument(metavar="RUN.mcap", help="A recording (.mcap).")],
     scenario: Annotated[
-        Path, typer.Option("--scenario", "-s", help="The scenario whose assertions to judge.")
+        Path, typer.Option("--scenario", "-s", metavar="FILE", help="The scenario whose assertions to judge.")
     ],
-    junit: Annotated[Path | None, typer.Option(help="Write the results as JUnit XML.")] = None,
+    junit: Annotated[
+        Path | None, typer.Option(metavar="FILE", help="Write the results as JUnit XML.")
+    ] = None,
     variant: Annotated[
-        int | None, typer.Option(help="The matrix variant the recording is of (0-based).", min=0)
+        int | None, typer.Option(metavar="N", help="The matrix variant the recording is of (0-based).", min=0)
     ] = None,
     allow_undecided: AllowUndecided = False,
 ) -> None:
@@ -603,9 +674,13 @@ def check(
 @app.command("test")
 def test_cmd(
     paths: Annotated[list[Path], typer.Argument(help="Scenario files or folders (their *.yaml).")],
-    jobs: Annotated[int, typer.Option("--jobs", "-j", help="Scenarios run at once.", min=1)] = 1,
-    junit: Annotated[Path | None, typer.Option(help="Write every result as JUnit XML.")] = None,
-    out_dir: Annotated[Path, typer.Option("--out", help="Folder for the recordings.")] = Path("runs/test"),
+    jobs: Annotated[int, typer.Option("--jobs", "-j", metavar="N", help="Scenarios run at once.", min=1)] = 1,
+    junit: Annotated[
+        Path | None, typer.Option(metavar="FILE", help="Write every result as JUnit XML.")
+    ] = None,
+    out_dir: Annotated[
+        Path, typer.Option("--out", metavar="FOLDER", help="Folder for the recordings.")
+    ] = Path("runs/test"),
     no_record: Annotated[
         bool, typer.Option("--no-record", help="Judge live only; write no recordings.")
     ] = False,
@@ -824,13 +899,15 @@ def info(
 
 @app.command()
 def report(
-    mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")],
+    mcap: Annotated[Path, typer.Argument(metavar="RUN.mcap", help="A recording (.mcap).")],
     output: Annotated[
-        Path | None, typer.Option("--output", "-o", help="The page (default: NAME.html).")
+        Path | None, typer.Option("--output", "-o", metavar="FILE", help="The page (default: NAME.html).")
     ] = None,
     scenario: Annotated[
         Path | None,
-        typer.Option("--scenario", "-s", help="The scenario (default: the one the recording carries)."),
+        typer.Option(
+            "--scenario", "-s", metavar="FILE", help="The scenario (default: the one the recording carries)."
+        ),
     ] = None,
 ) -> None:
     """One self-contained HTML page about a run: verdict, trajectory plot, assertions and the signals they
@@ -954,9 +1031,12 @@ class _progress_bar:
 
 @app.command()
 def recover(
-    mcap: Annotated[Path, typer.Argument(help="A recording cut short (its runner was killed).")],
+    mcap: Annotated[
+        Path, typer.Argument(metavar="CUT.mcap", help="A recording cut short (its runner was killed).")
+    ],
     output: Annotated[
-        Path | None, typer.Option("--output", "-o", help="Where to write (default: NAME.recovered.mcap).")
+        Path | None,
+        typer.Option("--output", "-o", metavar="FILE", help="Where to write (default: NAME.recovered.mcap)."),
     ] = None,
 ) -> None:
     """Rewrite a cut recording as a complete MCAP (summary, indexes): every message of its complete chunks.
@@ -981,7 +1061,7 @@ def recover(
 
 @app.command()
 def schema(
-    output: Annotated[Path, typer.Option("--output", "-o", help="Where to write it.")] = Path(
+    output: Annotated[Path, typer.Option("--output", "-o", metavar="FILE", help="Where to write it.")] = Path(
         "schemas/scenario.schema.json"
     ),
     check: Annotated[bool, typer.Option(help="Exit 1 if the file differs instead of writing it.")] = False,
@@ -1025,9 +1105,9 @@ def _tool_tokens(session: Any, run: str, tool: str) -> Any:
 @app.command()
 def echo(
     topic: Annotated[str, typer.Argument(help="Topic inside the run, e.g. r1/scan (or a full key).")],
-    n: Annotated[int | None, typer.Option("-n", help="Stop after N messages.", min=1)] = None,
+    n: Annotated[int | None, typer.Option("-n", metavar="N", help="Stop after N messages.", min=1)] = None,
     field: Annotated[
-        str | None, typer.Option(help="Print only this field, e.g. pose.pose.position.x.")
+        str | None, typer.Option(metavar="PATH", help="Print only this field, e.g. pose.pose.position.x.")
     ] = None,
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
@@ -1109,10 +1189,11 @@ def pub(
         str, typer.Argument(metavar="YAML", help="The message's fields, e.g. '{linear: {x: 0.3}}'.")
     ] = "{}",
     rate: Annotated[
-        float | None, typer.Option("-r", "--rate", help="Publish at this rate (Hz, wall).")
+        float | None, typer.Option("-r", "--rate", metavar="HZ", help="Publish at this rate (Hz, wall).")
     ] = None,
     n: Annotated[
-        int | None, typer.Option("-n", help="Publish N times (default: once, or forever with -r).")
+        int | None,
+        typer.Option("-n", metavar="N", help="Publish N times (default: once, or forever with -r)."),
     ] = None,
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
@@ -1186,7 +1267,9 @@ def pub(
 
 @app.command()
 def topics(
-    seconds: Annotated[float, typer.Option(help="How long to listen, wall seconds.", min=0.1)] = 1.0,
+    seconds: Annotated[
+        float, typer.Option(metavar="SECONDS", help="How long to listen, wall seconds.", min=0.1)
+    ] = 1.0,
     show_all: AllOpt = False,
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
@@ -1268,15 +1351,17 @@ def topics(
 def graph(
     output: Annotated[
         Path | None,
-        typer.Option("--output", "-o", help="Write OUTPUT.dot and OUTPUT.png (default: <run>-graph)."),
+        typer.Option(
+            "--output", "-o", metavar="NAME", help="Write NAME.dot and NAME.png (default: <run>-graph)."
+        ),
     ] = None,
     show_all: AllOpt = False,
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
 ) -> None:
-    """Draw a running scenario's graph (like rqt_graph): its processes (worlds, renderers, nodes, bridges,
-    the recorder, the tools), its topics, and who publishes and subscribes to what, as a Graphviz DOT file
-    and a PNG; the topics are listed on the terminal too.
+    """Draw a running scenario's graph (like rqt_graph) as a Graphviz DOT file and a PNG. It shows the
+    processes (worlds, renderers, nodes, bridges, the recorder, the tools), the topics, and who publishes
+    and subscribes to what; the topics are listed on the terminal too.
 
     Examples:
       scenario graph
@@ -1333,8 +1418,8 @@ k (or any other key) stops; Ctrl-C quits (and stops the robot)."""
 @app.command()
 def teleop(
     robot: Annotated[str, typer.Argument(help="The robot's name (its namespace), e.g. r1.")],
-    speed: Annotated[float, typer.Option(help="Linear speed, m/s.")] = 0.5,
-    turn: Annotated[float, typer.Option(help="Angular speed, rad/s.")] = 1.0,
+    speed: Annotated[float, typer.Option(metavar="M/S", help="Linear speed, m/s.")] = 0.5,
+    turn: Annotated[float, typer.Option(metavar="RAD/S", help="Angular speed, rad/s.")] = 1.0,
     topic: Annotated[str, typer.Option(help="Command topic inside the robot's namespace.")] = "cmd_vel",
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
@@ -1424,6 +1509,12 @@ def bench(ctx: typer.Context) -> None:
     from bench.__main__ import main as bench_main
 
     raise typer.Exit(bench_main(list(ctx.args)))
+
+
+# every command's help written as `_Command` writes it
+for _info in app.registered_commands:
+    if _info.cls in (None, typer.core.TyperCommand):
+        _info.cls = _Command
 
 
 def main() -> None:
