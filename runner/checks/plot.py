@@ -215,7 +215,7 @@ def trajectory_plot(plan: Any, mcap: Path, results: list[Result], out: Path) -> 
     if any(not f.moving for p in panels for f in p.shapes):
         legend.append(("world model", "solid"))
     if any(f.moving for p in panels for f in p.shapes):
-        legend.append(("loose model (at start)", "loose"))
+        legend.append(("movable model, at start", "loose"))
     if any(_region_points(s) for p in panels for s in p.specs):
         legend.append(("assertion region, goal", "region"))
     if failed:
