@@ -135,3 +135,23 @@ def test_the_report_shows_camera_frames(write_scenario, tmp_path: Path) -> None:
     assert img.shape == (48, 64, 3)
     red = (img[..., 0] > 120) & (img[..., 1] < 60) & (img[..., 2] < 60)
     assert red[:, 20:44].mean() > 0.3, "the red box ahead is not in the frame"
+
+
+@pytest.mark.timeout(240)
+def test_a_report_of_several_worlds_judges_and_plots_each_worlds_assertions(tmp_path: Path) -> None:
+    """With `worlds:`, each world's plan holds its own assertions (topics inside the world): the page
+    judges them all, and draws the rate plot of `arena/r1/scan` with its bounds."""
+    mcap = tmp_path / "worlds.mcap"
+    r = subprocess.run(
+        scenario_cmd("run", str(SCENARIOS / "two_worlds.yaml"), "--record", str(mcap), "-q"),
+        capture_output=True, text=True, timeout=180,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    page = tmp_path / "worlds.html"
+    r = run_cli("report", str(mcap), "-o", str(page), timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert "3/3 assertions pass, 2 signal plot(s)" in r.stdout  # speed, and the arena's lidar rate
+    text = page.read_text()
+    rate = next(svg for svg in re.findall(r"<svg.*?</svg>", text) if "Rate of arena/r1/scan" in svg)
+    assert "min 9.5 (arena_lidar_at_10_hz)" in rate and "max 10.5 (arena_lidar_at_10_hz)" in rate
+    assert 'alt="trajectory plot"' in text

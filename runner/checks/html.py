@@ -215,12 +215,14 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
 
     plan = plan or load_plan(mcap)
     summary = read_summary(mcap)
-    results = judge_recording(plan, mcap)[0] if plan.assertions else []
+    # (with several worlds, each world's plan holds its own assertions, their topics inside the world)
+    keyed = [(a, part.name) for part in plan.parts() for a in part.assertions]
+    assertions = [a for a, _ in keyed]
+    results = judge_recording(plan, mcap)[0] if assertions else []
     run = plan.name
     # signals: each robot's speed (ground truth), each checked topic's rate per sim second
     truth = {r.name: truth_key(p.name, r.namespace) for p in plan.parts() for r in p.robots}
-    rate_topics = sorted({a["topic"] for a in plan.assertions if a.get("type") == "topic_rate"})
-    rate_keys = [f"{run}/{t.strip('/')}" for t in rate_topics]
+    rate_keys = sorted({f"{w}/{a['topic'].strip('/')}" for a, w in keyed if a.get("type") == "topic_rate"})
     series = _series(mcap, set(truth.values()), stamps_only=set(rate_keys) - set(truth.values()))
     colours = run_colours(plan)  # each robot's colour, as in the trajectory plot and `scenario render`
     charts = []
@@ -245,13 +247,13 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
             speed.append((name, t, v, colour))
             travelled.append((name, t, dist, colour))
             tilt.append((name, t, tilts, colour))
-    kinds = {a.get("type") for a in plan.assertions}
+    kinds = {a.get("type") for a in assertions}
 
-    def bounds(kind: str, topic: str | None = None) -> list[Bound]:
-        """The bounds of the assertions of this kind (and topic), to draw as dashed lines."""
+    def bounds(kind: str, key: str | None = None) -> list[Bound]:
+        """The bounds of the assertions of this kind (and topic key), to draw as dashed lines."""
         out: list[Bound] = []
-        for a in plan.assertions:
-            if a.get("type") != kind or (topic is not None and a.get("topic") != topic):
+        for a, w in keyed:
+            if a.get("type") != kind or (key is not None and f"{w}/{a['topic'].strip('/')}" != key):
                 continue
             for side in ("min", "max"):
                 if isinstance(a.get(side), int | float):
@@ -265,7 +267,8 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
     if tilt and "max_tilt" in kinds:
         charts.append(svg_chart("Tilt from upright", "rad", tilt, bounds("max_tilt")))
     owners = {f"{p.name}/{r.namespace}/": hex_colour(colours[r.name]) for p in plan.parts() for r in p.robots}
-    for topic, key in zip(rate_topics, rate_keys, strict=True):
+    for key in rate_keys:
+        topic = key.removeprefix(f"{run}/")
         stamps = [s / 1e9 for s, _ in series.get(key, [])]
         if stamps:
             whole = max(1, int(stamps[-1]))  # whole sim seconds (a last, partial second would dip)
@@ -277,7 +280,7 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
                     f"Rate of {topic}",
                     "messages per sim second (Hz)",
                     [(topic, list(secs), list(counts.astype(float)), colour)],
-                    bounds("topic_rate", topic),
+                    bounds("topic_rate", key),
                 )
             )
     camera, frames = _camera_frames(mcap, summary)
