@@ -6,6 +6,7 @@ User mistakes (`ScenarioError`, `RunError`) are printed without a traceback and 
 
 from __future__ import annotations
 
+import inspect
 import json
 import math
 import re
@@ -22,12 +23,64 @@ from runner import interrupts
 from runner.errors import RunError, ScenarioError
 from runner.plan import RobotPlan
 
+
+def first_sentence(doc: str) -> str:
+    """A command's line in `scenario --help`: the first sentence of its docstring, on one line."""
+    one = " ".join(inspect.cleandoc(doc).split("\n\n")[0].split())
+    end = re.search(r"(?<=[.!?])\s+(?=[A-Z`(])", one)
+    return one[: end.start()] if end else one
+
+
+def _plain_help_option(option: Any) -> Any:
+    if option is not None:
+        option.metavar = ""  # (a flag: no `<bool>` beside it)
+    return option
+
+
+class _Command(typer.core.TyperCommand):
+    """A command whose help reads as a user's: a metavar for each value (FILE, SECONDS), none for a flag
+    (typer would print `<bool>`, `<str>`, `<float range>`), arguments by their metavar in the usage line
+    (`FILE`, not `{file}`), and a one-line, one-sentence short help for the command list (typer would keep
+    the docstring's hard line breaks)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        if not self.short_help and self.help:
+            self.short_help = first_sentence(self.help)
+        for param in self.params:
+            if isinstance(param, typer.core.TyperOption) and param.is_flag:
+                param.metavar = ""
+            elif param.metavar is None:
+                param.metavar = (param.name or "value").upper()
+            if isinstance(param, typer.core.TyperArgument):
+                # an argument's metavar names it; typer would add its type beside it
+                param.display_type_rich = lambda ctx: None  # type: ignore[method-assign]
+
+    def get_help_option(self, ctx: Any) -> Any:
+        return _plain_help_option(super().get_help_option(ctx))
+
+    def collect_usage_pieces(self, ctx: Any) -> list[str]:
+        pieces = [self.options_metavar] if self.options_metavar else []
+        for param in self.get_params(ctx):
+            if isinstance(param, typer.core.TyperArgument):
+                name = param.metavar or (param.name or "").upper()
+                name = name if param.required else f"[{name}]"
+                pieces.append(name + ("..." if param.nargs != 1 else ""))
+        return pieces
+
+
+class _Group(typer.core.TyperGroup):
+    def get_help_option(self, ctx: Any) -> Any:
+        return _plain_help_option(super().get_help_option(ctx))
+
+
 app = typer.Typer(
     name="scenario",
     help="Declarative robot-simulation scenarios: URDF/xacro robots, MuJoCo physics, Zenoh, MCAP.",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    cls=_Group,
 )
 # Wide tables when piped (CI logs): key names are long and worth reading whole.
 out = Console(highlight=False, emoji=False, width=None if sys.stdout.isatty() else 160)
@@ -212,6 +265,16 @@ def _print_notices(notices: list[str], verbose: bool) -> None:
         err.print("warning: " + text, markup=False, style="yellow")
 
 
+AllOpt = Annotated[
+    bool,
+    typer.Option(
+        "--all",
+        help="List the run's own helper topics too (`_truth`, `_contacts`, `_state`, `_model`, `_plan`: a "
+        "name part starting with `_`); hidden by default, and always recorded.",
+    ),
+]
+
+
 AllowUndecided = Annotated[
     bool,
     typer.Option(
@@ -225,30 +288,46 @@ AllowUndecided = Annotated[
 @app.command()
 def run(
     file: Annotated[Path, typer.Argument(help="Scenario YAML file.")],
-    duration: Annotated[float | None, typer.Option(help="Override the sim duration (s).", min=0.001)] = None,
-    rate: Annotated[str | None, typer.Option(help="realtime | max | a real-time factor.")] = None,
-    record: Annotated[str | None, typer.Option(help="MCAP file to write (overrides the scenario).")] = None,
+    duration: Annotated[
+        float | None, typer.Option(metavar="SECONDS", help="Override the sim duration (s).", min=0.001)
+    ] = None,
+    rate: Annotated[
+        str | None, typer.Option(metavar="RATE", help="realtime | max | a real-time factor.")
+    ] = None,
+    record: Annotated[
+        str | None, typer.Option(metavar="FILE", help="MCAP file to write (overrides the scenario).")
+    ] = None,
     no_record: Annotated[bool, typer.Option("--no-record", help="Do not record.")] = False,
     listen: Annotated[
         list[str] | None,
-        typer.Option(help="Zenoh endpoint to listen on, e.g. tcp/127.0.0.1:7447 (repeatable)."),
+        typer.Option(
+            metavar="ENDPOINT", help="Zenoh endpoint to listen on, e.g. tcp/127.0.0.1:7447 (repeatable)."
+        ),
     ] = None,
     connect: Annotated[
-        list[str] | None, typer.Option(help="Zenoh endpoint of another router to join (repeatable).")
+        list[str] | None,
+        typer.Option(metavar="ENDPOINT", help="Zenoh endpoint of another router to join (repeatable)."),
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress line and no table.")] = False,
-    junit: Annotated[Path | None, typer.Option(help="Write the assertions' results as JUnit XML.")] = None,
+    junit: Annotated[
+        Path | None, typer.Option(metavar="FILE", help="Write the assertions' results as JUnit XML.")
+    ] = None,
     no_judge: Annotated[
         bool,
         typer.Option("--no-judge", help="Do not judge the assertions (e.g. with a shortened --duration)."),
     ] = False,
-    results_json: Annotated[Path | None, typer.Option(help="Write the run's results as JSON.")] = None,
+    results_json: Annotated[
+        Path | None, typer.Option(metavar="FILE", help="Write the run's results as JSON.")
+    ] = None,
     variant: Annotated[
-        int | None, typer.Option(help="Run only this variant of the scenario's matrix (0-based).", min=0)
+        int | None,
+        typer.Option(metavar="N", help="Run only this variant of the scenario's matrix (0-based).", min=0),
     ] = None,
     host: Annotated[
         str | None,
-        typer.Option(help="With `hosts:` in the scenario: run this host's part and join the main host."),
+        typer.Option(
+            metavar="NAME", help="With `hosts:` in the scenario: run this host's part and join the main host."
+        ),
     ] = None,
     local: Annotated[
         bool, typer.Option("--local", help="Run every part on this machine, whatever `hosts:` says.")
@@ -272,6 +351,7 @@ def run(
         ),
     ] = None,
     allow_undecided: AllowUndecided = False,
+    show_all: AllOpt = False,
 ) -> None:
     """Validate, compile and run a scenario; record every message to MCAP; judge its assertions. With a
     `matrix:`, every variant runs and is judged on its own. With `hosts:`, this plays the first (main)
@@ -336,6 +416,7 @@ def run(
             strict,
             foxglove,
             allow_undecided=allow_undecided,
+            show_all=show_all,
         )
         suites.append(suite)
         code = max(code, rc)
@@ -396,6 +477,7 @@ def _run_one(
     strict: bool = False,
     foxglove: int | None = None,
     allow_undecided: bool = False,
+    show_all: bool = False,
 ) -> tuple[Any, int]:
     from runner.checks.judge import ended_early
     from runner.checks.report import Suite, _now, judge_for
@@ -462,7 +544,7 @@ def _run_one(
         judge.finish(result.sim_ns, complete=ended is None, why=ended or "") if judge is not None else []
     )
     if not quiet:
-        _print_summary(result)
+        _print_summary(result, show_all)
     if results:
         _print_results(results, allow_undecided)
     error = result.error
@@ -540,13 +622,15 @@ def _print_results(results: list[Any], allow_undecided: bool = False) -> None:
 
 @app.command()
 def check(
-    mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")],
+    mcap: Annotated[Path, typer.Argument(metavar="RUN.mcap", help="A recording (.mcap).")],
     scenario: Annotated[
-        Path, typer.Option("--scenario", "-s", help="The scenario whose assertions to judge.")
+        Path, typer.Option("--scenario", "-s", metavar="FILE", help="The scenario whose assertions to judge.")
     ],
-    junit: Annotated[Path | None, typer.Option(help="Write the results as JUnit XML.")] = None,
+    junit: Annotated[
+        Path | None, typer.Option(metavar="FILE", help="Write the results as JUnit XML.")
+    ] = None,
     variant: Annotated[
-        int | None, typer.Option(help="The matrix variant the recording is of (0-based).", min=0)
+        int | None, typer.Option(metavar="N", help="The matrix variant the recording is of (0-based).", min=0)
     ] = None,
     allow_undecided: AllowUndecided = False,
 ) -> None:
@@ -590,9 +674,13 @@ def check(
 @app.command("test")
 def test_cmd(
     paths: Annotated[list[Path], typer.Argument(help="Scenario files or folders (their *.yaml).")],
-    jobs: Annotated[int, typer.Option("--jobs", "-j", help="Scenarios run at once.", min=1)] = 1,
-    junit: Annotated[Path | None, typer.Option(help="Write every result as JUnit XML.")] = None,
-    out_dir: Annotated[Path, typer.Option("--out", help="Folder for the recordings.")] = Path("runs/test"),
+    jobs: Annotated[int, typer.Option("--jobs", "-j", metavar="N", help="Scenarios run at once.", min=1)] = 1,
+    junit: Annotated[
+        Path | None, typer.Option(metavar="FILE", help="Write every result as JUnit XML.")
+    ] = None,
+    out_dir: Annotated[
+        Path, typer.Option("--out", metavar="FOLDER", help="Folder for the recordings.")
+    ] = Path("runs/test"),
     no_record: Annotated[
         bool, typer.Option("--no-record", help="Judge live only; write no recordings.")
     ] = False,
@@ -708,7 +796,9 @@ def test_cmd(
     raise typer.Exit(0 if ok == len(suites) else 1)
 
 
-def _print_summary(result: Any) -> None:
+def _print_summary(result: Any, show_all: bool = False) -> None:
+    from runner.plan import hidden_key
+
     table = Table(
         "topic",
         "type",
@@ -720,8 +810,12 @@ def _print_summary(result: Any) -> None:
         title_justify="left",
     )
     lost = result.lost
+    hidden = 0
     for t in result.topics:
         n_lost = lost.get(t.key, 0) + t.lost
+        if hidden_key(t.key) and not show_all and not n_lost:  # (a loss is never hidden)
+            hidden += 1
+            continue
         published = result.published.get(t.key)  # (the worlds' count; other publishers say theirs by seq)
         table.add_row(
             t.key,
@@ -731,6 +825,9 @@ def _print_summary(result: Any) -> None:
             f"{t.rate():.1f}",
             f"[red]{n_lost}[/red]" if n_lost else "0",
         )
+    if hidden:
+        table.caption = f"and {hidden} helper topic(s) (`_truth`, `_state`...): --all lists them"
+        table.caption_justify = "left"
     if result.topics:
         out.print(table)
     for key, whys in sorted(getattr(result, "rejected", {}).items()):
@@ -743,11 +840,15 @@ def _print_summary(result: Any) -> None:
 
 
 @app.command()
-def info(mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")]) -> None:
+def info(
+    mcap: Annotated[Path, typer.Argument(metavar="RUN.mcap", help="A recording (.mcap).")],
+    show_all: AllOpt = False,
+) -> None:
     """Topics, types, message counts and the sim-time span of a recording.
 
     Example: scenario info runs/two_robots.mcap
     """
+    from runner.plan import hidden_key
     from runner.record import read_summary, recording_live
 
     if not mcap.is_file():
@@ -759,13 +860,19 @@ def info(mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")]) -> 
     start, end = s["start_ns"], s["end_ns"]
     span = (end - start) / 1e9
     table = Table("topic", "type", "count", "rate (sim Hz)", title=str(mcap), title_justify="left")
+    hidden = [t for t in s["topics"] if hidden_key(t["topic"])]
     for t in s["topics"]:
+        if t in hidden and not show_all:
+            continue
         table.add_row(
             t["topic"],
             t["type"],
             str(t["count"]),
             f"{(t['count'] - 1) / span:.1f}" if span > 0 and t["count"] > 1 else "-",
         )
+    if hidden and not show_all:
+        table.caption = f"and {len(hidden)} helper topic(s) (`_truth`, `_state`...): --all lists them"
+        table.caption_justify = "left"
     out.print(table)
     out.print(f"{s['messages']} messages, sim time {start / 1e9:.3f} s .. {end / 1e9:.3f} s ({span:.3f} s)")
     stopped = s.get("stopped")
@@ -792,13 +899,15 @@ def info(mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")]) -> 
 
 @app.command()
 def report(
-    mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")],
+    mcap: Annotated[Path, typer.Argument(metavar="RUN.mcap", help="A recording (.mcap).")],
     output: Annotated[
-        Path | None, typer.Option("--output", "-o", help="The page (default: NAME.html).")
+        Path | None, typer.Option("--output", "-o", metavar="FILE", help="The page (default: NAME.html).")
     ] = None,
     scenario: Annotated[
         Path | None,
-        typer.Option("--scenario", "-s", help="The scenario (default: the one the recording carries)."),
+        typer.Option(
+            "--scenario", "-s", metavar="FILE", help="The scenario (default: the one the recording carries)."
+        ),
     ] = None,
 ) -> None:
     """One self-contained HTML page about a run: verdict, trajectory plot, assertions and the signals they
@@ -828,17 +937,37 @@ def report(
 
 @app.command()
 def render(
-    mcap: Annotated[Path, typer.Argument(help="A recording (.mcap).")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="The video or picture: .mp4, .gif or .png.")],
+    mcap: Annotated[Path, typer.Argument(metavar="RUN.mcap", help="A recording (.mcap).")],
+    output: Annotated[
+        Path,
+        typer.Option("--output", "-o", metavar="FILE", help="The video or picture: .mp4, .gif or .png."),
+    ],
     camera: Annotated[
-        str, typer.Option(help="overview (the whole scene), chase:ROBOT (following it), or a model camera.")
+        str,
+        typer.Option(
+            metavar="CAMERA",
+            help="overview (the whole scene), chase:ROBOT (following it), or a model camera.",
+        ),
     ] = "overview",
-    fps: Annotated[float, typer.Option(help="Frames per sim second.", min=1, max=120)] = 15.0,
-    size: Annotated[str, typer.Option(help="WIDTHxHEIGHT in pixels.")] = "640x480",
-    world: Annotated[str | None, typer.Option(help="With several worlds: which one.")] = None,
+    fps: Annotated[
+        float,
+        typer.Option(
+            metavar="FPS",
+            help="Frames per sim second; it plays as long as the run took in sim time (a GIF: 50 at most).",
+            min=1,
+            max=120,
+        ),
+    ] = 15.0,
+    size: Annotated[
+        str, typer.Option(metavar="WxH", help="Width and height in pixels, e.g. 640x480.")
+    ] = "960x720",
+    world: Annotated[
+        str | None, typer.Option(metavar="WORLD", help="With several worlds: which one.")
+    ] = None,
 ) -> None:
     """Render a recorded run again (MuJoCo, offscreen, CPU where there is no GPU): the robots moving, their
-    paths drawn as they go. A .png is the last frame.
+    paths drawn as they go, each in the robot's colour (as in the trajectory plot and the report). A .png
+    is the run's last moment.
 
     Examples:
       scenario render runs/two_robots.mcap -o two_robots.mp4
@@ -848,6 +977,8 @@ def render(
 
     try:
         w, h = (int(v) for v in size.lower().split("x"))
+        if w < 16 or h < 16:
+            raise ValueError
     except ValueError:
         raise _fail(RunError(f"--size {size!r}: expected WIDTHxHEIGHT, e.g. 640x480")) from None
     if not mcap.is_file():
@@ -856,14 +987,23 @@ def render(
         rec = replay.load(mcap, world)
         notes: list[str] = []
         with _progress_bar("rendering") as bar:
-            n = replay.write(
+            got = replay.write(
                 rec, output, camera=camera, width=w, height=h, fps=fps, progress=bar, notes=notes
             )
     except RunError as e:
         raise _fail(e) from None
     for note in notes:
         err.print(f"note: {note}", markup=False, style="yellow")
-    out.print(f"{output}: {n} frames, {rec.times[-1] / 1e9:.1f} s sim, camera {camera}", markup=False)
+    sim = f"{rec.times[-1] / 1e9:.2f} s sim"
+    if output.suffix.lower() == ".png":
+        out.print(f"{output}: the run at {sim}, camera {camera}", markup=False)
+        return
+    merged = f" ({got.merged} unchanged frames shown on)" if got.merged else ""
+    out.print(
+        f"{output}: {got.frames} frames{merged}, plays {got.seconds:.2f} s at {got.fps:g} fps "
+        f"({sim}), camera {camera}",
+        markup=False,
+    )
 
 
 class _progress_bar:
@@ -891,9 +1031,12 @@ class _progress_bar:
 
 @app.command()
 def recover(
-    mcap: Annotated[Path, typer.Argument(help="A recording cut short (its runner was killed).")],
+    mcap: Annotated[
+        Path, typer.Argument(metavar="CUT.mcap", help="A recording cut short (its runner was killed).")
+    ],
     output: Annotated[
-        Path | None, typer.Option("--output", "-o", help="Where to write (default: NAME.recovered.mcap).")
+        Path | None,
+        typer.Option("--output", "-o", metavar="FILE", help="Where to write (default: NAME.recovered.mcap)."),
     ] = None,
 ) -> None:
     """Rewrite a cut recording as a complete MCAP (summary, indexes): every message of its complete chunks.
@@ -918,7 +1061,7 @@ def recover(
 
 @app.command()
 def schema(
-    output: Annotated[Path, typer.Option("--output", "-o", help="Where to write it.")] = Path(
+    output: Annotated[Path, typer.Option("--output", "-o", metavar="FILE", help="Where to write it.")] = Path(
         "schemas/scenario.schema.json"
     ),
     check: Annotated[bool, typer.Option(help="Exit 1 if the file differs instead of writing it.")] = False,
@@ -938,12 +1081,14 @@ def schema(
     out.print(f"wrote {output}", markup=False)
 
 
-RunOpt = Annotated[str | None, typer.Option("--run", help="The run to join (default: the one running here).")]
-AllOpt = Annotated[
-    bool, typer.Option("--all", help="Show the run's own helper topics too (`_truth`, `_contacts`).")
+RunOpt = Annotated[
+    str | None, typer.Option("--run", metavar="ID", help="The run to join (default: the one running here).")
 ]
 ConnectOpt = Annotated[
-    list[str] | None, typer.Option("--connect", help="Zenoh endpoint of the run (default: the local run's).")
+    list[str] | None,
+    typer.Option(
+        "--connect", metavar="ENDPOINT", help="Zenoh endpoint of the run (default: the local run's)."
+    ),
 ]
 
 
@@ -960,9 +1105,9 @@ def _tool_tokens(session: Any, run: str, tool: str) -> Any:
 @app.command()
 def echo(
     topic: Annotated[str, typer.Argument(help="Topic inside the run, e.g. r1/scan (or a full key).")],
-    n: Annotated[int | None, typer.Option("-n", help="Stop after N messages.", min=1)] = None,
+    n: Annotated[int | None, typer.Option("-n", metavar="N", help="Stop after N messages.", min=1)] = None,
     field: Annotated[
-        str | None, typer.Option(help="Print only this field, e.g. pose.pose.position.x.")
+        str | None, typer.Option(metavar="PATH", help="Print only this field, e.g. pose.pose.position.x.")
     ] = None,
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
@@ -1044,10 +1189,11 @@ def pub(
         str, typer.Argument(metavar="YAML", help="The message's fields, e.g. '{linear: {x: 0.3}}'.")
     ] = "{}",
     rate: Annotated[
-        float | None, typer.Option("-r", "--rate", help="Publish at this rate (Hz, wall).")
+        float | None, typer.Option("-r", "--rate", metavar="HZ", help="Publish at this rate (Hz, wall).")
     ] = None,
     n: Annotated[
-        int | None, typer.Option("-n", help="Publish N times (default: once, or forever with -r).")
+        int | None,
+        typer.Option("-n", metavar="N", help="Publish N times (default: once, or forever with -r)."),
     ] = None,
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
@@ -1121,7 +1267,9 @@ def pub(
 
 @app.command()
 def topics(
-    seconds: Annotated[float, typer.Option(help="How long to listen, wall seconds.", min=0.1)] = 1.0,
+    seconds: Annotated[
+        float, typer.Option(metavar="SECONDS", help="How long to listen, wall seconds.", min=0.1)
+    ] = 1.0,
     show_all: AllOpt = False,
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
@@ -1134,7 +1282,7 @@ def topics(
     import time
 
     from runner.graph import query_graph
-    from runner.plan import hidden_topic
+    from runner.plan import hidden_key
     from runner.tools import find_run, joined
     from runner.transport import type_from_encoding, unpack_attachment
 
@@ -1172,8 +1320,10 @@ def topics(
         "rate (Hz, sim)",
         title=f"{name}: live topics",
     )
+    hidden = 0
     for key in sorted(seen):
-        if not show_all and hidden_topic(key.removeprefix(name + "/")):
+        if not show_all and hidden_key(key):
+            hidden += 1
             continue  # hidden, as `ros2 topic list` hides `_` topics
         e = seen[key]
         stamps = e["t"]
@@ -1191,6 +1341,9 @@ def topics(
             f"{e['n'] / seconds:.1f}",
             f"{sim:.1f}" if sim else "-",
         )
+    if hidden:
+        table.caption = f"and {hidden} helper topic(s) (`_truth`, `_state`...): --all lists them"
+        table.caption_justify = "left"
     out.print(table)
 
 
@@ -1198,15 +1351,17 @@ def topics(
 def graph(
     output: Annotated[
         Path | None,
-        typer.Option("--output", "-o", help="Write OUTPUT.dot and OUTPUT.png (default: <run>-graph)."),
+        typer.Option(
+            "--output", "-o", metavar="NAME", help="Write NAME.dot and NAME.png (default: <run>-graph)."
+        ),
     ] = None,
     show_all: AllOpt = False,
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
 ) -> None:
-    """Draw a running scenario's graph (like rqt_graph): its processes (worlds, renderers, nodes, bridges,
-    the recorder, the tools), its topics, and who publishes and subscribes to what, as a Graphviz DOT file
-    and a PNG; the topics are listed on the terminal too.
+    """Draw a running scenario's graph (like rqt_graph) as a Graphviz DOT file and a PNG. It shows the
+    processes (worlds, renderers, nodes, bridges, the recorder, the tools), the topics, and who publishes
+    and subscribes to what; the topics are listed on the terminal too.
 
     Examples:
       scenario graph
@@ -1263,8 +1418,8 @@ k (or any other key) stops; Ctrl-C quits (and stops the robot)."""
 @app.command()
 def teleop(
     robot: Annotated[str, typer.Argument(help="The robot's name (its namespace), e.g. r1.")],
-    speed: Annotated[float, typer.Option(help="Linear speed, m/s.")] = 0.5,
-    turn: Annotated[float, typer.Option(help="Angular speed, rad/s.")] = 1.0,
+    speed: Annotated[float, typer.Option(metavar="M/S", help="Linear speed, m/s.")] = 0.5,
+    turn: Annotated[float, typer.Option(metavar="RAD/S", help="Angular speed, rad/s.")] = 1.0,
     topic: Annotated[str, typer.Option(help="Command topic inside the robot's namespace.")] = "cmd_vel",
     run_name: RunOpt = None,
     connect: ConnectOpt = None,
@@ -1354,6 +1509,12 @@ def bench(ctx: typer.Context) -> None:
     from bench.__main__ import main as bench_main
 
     raise typer.Exit(bench_main(list(ctx.args)))
+
+
+# every command's help written as `_Command` writes it
+for _info in app.registered_commands:
+    if _info.cls in (None, typer.core.TyperCommand):
+        _info.cls = _Command
 
 
 def main() -> None:

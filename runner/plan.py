@@ -206,6 +206,12 @@ def hidden_topic(rel: str) -> bool:
     return any(chunk.startswith("_") for chunk in rel.split("/"))
 
 
+def hidden_key(key: str) -> bool:
+    """`hidden_topic` for a full key (`<run>/...`, its first chunk the run's name): what `scenario info`,
+    `topics`, the end-of-run table and the report leave out unless told `--all`."""
+    return hidden_topic(key.split("/", 1)[1] if "/" in key else key)
+
+
 def topic_key(run: str, namespace: str, topic: str) -> str:
     """`scan` in namespace r1 -> `run/r1/scan`; `/clock` (absolute) -> `run/clock`."""
     if topic.startswith("/"):

@@ -3,14 +3,22 @@
 A recording carries the compiled model (`<run>/_model`, MJCF) and the state (`<run>/_state`: qpos and
 mocap poses, at `foxglove.tf_rate`). Each frame poses the model at the last state at or before its time,
 and MuJoCo's offscreen renderer draws it (EGL or OSMesa: on the CPU where there is no GPU), from above the
-whole scene (`overview`) or following a robot (`chase:r1`), with each robot's path so far drawn as a line.
-`.mp4` is written by ffmpeg (imageio-ffmpeg), `.gif` and `.png` (the last frame) by Pillow.
+whole scene (`overview`: every model and every robot wherever it goes, filling the picture) or following
+a robot (`chase:r1`), with each robot's path so far drawn in the robot's colour (`runner.pictures`: the
+same as in the trajectory plot and the report).
+
+A video has one frame every 1/fps sim seconds and plays for as long as the run took in sim time. `.mp4` is
+written by ffmpeg (imageio-ffmpeg); `.gif` by Pillow, each frame's delay in whole hundredths of a second
+(a GIF's unit) so that they add up to the run's time, and a frame that shows the same picture as the one
+before merged into it (as Pillow would), so that the count said is the count written; `.png` is the run's
+last moment.
 """
 
 from __future__ import annotations
 
 import bisect
 import itertools
+import math
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,8 +28,22 @@ import mujoco
 import numpy as np
 
 from runner.errors import RunError
+from runner.pictures import (
+    FRAME_REACH_M,
+    FRAME_REACH_SPANS,
+    PALETTE,
+    RGB,
+    fit_camera,
+    model_colours,
+    model_of,
+    reach,
+    robot_bodies,
+    run_colours,
+)
 
-PATH_COLORS = [(0.85, 0.2, 0.2), (0.2, 0.35, 0.9), (0.1, 0.6, 0.2), (0.9, 0.6, 0.1), (0.5, 0.2, 0.7)]
+DEFAULT_SIZE = (960, 720)
+# A GIF says how long each frame shows in hundredths of a second, and viewers slow down delays under 2
+GIF_MAX_FPS = 50.0
 
 
 @dataclass
@@ -31,6 +53,7 @@ class Recording:
     times: list[int]  # sim ns of each state
     states: list[np.ndarray]
     robots: set[str] | None = None  # the scenario's robot names (from its recorded plan), when known
+    plan: Any = None  # the recorded plan (RunPlan), when known: every robot's colour comes from it
 
 
 def load(mcap: Path, world: str | None = None) -> Recording:
@@ -40,7 +63,7 @@ def load(mcap: Path, world: str | None = None) -> Recording:
 
     mjcf: dict[str, str] = {}
     states: dict[str, list[tuple[int, np.ndarray]]] = {}
-    robots: set[str] | None = None
+    plan: Any = None
     try:
         with open(mcap, "rb") as f:
             for _schema, channel, message in make_reader(f).iter_messages(log_time_order=True):
@@ -48,8 +71,8 @@ def load(mcap: Path, world: str | None = None) -> Recording:
                 if topic.endswith("/_model"):
                     text = msgs.decode(message.data, "std_msgs/msg/String").data
                     mjcf.setdefault(topic[: -len("/_model")], text)
-                elif topic.endswith("/_plan") and robots is None:
-                    robots = _robot_names(msgs.decode(message.data, "std_msgs/msg/String").data)
+                elif topic.endswith("/_plan") and plan is None:
+                    plan = _plan_of(msgs.decode(message.data, "std_msgs/msg/String").data)
                 elif topic.endswith("/_state"):
                     values = msgs.decode(message.data, "std_msgs/msg/Float64MultiArray").data
                     states.setdefault(topic[: -len("/_state")], []).append(
@@ -66,53 +89,49 @@ def load(mcap: Path, world: str | None = None) -> Recording:
         )
     run = runs[0]
     pairs = states[run]
-    return Recording(run, mjcf[run], [t for t, _ in pairs], [s for _, s in pairs], robots)
+    robots = None if plan is None else {r.name for p in plan.parts() for r in p.robots}
+    return Recording(run, mjcf[run], [t for t, _ in pairs], [s for _, s in pairs], robots, plan)
 
 
-def _robot_names(plan_json: str) -> set[str] | None:
+def _plan_of(plan_json: str) -> Any:
     from runner.plan import RunPlan
 
     try:
-        plan = RunPlan.model_validate_json(plan_json)
+        return RunPlan.model_validate_json(plan_json)
     except ValueError:
         return None
-    return {r.name for p in plan.parts() for r in p.robots}
 
 
 def _robots(m: mujoco.MjModel, names: set[str] | None = None) -> list[tuple[str, int]]:
-    """(robot name, root body) of each robot: the world's top bodies named `<robot>/...`; with the
-    scenario's robot names known, only theirs (an SDF world's models are named `<model>/...` too)."""
-    out = []
-    for b in range(1, m.nbody):
-        name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b) or ""
-        if int(m.body_parentid[b]) == 0 and "/" in name:
-            robot = name.split("/", 1)[0]
-            if names is None or robot in names:
-                out.append((robot, b))
-    return out
+    """(robot name, root body) of each robot (see `runner.pictures.robot_bodies`)."""
+    return robot_bodies(m, names)
 
 
-# What the overview frames: everything within this many metres of what moves (robots and the bodies that
-# move), or within this many times what moves spans, whichever is larger; farther geoms are left out.
-_FRAME_REACH_M = 100.0
-_FRAME_REACH_SPANS = 20.0
+def colours(m: mujoco.MjModel, rec: Recording) -> dict[str, RGB]:
+    """Each robot's colour: the one it has in the trajectory plot and the report (`runner.pictures`)."""
+    if rec.plan is not None:
+        return run_colours(rec.plan, {rec.run: m})
+    return model_colours(m, rec.robots)
 
 
-def _framing(m: mujoco.MjModel, d: mujoco.MjData, rec: Recording) -> tuple[np.ndarray, float, list[str]]:
-    """Centre and size of what is worth seeing: every geom but the (infinite) ground planes, at the start,
-    and where the bodies go over the run; and the models left out because they lie far beyond the robots
-    (a world model posed hundreds of kilometres away, a model without collision falling forever would
-    shrink the rest to nothing)."""
+# The overview: from the south (x to the right, y away: as the trajectory plot draws it), tilted enough to
+# see the walls' sides.
+OVERVIEW_AZIMUTH = 90.0
+OVERVIEW_ELEVATION = -60.0
+OVERVIEW_MARGIN = 0.04  # of the half-frame, kept free around what is framed
+
+
+def _framing(m: mujoco.MjModel, d: mujoco.MjData, rec: Recording) -> tuple[np.ndarray, list[str]]:
+    """What is worth seeing (points, one a row: the corners of each geom's box) and the models left out.
+
+    Every geom but the (infinite) ground planes, at the start, and where the bodies go over the run; but
+    not the models far beyond the robots (a world model posed hundreds of kilometres away, a model without
+    collision falling forever would shrink the rest to nothing)."""
     corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
 
     def box(g: int) -> list[np.ndarray]:
         center, half = m.geom_aabb[g][:3], m.geom_aabb[g][3:]
         return list(d.geom_xpos[g] + (center + corners * half) @ d.geom_xmat[g].reshape(3, 3).T)
-
-    def model_of(g: int) -> str:
-        root = int(m.body_rootid[int(m.geom_bodyid[g])])
-        # a scenario's world model is a geom of the world body; an SDF model or a robot, bodies `<name>/...`
-        return (m.body(root).name if root else m.geom(g).name or "a world geom").split("/")[0]
 
     solid = [g for g in range(m.ngeom) if int(m.geom_type[g]) != int(mujoco.mjtGeom.mjGEOM_PLANE)]
     robots = {b for _, b in _robots(m, rec.robots)}
@@ -138,60 +157,95 @@ def _framing(m: mujoco.MjModel, d: mujoco.MjData, rec: Recording) -> tuple[np.nd
     left_out: list[str] = []
     points: list[np.ndarray] = []
     if subject:
-        ref = np.array(subject)
-        lo, hi = ref.min(axis=0), ref.max(axis=0)
-        centre, reach = (lo + hi) / 2, max(_FRAME_REACH_M, _FRAME_REACH_SPANS * float(np.max(hi - lo)))
+        centre, radius = reach(np.array(subject))
         for g, pts in boxes.items():
-            far = np.max(np.linalg.norm(np.array(pts) - centre, axis=1)) > reach
+            far = np.max(np.linalg.norm(np.array(pts) - centre, axis=1)) > radius
             if far and int(m.body_rootid[int(m.geom_bodyid[g])]) not in robots:
-                if model_of(g) not in left_out:
-                    left_out.append(model_of(g))
+                if model_of(m, g) not in left_out:
+                    left_out.append(model_of(m, g))
                 continue
             points += pts
     if not points:
-        return np.array(m.stat.center), 2.0 * float(m.stat.extent), left_out
-    pts = np.array(points)
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
-    return (lo + hi) / 2, float(max(hi[0] - lo[0], hi[1] - lo[1], 1.0)), left_out
+        c, e = np.array(m.stat.center), float(m.stat.extent)
+        return c + corners * e, left_out
+    return np.array(points), left_out
+
+
+def frame_times(end_ns: int, fps: float) -> list[int]:
+    """The sim time of each frame of a video of `end_ns` sim ns at `fps`: one every 1/fps s from 0, as
+    many as play for the run's length (the last one shows the run's last 1/fps s)."""
+    n = max(1, math.ceil(end_ns * fps / 1e9 - 1e-6))
+    return [round(i * 1e9 / fps) for i in range(n)]
+
+
+def overview_camera(
+    m: mujoco.MjModel,
+    d: mujoco.MjData,
+    rec: Recording,
+    width: int,
+    height: int,
+    notes: list[str] | None = None,
+) -> tuple[mujoco.MjvCamera, float]:
+    """The overview's free camera, placed so that the whole world (every model, every robot wherever it
+    goes in the run) fills a `width` x `height` picture, with a small margin; and the span (m) of what it
+    frames. Sets the model's visual settings that depend on it (shadows, clipping)."""
+    points, left_out = _framing(m, d, rec)
+    lookat, distance = fit_camera(
+        points,
+        azimuth=OVERVIEW_AZIMUTH,
+        elevation=OVERVIEW_ELEVATION,
+        fovy=float(m.vis.global_.fovy),
+        aspect=width / height,
+        margin=OVERVIEW_MARGIN,
+    )
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    span = float(max(hi[0] - lo[0], hi[1] - lo[1], 1.0))
+    if left_out:
+        # MuJoCo scales its clipping planes and lights with the model's extent: the far model's would put
+        # the near plane kilometres away
+        m.stat.extent, m.stat.center = span, lookat
+        if notes is not None:
+            notes.append(
+                f"the overview leaves out {', '.join(left_out[:5])}{' ...' if len(left_out) > 5 else ''}: "
+                f"farther than {FRAME_REACH_M:g} m (or {FRAME_REACH_SPANS:g} times their spread) from "
+                "the robots at some time of the run"
+            )
+    extent = max(float(m.stat.extent), 1e-6)
+    # the shadow map must cover what is framed, or its edge speckles the floor (shadow acne)
+    m.vis.map.shadowclip = max(float(m.vis.map.shadowclip), max(25.0, 3.0 * span) / extent)
+    # and the far clipping plane must lie beyond what is framed
+    m.vis.map.zfar = max(float(m.vis.map.zfar), 2.0 * (distance + span) / extent)
+    cam = mujoco.MjvCamera()
+    cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+    cam.lookat[:] = lookat
+    cam.distance = distance
+    cam.azimuth, cam.elevation = OVERVIEW_AZIMUTH, OVERVIEW_ELEVATION
+    return cam, span
 
 
 def frames(
     rec: Recording,
     *,
     camera: str = "overview",
-    width: int = 640,
-    height: int = 480,
+    width: int = DEFAULT_SIZE[0],
+    height: int = DEFAULT_SIZE[1],
     fps: float = 15.0,
     last_only: bool = False,
     notes: list[str] | None = None,
 ) -> Iterator[np.ndarray]:
-    """RGB frames of the recording, one every 1/fps sim seconds (or only the last, paths complete);
+    """RGB frames of the recording at `frame_times` (or only the last, at the run's end, paths complete);
     `notes` receives what the viewer should know (models left out of the overview)."""
     m = mujoco.MjModel.from_xml_string(rec.mjcf)
     d = mujoco.MjData(m)
     m.vis.global_.offwidth = max(int(m.vis.global_.offwidth), width)
     m.vis.global_.offheight = max(int(m.vis.global_.offheight), height)
     robots = _robots(m, rec.robots)
+    colour = colours(m, rec)
     cam = mujoco.MjvCamera()
+    path_radius = 0.02
     if camera == "overview":
-        center, span, left_out = _framing(m, d, rec)
-        if left_out:
-            # MuJoCo scales its clipping planes and lights with the model's extent: the far model's would
-            # put the near plane kilometres away
-            m.stat.extent, m.stat.center = max(span, 1.0), center
-        if left_out and notes is not None:
-            notes.append(
-                f"the overview leaves out {', '.join(left_out[:5])}{' ...' if len(left_out) > 5 else ''}: "
-                f"farther than {_FRAME_REACH_M:g} m (or {_FRAME_REACH_SPANS:g} times their spread) from "
-                "the robots at some time of the run"
-            )
-        # the shadow map must cover what is framed, or its edge speckles the floor (shadow acne)
-        extent = max(float(m.stat.extent), 1e-6)
-        m.vis.map.shadowclip = max(float(m.vis.map.shadowclip), max(25.0, 3.0 * span) / extent)
-        cam.type = mujoco.mjtCamera.mjCAMERA_FREE
-        cam.lookat[:] = center
-        cam.distance = 1.3 * span / (2 * np.tan(np.radians(float(m.vis.global_.fovy)) / 2))
-        cam.azimuth, cam.elevation = 135.0, -60.0
+        cam, span = overview_camera(m, d, rec, width, height, notes)
+        path_radius = max(0.02, 0.003 * span)  # a path as wide as a few pixels, whatever the world's size
     elif camera.startswith("chase:"):
         name = camera.split(":", 1)[1]
         body = next((b for r, b in robots if r == name), None)
@@ -208,40 +262,72 @@ def frames(
     nq, nm = m.nq, m.nmocap
     trails: list[list[np.ndarray]] = [[] for _ in robots]
     end = rec.times[-1]
-    step = round(1e9 / fps)
+    times = [end] if last_only else frame_times(end, fps)
+    # a path is a capsule from point to point: one every `step` metres of the way (each recorded state
+    # would be thousands on a long run, more than the scene holds)
+    step = max(0.02, path_radius)
     with mujoco.Renderer(m, height, width) as renderer:
-        for t in range(0, end + 1, step):
-            i = max(0, bisect.bisect_right(rec.times, t) - 1)
-            state = rec.states[i]
-            d.qpos[:] = state[:nq]
-            if nm:
-                d.mocap_pos[:] = state[nq : nq + 3 * nm].reshape(nm, 3)
-                d.mocap_quat[:] = state[nq + 3 * nm : nq + 7 * nm].reshape(nm, 4)
-            mujoco.mj_kinematics(m, d)
+        done = 0  # states already on the paths
+        for t in times:
+            upto = max(1, bisect.bisect_right(rec.times, t))
+            for i in range(done, upto):
+                _pose(m, d, rec.states[i], nq, nm)
+                for k, (_name, body) in enumerate(robots):
+                    here, trail = np.array(d.xpos[body]), trails[k]
+                    if len(trail) < 2 or np.linalg.norm(trail[-2] - here) >= step:
+                        trail.append(here)
+                    else:  # (the last point follows the robot until the next is far enough)
+                        trail[-1] = here
+            done = max(done, upto)
+            _pose(m, d, rec.states[upto - 1], nq, nm)
             mujoco.mj_comPos(m, d)  # subtree centres of mass: what a tracking (chase) camera looks at
-            for k, (_name, body) in enumerate(robots):
-                trails[k].append(np.array(d.xpos[body]))
-            if last_only and t + step <= end:
-                continue
             mujoco.mj_camlight(m, d)
             renderer.update_scene(d, camera=cam)
-            for k in range(len(robots)):
-                _draw_path(renderer.scene, trails[k], PATH_COLORS[k % len(PATH_COLORS)])
+            for k, (name, _body) in enumerate(robots):
+                rgb = colour.get(name, PALETTE[k % len(PALETTE)])
+                _draw_path(renderer.scene, trails[k], rgb, path_radius)
             yield renderer.render().copy()
 
 
-def _draw_path(scene: Any, points: list[np.ndarray], rgb: tuple[float, float, float]) -> None:
+def _pose(m: mujoco.MjModel, d: mujoco.MjData, state: np.ndarray, nq: int, nm: int) -> None:
+    d.qpos[:] = state[:nq]
+    if nm:
+        d.mocap_pos[:] = state[nq : nq + 3 * nm].reshape(nm, 3)
+        d.mocap_quat[:] = state[nq + 3 * nm : nq + 7 * nm].reshape(nm, 4)
+    mujoco.mj_kinematics(m, d)
+
+
+def _draw_path(scene: Any, points: list[np.ndarray], rgb: RGB, radius: float) -> None:
     rgba = np.array([*rgb, 1.0], dtype=np.float32)
+    lift = np.array([0.0, 0.0, max(0.02, radius)])
     for a, b in itertools.pairwise(points):
-        if scene.ngeom >= scene.maxgeom or np.allclose(a, b):
+        if scene.ngeom >= scene.maxgeom:
+            break
+        if np.allclose(a, b):
             continue
         g = scene.geoms[scene.ngeom]
         mujoco.mjv_initGeom(
             g, mujoco.mjtGeom.mjGEOM_CAPSULE, np.zeros(3), np.zeros(3), np.eye(3).ravel(), rgba
         )
-        lift = np.array([0.0, 0.0, 0.02])
-        mujoco.mjv_connector(g, mujoco.mjtGeom.mjGEOM_CAPSULE, 0.02, a + lift, b + lift)
+        mujoco.mjv_connector(g, mujoco.mjtGeom.mjGEOM_CAPSULE, radius, a + lift, b + lift)
         scene.ngeom += 1
+
+
+@dataclass
+class Written:
+    """What a video or picture holds, as a player reads it back."""
+
+    frames: int
+    seconds: float  # how long it plays (0 for a picture)
+    fps: float  # frames per second it plays at (a GIF: on average)
+    merged: int = 0  # frames that were the same picture as the one before (a GIF shows it on)
+
+
+def gif_delays(n: int, fps: float) -> list[int]:
+    """Each frame's delay in milliseconds, whole hundredths of a second (a GIF's unit), adding up to n/fps
+    rounded to the hundredth: at 15 fps, 70, 70, 60, 70, 70, 60... (6.67 cs is not a GIF delay)."""
+    edges = [round(100 * i / fps) for i in range(n + 1)]
+    return [10 * (b - a) for a, b in itertools.pairwise(edges)]
 
 
 def write(
@@ -249,17 +335,22 @@ def write(
     out: Path,
     *,
     camera: str = "overview",
-    width: int = 640,
-    height: int = 480,
+    width: int = DEFAULT_SIZE[0],
+    height: int = DEFAULT_SIZE[1],
     fps: float = 15.0,
     progress: Callable[[int, int], None] | None = None,
     notes: list[str] | None = None,
-) -> int:
-    """Render `rec` into `out` (.mp4, .gif, .png); returns the number of frames (`notes`: see `frames`)."""
+) -> Written:
+    """Render `rec` into `out` (.mp4, .gif, .png): one frame every 1/fps sim seconds, so that it plays for
+    as long as the run took in sim time (`notes`: see `frames`). Returns what the file holds."""
     suffix = out.suffix.lower()
     if suffix not in (".mp4", ".gif", ".png"):
         raise RunError(f"{out}: write .mp4, .gif or .png")
-    total = 1 if suffix == ".png" else len(range(0, rec.times[-1] + 1, round(1e9 / fps)))
+    if suffix == ".gif" and fps > GIF_MAX_FPS:
+        if notes is not None:
+            notes.append(f"a GIF plays at {GIF_MAX_FPS:g} fps at most: --fps {fps:g} became {GIF_MAX_FPS:g}")
+        fps = GIF_MAX_FPS
+    total = 1 if suffix == ".png" else len(frame_times(rec.times[-1], fps))
     out.parent.mkdir(parents=True, exist_ok=True)
     images = frames(
         rec, camera=camera, width=width, height=height, fps=fps, last_only=suffix == ".png", notes=notes
@@ -280,20 +371,33 @@ def write(
                     progress(count, total)
         finally:
             writer.close()
-        return count
+        return Written(count, count / fps, fps)
     from PIL import Image
 
-    kept: list[Any] = []
-    for img in images:
-        count += 1
-        if suffix == ".gif":
-            kept.append(Image.fromarray(img).convert("P", palette=Image.Palette.ADAPTIVE))
-        else:
-            kept = [Image.fromarray(img)]  # a picture: the last frame, with the whole paths
+    if suffix == ".png":
+        for img in images:  # one: the run's end, with the whole paths
+            Image.fromarray(img).save(out)
+            count += 1
         if progress:
             progress(count, total)
-    if suffix == ".gif":
-        kept[0].save(out, save_all=True, append_images=kept[1:], duration=round(1000 / fps), loop=0)
-    else:
-        kept[0].save(out)
-    return count
+        return Written(count, 0.0, 0.0)
+    delays = gif_delays(total, fps)
+    kept: list[Any] = []
+    shown: list[int] = []  # each kept frame's delay, ms
+    last: bytes | None = None
+    for img in images:
+        frame = Image.fromarray(img).convert("P", palette=Image.Palette.ADAPTIVE)
+        # the same picture as the one before (nothing moved): shown on for longer instead, as Pillow would
+        # merge it anyway (and the count said would not be the count written)
+        same = frame.convert("RGB").tobytes()
+        if same == last:
+            shown[-1] += delays[count]
+        else:
+            kept.append(frame)
+            shown.append(delays[count])
+        last = same
+        count += 1
+        if progress:
+            progress(count, total)
+    kept[0].save(out, save_all=True, append_images=kept[1:], duration=shown, loop=0)
+    return Written(len(kept), sum(shown) / 1000, fps, merged=count - len(kept))

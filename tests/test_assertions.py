@@ -184,18 +184,20 @@ def test_live_and_offline_judgements_agree_and_junit_names_the_failure(write_sce
     # a failed run leaves a trajectory plot beside its recording
     png = mcap.with_suffix(".trajectory.png")
     assert png.is_file() and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    import zlib
+    from PIL import Image
 
-    data = png.read_bytes()
-    idat = data.index(b"IDAT")
-    size = int.from_bytes(data[idat - 4 : idat], "big")
-    raw = np.frombuffer(zlib.decompress(data[idat + 4 : idat + 4 + size]), dtype=np.uint8).reshape(
-        640, 1 + 640 * 3
-    )
-    rgb = raw[:, 1:].reshape(640, 640, 3).astype(int)
-    red = (rgb[..., 0] > 200) & (rgb[..., 1] < 60) & (rgb[..., 2] < 60)
-    blue = (rgb[..., 2] > 150) & (rgb[..., 0] < 60)
-    assert red.sum() > 20 and blue.sum() > 50  # the failure marks and r1's path are drawn
+    from runner.checks.plot import FAILED, INK
+    from runner.pictures import rgb255, run_colours
+
+    rgb = np.asarray(Image.open(png).convert("RGB")).astype(int)
+    r1, r2 = (rgb255(run_colours(plan_of(path))[n]) for n in ("r1", "r2"))
+    assert r1 != r2  # two robots from one file, one colour of their own: r2 takes another
+
+    def count(colour: tuple[int, int, int]) -> int:
+        return int((np.abs(rgb - colour).max(axis=2) <= 8).sum())
+
+    # r1's and r2's paths, the failed regions and the crosses where pose assertions failed
+    assert count(r1) > 100 and count(r2) > 50 and count(FAILED) > 100 and count(INK) > 50
 
 
 @pytest.mark.timeout(120)

@@ -39,12 +39,13 @@ def test_the_video_moves_and_shows_both_robots(recording: Path, tmp_path: Path) 
     video = tmp_path / "run.mp4"
     r = run_cli("render", str(recording), "-o", str(video), "--size", "480x360", "--fps", "5", timeout=100)
     assert r.returncode == 0, r.stderr
-    assert "31 frames, 6.0 s sim" in r.stdout
+    # one frame every 1/5 s of the 6 s run: it plays for 6 s
+    assert "30 frames, plays 6.00 s at 5 fps" in r.stdout, r.stdout
     reader = imageio_ffmpeg.read_frames(str(video))
     meta = next(reader)
     assert tuple(meta["size"]) == (480, 360)
     frames = [np.frombuffer(f, np.uint8).reshape(360, 480, 3) for f in reader]
-    assert len(frames) == 31
+    assert len(frames) == 30
     first, last = frames[0], frames[-1]
     moved = (np.abs(first.astype(int) - last.astype(int)).max(axis=2) > 30).sum()
     assert moved > 100, moved  # the robots moved, their paths grew
@@ -63,7 +64,7 @@ def test_a_picture_a_gif_and_a_chase_camera(recording: Path, tmp_path: Path) -> 
     png = tmp_path / "end.png"
     assert run_cli("render", str(recording), "-o", str(png), timeout=60).returncode == 0
     with Image.open(png) as img:
-        assert img.size == (640, 480)
+        assert img.size == (960, 720)  # the default size
         assert min(_robot_pixels(np.asarray(img.convert("RGB")))) > 30
     gif = tmp_path / "chase.gif"
     r = run_cli(
@@ -71,12 +72,12 @@ def test_a_picture_a_gif_and_a_chase_camera(recording: Path, tmp_path: Path) -> 
     )
     assert r.returncode == 0, r.stderr
     with Image.open(gif) as img:
-        # 13 frames at 2 per second (Pillow merges identical neighbours, adding up their durations)
+        # 12 frames at 2 per second: 6 s (a frame like the one before is merged into it, shown for longer)
         durations = []
         for frame in range(img.n_frames):
             img.seek(frame)
             durations.append(img.info["duration"])
-        assert sum(durations) == 13 * 500 and img.size == (160, 120)
+        assert sum(durations) == 12 * 500 and img.size == (160, 120)
         for frame in (0, img.n_frames - 1):  # r2 starts at (2, 0) and ends metres away: the camera follows it
             img.seek(frame)
             middle = np.asarray(img.convert("RGB"))[40:80, 50:110]

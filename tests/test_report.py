@@ -38,6 +38,10 @@ def test_the_report_shows_the_verdict_the_plots_and_the_topics(tmp_path: Path) -
     assert text.count("<svg") == 5 and 'src="data:image/png;base64,' in text
     assert "two_robots/r1/scan" in text and "_truth" not in text  # topics, helpers hidden
     assert not re.search(r'(src|href)="(https?:)?//', text)  # self-contained: nothing fetched
+    # a rate plot draws its assertion's bounds, dashed and labelled
+    rate = next(svg for svg in re.findall(r"<svg.*?</svg>", text) if "Rate of r1/scan" in svg)
+    assert rate.count('class="bound"') == 2 and 'stroke-dasharray="6,4"' in rate
+    assert "min 9.5 (lidar_at_10_hz)" in rate and "max 10.5 (lidar_at_10_hz)" in rate
 
     chromium = shutil.which("chromium") or shutil.which("chromium-browser")
     assert chromium, "headless Chromium is needed (Debian: apt-get install chromium; .ci/run installs it)"
@@ -49,9 +53,10 @@ def test_the_report_shows_the_verdict_the_plots_and_the_topics(tmp_path: Path) -
     )  # fmt: skip
     img = np.asarray(Image.open(shot).convert("RGB")).astype(int)
     r_, g_, b_ = img[..., 0], img[..., 1], img[..., 2]
-    # the speed plot's lines (#d62728 red, #1f77b4 blue) and the verdict badge (#1a7f37 green) are drawn
-    red = (abs(r_ - 0xD6) < 30) & (abs(g_ - 0x27) < 40) & (abs(b_ - 0x28) < 40)
-    blue = (abs(r_ - 0x1F) < 30) & (abs(g_ - 0x77) < 40) & (abs(b_ - 0xB4) < 40)
+    # the plots' lines in the robots' colours (r1 red, r2 blue: their own, from the scenario) and the
+    # verdict badge (#1a7f37 green) are drawn
+    red = (abs(r_ - 0xD9) < 30) & (abs(g_ - 0x33) < 40) & (abs(b_ - 0x33) < 40)
+    blue = (abs(r_ - 0x33) < 30) & (abs(g_ - 0x59) < 40) & (abs(b_ - 0xE6) < 40)
     green = (abs(r_ - 0x1A) < 20) & (abs(g_ - 0x7F) < 20) & (abs(b_ - 0x37) < 20)
     assert red.sum() > 200 and blue.sum() > 200 and green.sum() > 200, (red.sum(), blue.sum(), green.sum())
 
@@ -130,3 +135,23 @@ def test_the_report_shows_camera_frames(write_scenario, tmp_path: Path) -> None:
     assert img.shape == (48, 64, 3)
     red = (img[..., 0] > 120) & (img[..., 1] < 60) & (img[..., 2] < 60)
     assert red[:, 20:44].mean() > 0.3, "the red box ahead is not in the frame"
+
+
+@pytest.mark.timeout(240)
+def test_a_report_of_several_worlds_judges_and_plots_each_worlds_assertions(tmp_path: Path) -> None:
+    """With `worlds:`, each world's plan holds its own assertions (topics inside the world): the page
+    judges them all, and draws the rate plot of `arena/r1/scan` with its bounds."""
+    mcap = tmp_path / "worlds.mcap"
+    r = subprocess.run(
+        scenario_cmd("run", str(SCENARIOS / "two_worlds.yaml"), "--record", str(mcap), "-q"),
+        capture_output=True, text=True, timeout=180,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    page = tmp_path / "worlds.html"
+    r = run_cli("report", str(mcap), "-o", str(page), timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert "3/3 assertions pass, 2 signal plot(s)" in r.stdout  # speed, and the arena's lidar rate
+    text = page.read_text()
+    rate = next(svg for svg in re.findall(r"<svg.*?</svg>", text) if "Rate of arena/r1/scan" in svg)
+    assert "min 9.5 (arena_lidar_at_10_hz)" in rate and "max 10.5 (arena_lidar_at_10_hz)" in rate
+    assert 'alt="trajectory plot"' in text

@@ -46,6 +46,11 @@ def test_demo_runs_to_completion_and_records_every_topic(demo_run):
     proc, mcap = demo_run
     assert proc.returncode == 0, proc.stderr
     assert "completed: 20.00 s sim" in proc.stdout
+    # the end-of-run table leaves the helper topics out (as `scenario info` and `topics` do): --all
+    assert (
+        "two_robots/r1/scan" in proc.stdout and "/_truth" not in proc.stdout and "/_state" not in proc.stdout
+    )
+    assert "and 6 helper topic(s)" in proc.stdout
     messages = read_mcap(mcap)  # every message decodes with an independent ROS 2 CDR decoder
     counts = Counter(topic for topic, _, _, _ in messages)
     for suffix, rate in DEMO_RATES.items():
@@ -86,6 +91,14 @@ def test_info_lists_topics_and_span(demo_run):
     assert proc.returncode == 0, proc.stderr
     assert "two_robots/r1/scan" in proc.stdout and "sensor_msgs/msg/LaserScan" in proc.stdout
     assert "20.000 s" in proc.stdout
+    # the run's helper topics (a name part starting with `_`) are recorded, listed only with --all
+    helpers = ("two_robots/_contacts", "two_robots/_state", "two_robots/_model", "two_robots/_plan",
+               "two_robots/r1/_truth")  # fmt: skip
+    assert not any(key in proc.stdout for key in helpers), proc.stdout
+    assert "and 6 helper topic(s)" in proc.stdout and "--all lists them" in proc.stdout
+    every = run_cli("info", str(mcap), "--all")
+    assert every.returncode == 0, every.stderr
+    assert all(key in every.stdout for key in helpers) and "helper topic(s)" not in every.stdout
 
 
 CLIENT = textwrap.dedent(

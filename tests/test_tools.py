@@ -105,6 +105,11 @@ def test_echo_pub_and_topics_work_on_a_live_run(live_run: str) -> None:
     assert "world" in scan_row and "recorder" not in scan_row  # (--no-record: no recorder)
     cmd_row = next(line for line in proc.stdout.splitlines() if "toolrun/r1/cmd_vel" in line)
     assert "geometry_msgs/msg/Twist" in cmd_row  # subscribed by the world, silent: listed all the same
+    # the run's helper topics (`_state`, for `scenario render`) only with --all, as in `scenario info`
+    assert "toolrun/_state" not in proc.stdout and "helper topic(s)" in proc.stdout, proc.stdout
+    every = run_cli("topics", "--seconds", "1", "--all", timeout=30)
+    assert every.returncode == 0, every.stderr
+    assert "toolrun/_state" in every.stdout and "helper topic(s)" not in every.stdout, every.stdout
 
 
 @pytest.mark.timeout(90)

@@ -22,7 +22,6 @@ import numpy as np
 from runner import msgs
 from runner.errors import RunError
 
-COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"]
 STYLE = """
 body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;margin:2em auto;max-width:1000px;
 color:#222;padding:0 1em}h1{margin-bottom:.1em}.sub{color:#666;margin-top:0}table{border-collapse:collapse;
@@ -102,7 +101,11 @@ def _camera_frames(mcap: Path, summary: dict[str, Any], n: int = 3) -> tuple[str
     before depth ones); read one message at a time, so a long run's images never sit in memory."""
     from mcap.reader import make_reader
 
-    cams = [t for t in summary["topics"] if t["type"] == "sensor_msgs/msg/Image" and "/_" not in t["topic"]]
+    from runner.plan import hidden_key
+
+    cams = [
+        t for t in summary["topics"] if t["type"] == "sensor_msgs/msg/Image" and not hidden_key(t["topic"])
+    ]
     cams.sort(key=lambda t: ("depth" in t["topic"], t["topic"]))
     for t in cams:
         count = int(t["count"])
@@ -123,35 +126,53 @@ def _camera_frames(mcap: Path, summary: dict[str, Any], n: int = 3) -> tuple[str
     return "", []
 
 
-def svg_chart(
-    title: str, unit: str, lines: list[tuple[str, list[float], list[float]]], bound: float | None = None
-) -> str:
-    """A small line chart: (label, sim times s, values) per line; an optional horizontal bound."""
-    w, h, pad = 640, 200, 40
-    xs = [x for _l, t, _v in lines for x in t] or [0.0, 1.0]
-    ys = [y for _l, _t, v in lines for y in v if math.isfinite(y)] + ([bound] if bound is not None else [])
+Line = tuple[str, list[float], list[float], str]  # label, sim times (s), values, colour (#rrggbb)
+Bound = tuple[float, str]  # a horizontal line: value, label
+
+
+def svg_chart(title: str, unit: str, lines: list[Line], bounds: list[Bound] | None = None) -> str:
+    """A small line chart: (label, sim times s, values, colour) per line; the assertions' bounds as dashed
+    horizontal lines, each labelled."""
+    w, h, pad, left = 640, 220, 36, 48
+    bounds = [(v, label) for v, label in bounds or [] if v is not None and math.isfinite(v)]
+    xs = [x for _l, t, _v, _c in lines for x in t] or [0.0, 1.0]
+    ys = [y for _l, _t, v, _c in lines for y in v if math.isfinite(y)] + [v for v, _ in bounds]
     ys = ys or [0.0, 1.0]
     x0, x1 = min(xs), max(max(xs), min(xs) + 1e-9)
-    y0, y1 = min(0.0, min(ys)), max(ys) * 1.1 or 1.0
+    y0, y1 = min(0.0, min(ys)), max(ys) * 1.12 or 1.0
 
     def px(x: float, y: float) -> str:
-        u = pad + (x - x0) / (x1 - x0) * (w - 2 * pad)
+        u = left + (x - x0) / (x1 - x0) * (w - left - pad)
         v = h - pad + (y0 - y) / (y1 - y0) * (h - 2 * pad)
         return f"{u:.1f},{v:.1f}"
 
+    def ypx(y: float) -> float:
+        return h - pad + (y0 - y) / (y1 - y0) * (h - 2 * pad)
+
     parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" role="img">']
-    parts.append(f'<text x="{pad}" y="16" font-size="13" font-weight="600">{html.escape(title)}</text>')
-    parts.append(f'<line x1="{pad}" y1="{h - pad}" x2="{w - pad}" y2="{h - pad}" stroke="#999"/>')
-    parts.append(f'<line x1="{pad}" y1="{pad}" x2="{pad}" y2="{h - pad}" stroke="#999"/>')
-    parts.append(f'<text x="{pad - 4}" y="{pad + 4}" font-size="10" text-anchor="end">{y1:.3g}</text>')
-    parts.append(f'<text x="{pad - 4}" y="{h - pad}" font-size="10" text-anchor="end">{y0:.3g}</text>')
+    parts.append(f'<text x="{left}" y="18" font-size="13" font-weight="600">{html.escape(title)}</text>')
+    parts.append(f'<line x1="{left}" y1="{h - pad}" x2="{w - pad}" y2="{h - pad}" stroke="#999"/>')
+    parts.append(f'<line x1="{left}" y1="{pad}" x2="{left}" y2="{h - pad}" stroke="#999"/>')
+    parts.append(f'<text x="{left - 4}" y="{pad + 4}" font-size="10" text-anchor="end">{y1:.3g}</text>')
+    parts.append(f'<text x="{left - 4}" y="{h - pad}" font-size="10" text-anchor="end">{y0:.3g}</text>')
+    parts.append(f'<text x="{left}" y="{h - pad + 14}" font-size="10">{x0:.3g} s</text>')
     parts.append(f'<text x="{w - pad}" y="{h - pad + 14}" font-size="10" text-anchor="end">{x1:.3g} s</text>')
-    parts.append(f'<text x="{pad}" y="{h - 8}" font-size="10">{html.escape(unit)}</text>')
-    if bound is not None:
-        a, b = px(x0, bound), px(x1, bound)
-        parts.append(f'<polyline points="{a} {b}" stroke="#cf222e" stroke-dasharray="5,4" fill="none"/>')
-    for i, (label, t, v) in enumerate(lines):
-        colour = COLOURS[i % len(COLOURS)]
+    parts.append(f'<text x="{left}" y="{h - 6}" font-size="10">{html.escape(unit)}</text>')
+    top = max((v for v, _ in bounds), default=None)
+    for value, label in bounds:
+        a, b = px(x0, value), px(x1, value)
+        # the highest bound's label above its line, the others below theirs: a min and a max close
+        # together (a rate's 9.5..10.5 Hz) keep their labels apart
+        dy = -4 if value == top else 12
+        parts.append(
+            f'<polyline class="bound" points="{a} {b}" stroke="#555" stroke-width="1.2" '
+            'stroke-dasharray="6,4" fill="none"/>'
+        )
+        parts.append(
+            f'<text x="{left + 6}" y="{ypx(value) + dy:.1f}" font-size="10" fill="#444">'
+            f"{html.escape(label)}</text>"
+        )
+    for i, (label, t, v, colour) in enumerate(lines):
         pts = " ".join(px(a, b) for a, b in zip(t, v, strict=True) if math.isfinite(b))
         parts.append(f'<polyline points="{pts}" stroke="{colour}" stroke-width="1.8" fill="none"/>')
         parts.append(
@@ -160,6 +181,16 @@ def svg_chart(
         )
     parts.append("</svg>")
     return "".join(parts)
+
+
+def _shown_path(file: str | None) -> str:
+    """The scenario's file as the reader would type it: relative to the current folder when below it."""
+    if not file:
+        return ""
+    try:
+        return str(Path(file).resolve().relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return file
 
 
 def _png_uri(path_or_rgb: Path | np.ndarray) -> str:
@@ -178,19 +209,26 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
     from runner.checks.judge import truth_key
     from runner.checks.plot import trajectory_plot
     from runner.checks.report import judge_recording
+    from runner.pictures import NEUTRAL, hex_colour, run_colours
+    from runner.plan import hidden_key
     from runner.record import read_summary
 
     plan = plan or load_plan(mcap)
     summary = read_summary(mcap)
-    results = judge_recording(plan, mcap)[0] if plan.assertions else []
+    # (with several worlds, each world's plan holds its own assertions, their topics inside the world)
+    keyed = [(a, part.name) for part in plan.parts() for a in part.assertions]
+    assertions = [a for a, _ in keyed]
+    results = judge_recording(plan, mcap)[0] if assertions else []
     run = plan.name
     # signals: each robot's speed (ground truth), each checked topic's rate per sim second
     truth = {r.name: truth_key(p.name, r.namespace) for p in plan.parts() for r in p.robots}
-    rate_topics = sorted({a["topic"] for a in plan.assertions if a.get("type") == "topic_rate"})
-    rate_keys = {f"{run}/{t.strip('/')}" for t in rate_topics}
-    series = _series(mcap, set(truth.values()), stamps_only=rate_keys - set(truth.values()))
+    rate_keys = sorted({f"{w}/{a['topic'].strip('/')}" for a, w in keyed if a.get("type") == "topic_rate"})
+    series = _series(mcap, set(truth.values()), stamps_only=set(rate_keys) - set(truth.values()))
+    colours = run_colours(plan)  # each robot's colour, as in the trajectory plot and `scenario render`
     charts = []
-    speed, travelled, tilt = [], [], []
+    speed: list[Line] = []
+    travelled: list[Line] = []
+    tilt: list[Line] = []
     for name, key in truth.items():
         t, v, dist, tilts = [], [], [], []
         last = None
@@ -205,31 +243,44 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
             # the angle between the body's z axis and the world's
             tilts.append(math.acos(max(-1.0, min(1.0, 1 - 2 * (q.x * q.x + q.y * q.y)))))
         if t:
-            speed.append((name, t, v))
-            travelled.append((name, t, dist))
-            tilt.append((name, t, tilts))
-    kinds = {a.get("type") for a in plan.assertions}
+            colour = hex_colour(colours[name])
+            speed.append((name, t, v, colour))
+            travelled.append((name, t, dist, colour))
+            tilt.append((name, t, tilts, colour))
+    kinds = {a.get("type") for a in assertions}
 
-    def bound(kind: str) -> float | None:
-        return next((a.get("max") for a in plan.assertions if a.get("type") == kind and a.get("max")), None)
+    def bounds(kind: str, key: str | None = None) -> list[Bound]:
+        """The bounds of the assertions of this kind (and topic key), to draw as dashed lines."""
+        out: list[Bound] = []
+        for a, w in keyed:
+            if a.get("type") != kind or (key is not None and f"{w}/{a['topic'].strip('/')}" != key):
+                continue
+            for side in ("min", "max"):
+                if isinstance(a.get(side), int | float):
+                    out.append((float(a[side]), f"{side} {a[side]:g} ({a.get('name', kind)})"))
+        return out
 
     if speed:
-        charts.append(svg_chart("Speed of each robot (ground truth)", "m/s", speed, bound("max_speed")))
+        charts.append(svg_chart("Speed of each robot (ground truth)", "m/s", speed, bounds("max_speed")))
     if travelled and "distance_traveled" in kinds:
-        charts.append(svg_chart("Distance travelled", "m", travelled, bound("distance_traveled")))
+        charts.append(svg_chart("Distance travelled", "m", travelled, bounds("distance_traveled")))
     if tilt and "max_tilt" in kinds:
-        charts.append(svg_chart("Tilt from upright", "rad", tilt, bound("max_tilt")))
-    for topic, key in zip(rate_topics, sorted(rate_keys), strict=True):
+        charts.append(svg_chart("Tilt from upright", "rad", tilt, bounds("max_tilt")))
+    owners = {f"{p.name}/{r.namespace}/": hex_colour(colours[r.name]) for p in plan.parts() for r in p.robots}
+    for key in rate_keys:
+        topic = key.removeprefix(f"{run}/")
         stamps = [s / 1e9 for s, _ in series.get(key, [])]
         if stamps:
             whole = max(1, int(stamps[-1]))  # whole sim seconds (a last, partial second would dip)
             counts = np.histogram(stamps, bins=np.arange(0, whole + 1))[0]
             secs = np.arange(0, whole) + 0.5
+            colour = next((c for prefix, c in owners.items() if key.startswith(prefix)), hex_colour(NEUTRAL))
             charts.append(
                 svg_chart(
                     f"Rate of {topic}",
-                    "messages per sim second",
-                    [(topic, list(secs), list(counts.astype(float)))],
+                    "messages per sim second (Hz)",
+                    [(topic, list(secs), list(counts.astype(float)), colour)],
+                    bounds("topic_rate", key),
                 )
             )
     camera, frames = _camera_frames(mcap, summary)
@@ -245,7 +296,7 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
         if span > 0 and t["count"] > 1
         else f"<tr><td>{h(t['topic'])}</td><td>{h(t['type'])}</td><td>{t['count']}</td><td>-</td></tr>"
         for t in summary["topics"]
-        if "/_" not in t["topic"]
+        if not hidden_key(t["topic"])  # the run's helper topics (`_truth`...): as `scenario info` hides them
     )
     label = {"pass": "pass", "fail": "FAIL", "undecided": "not decided"}
 
@@ -269,14 +320,14 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
     page = [
         f'<!doctype html><html><head><meta charset="utf-8"><title>{h(run)}: run report</title>',
         f"<style>{STYLE}</style></head><body>",
-        f'<h1>{h(run)}</h1><p class="sub">{h(plan.model_dump().get("scenario_file") or "")}</p>',
+        f'<h1>{h(run)}</h1><p class="sub">{h(_shown_path(plan.scenario_file))}</p>',
         f"<p>{verdict} &nbsp; {span:.2f} s sim, {summary['messages']} messages recorded"
         + (" (the recording was cut)" if summary.get("cut") else "")
         + "</p>",
     ]
     if trajectory:
         page.append(
-            f'<figure><img alt="trajectory plot" src="{trajectory}" width="640">'
+            f'<figure><img alt="trajectory plot" src="{trajectory}" style="max-width:100%">'
             "<figcaption>Paths from above, with the assertions' regions and goals</figcaption></figure>"
         )
     if results:

@@ -1,15 +1,18 @@
-"""A trajectory plot (PNG) of a judged recording: every robot's path from above, the assertions' regions and
-goals, and a red cross where a failure happened. Written beside the MCAP when an assertion fails.
+"""A trajectory plot (PNG) of a judged recording: the world from above (its models as grey shapes), every
+robot's true path in the robot's own colour, the assertions' regions and goals, and a cross where a
+failure happened; axes in metres, equal aspect, and a legend. Written beside the MCAP when an assertion
+fails, and shown at the top of `scenario report`'s page.
 
-Plain numpy drawing and a minimal PNG writer (zlib): no plotting stack to install for a picture this simple.
+Drawn with Pillow (twice the size, then halved: smooth lines and text); the world comes from the compiled
+model the recording carries (its `_plan`), each robot's colour from `runner.pictures` (the same as in the
+report's plots and in `scenario render`). With several worlds, one panel each.
 """
 
 from __future__ import annotations
 
 import itertools
 import math
-import struct
-import zlib
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -17,126 +20,359 @@ import numpy as np
 
 from runner.checks import POSE_KINDS, specs_from_plan
 from runner.checks.judge import Result, truth_key
+from runner.pictures import RGB, Footprint, footprints, reach, rgb255, robot_bodies, run_colours
 
-SIZE = 640
-MARGIN = 40
-COLOURS = [(31, 119, 180), (255, 127, 14), (44, 160, 44), (148, 103, 189), (140, 86, 75), (227, 119, 194)]
-RED = (214, 39, 40)
-GREY = (150, 150, 150)
+SS = 2  # drawn at this many times the size, then reduced
+PLOT_W, PLOT_H = 760, 600  # the largest plot area of one world (pixels); several worlds share the width
+MAX_ASPECT = 2.5  # a long, thin world gets room around it rather than a plot one pixel high
+LEFT, TOP, BOTTOM, GAP, LEGEND_PAD = 62, 40, 52, 64, 28
+
+INK = (40, 40, 46)
+AXIS = (120, 120, 128)
+GRID = (228, 228, 234)
+PAPER = (255, 255, 255)
+FIELD = (251, 251, 253)
+SOLID = (168, 170, 178)  # world models
+SOLID_EDGE = (118, 120, 128)
+LOOSE = (212, 214, 220)  # models that can move, where they start
+REGION = (84, 88, 100)
+FAILED = (207, 34, 46)
 
 
-def write_png(path: Path, rgb: np.ndarray) -> None:
-    h, w, _ = rgb.shape
-    raw = b"".join(b"\x00" + rgb[y].astype(np.uint8).tobytes() for y in range(h))
+def _fonts() -> dict[str, Any]:
+    from PIL import ImageFont
 
-    def chunk(tag: bytes, data: bytes) -> bytes:
+    return {k: ImageFont.load_default(size=s * SS) for k, s in (("title", 15), ("label", 13), ("small", 11))}
+
+
+@dataclass
+class _Panel:
+    title: str
+    shapes: list[Footprint]
+    paths: dict[str, np.ndarray]  # robot -> rows of (t ns, x, y)
+    specs: list[Any]
+    left_out: list[str] = field(default_factory=list)
+    lo: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    hi: np.ndarray = field(default_factory=lambda: np.ones(2))
+    scale: float = 1.0  # pixels (final) per metre
+    origin: tuple[float, float] = (0.0, 0.0)  # top-left corner of the plot area (final pixels)
+
+    @property
+    def size(self) -> tuple[float, float]:
+        return float(self.hi[0] - self.lo[0]) * self.scale, float(self.hi[1] - self.lo[1]) * self.scale
+
+    def px(self, x: float, y: float) -> tuple[float, float]:
+        """Drawing pixel (at SS) of a point in metres."""
         return (
-            struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
+            (self.origin[0] + (x - self.lo[0]) * self.scale) * SS,
+            (self.origin[1] + (self.hi[1] - y) * self.scale) * SS,
         )
 
-    png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
-    png += chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b"")
-    path.write_bytes(png)
+
+def _region_points(s: Any) -> list[np.ndarray]:
+    region = getattr(s, "region", None)
+    out = []
+    if region is not None and region.center is not None:
+        c, r = np.array(region.center, dtype=float), float(region.radius or 0.0)
+        out.append(np.array([c - r, c + r]))
+    elif region is not None and region.min is not None:
+        out.append(np.array([region.min, region.max], dtype=float))
+    if getattr(s, "point", None) is not None:
+        tol = float(getattr(s, "tolerance", 0.1) or 0.1)
+        out.append(np.array([np.array(s.point) - tol, np.array(s.point) + tol], dtype=float))
+    return out
 
 
-class _Canvas:
-    def __init__(self, lo: np.ndarray, hi: np.ndarray):
-        self.img = np.full((SIZE, SIZE, 3), 255, dtype=np.uint8)
-        span = max(float(np.max(hi - lo)), 1e-3)
-        self.scale = (SIZE - 2 * MARGIN) / span
-        self.lo = lo
-
-    def px(self, x: float, y: float) -> tuple[int, int]:
-        u = MARGIN + (x - self.lo[0]) * self.scale
-        v = SIZE - MARGIN - (y - self.lo[1]) * self.scale
-        return round(u), round(v)
-
-    def dot(self, u: int, v: int, colour: tuple[int, int, int], r: int = 1) -> None:
-        self.img[
-            max(v - r, 0) : max(min(v + r + 1, SIZE), 0), max(u - r, 0) : max(min(u + r + 1, SIZE), 0)
-        ] = colour
-
-    def line(
-        self, a: tuple[float, float], b: tuple[float, float], colour: tuple[int, int, int], r: int = 1
-    ) -> None:
-        (u0, v0), (u1, v1) = self.px(*a), self.px(*b)
-        n = max(abs(u1 - u0), abs(v1 - v0), 1)
-        for t in np.linspace(0.0, 1.0, n + 1):
-            self.dot(round(u0 + (u1 - u0) * t), round(v0 + (v1 - v0) * t), colour, r)
-
-    def circle(self, c: tuple[float, float], radius: float, colour: tuple[int, int, int]) -> None:
-        pts = [
-            (c[0] + radius * math.cos(a), c[1] + radius * math.sin(a))
-            for a in np.linspace(0, 2 * math.pi, 73)
-        ]
-        for p, q in itertools.pairwise(pts):
-            self.line(p, q, colour, 0)
-
-    def box(self, lo: tuple[float, float], hi: tuple[float, float], colour: tuple[int, int, int]) -> None:
-        corners = [(lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1]), (lo[0], lo[1])]
-        for p, q in itertools.pairwise(corners):
-            self.line(p, q, colour, 0)
-
-    def cross(self, c: tuple[float, float], colour: tuple[int, int, int]) -> None:
-        u, v = self.px(*c)
-        for d in range(-8, 9):
-            self.dot(u + d, v + d, colour, 1)
-            self.dot(u + d, v - d, colour, 1)
+def _bounds(panel: _Panel) -> None:
+    """The panel's extent: the whole world (but what lies far beyond the robots), the paths, the regions;
+    with a margin, and no thinner than MAX_ASPECT."""
+    path_pts = [p[:, 1:3] for p in panel.paths.values() if len(p)]
+    subject = np.vstack(path_pts) if path_pts else np.zeros((1, 2))
+    centre, radius = reach(subject)
+    kept = []
+    for f in panel.shapes:
+        if np.max(np.linalg.norm(f.points() - centre, axis=1)) > radius:
+            if f.model not in panel.left_out:
+                panel.left_out.append(f.model)
+        else:
+            kept.append(f)
+    panel.shapes = kept
+    pts = [subject, *(f.points() for f in kept)]
+    for s in panel.specs:
+        pts += _region_points(s)
+    allpts = np.vstack(pts)
+    lo, hi = allpts.min(axis=0), allpts.max(axis=0)
+    pad = max(0.3, 0.04 * float(np.max(hi - lo)))
+    lo, hi = lo - pad, hi + pad
+    span = hi - lo
+    for a, b in ((0, 1), (1, 0)):  # widen the thin side
+        if span[b] * MAX_ASPECT < span[a]:
+            grow = span[a] / MAX_ASPECT - span[b]
+            lo[b], hi[b] = lo[b] - grow / 2, hi[b] + grow / 2
+    panel.lo, panel.hi = lo, hi
 
 
-def trajectory_plot(plan: Any, mcap: Path, results: list[Result], out: Path) -> Path | None:
-    """Draw the robots' true paths from `mcap` (their `_truth` topics) with the assertions; None if the
-    recording holds no path."""
+def _nice_step(span: float, ticks: int = 8) -> float:
+    raw = span / ticks
+    mag = 10 ** math.floor(math.log10(raw))
+    return next(m * mag for m in (1, 2, 2.5, 5, 10) if m * mag >= raw)
+
+
+def _tick_label(v: float) -> str:
+    text = f"{round(v, 6):g}"
+    return "0" if text == "-0" else text
+
+
+def _dashed(draw: Any, pts: list[tuple[float, float]], fill: tuple[int, int, int], width: int) -> None:
+    on, off = 7 * SS, 5 * SS
+    carry, drawing = 0.0, True
+    for (x0, y0), (x1, y1) in itertools.pairwise(pts):
+        length = math.hypot(x1 - x0, y1 - y0)
+        t = 0.0
+        while t < length:
+            run = min((on if drawing else off) - carry, length - t)
+            if drawing:
+                a, b = t / length, (t + run) / length
+                draw.line(
+                    [(x0 + (x1 - x0) * a, y0 + (y1 - y0) * a), (x0 + (x1 - x0) * b, y0 + (y1 - y0) * b)],
+                    fill=fill,
+                    width=width,
+                )
+            t += run
+            carry += run
+            if carry >= (on if drawing else off) - 1e-9:
+                carry, drawing = 0.0, not drawing
+
+
+def _circle_pts(c: tuple[float, float], r: float, n: int = 72) -> list[tuple[float, float]]:
+    return [(c[0] + r * math.cos(a), c[1] + r * math.sin(a)) for a in np.linspace(0, 2 * math.pi, n + 1)]
+
+
+def _cross(draw: Any, u: float, v: float) -> None:
+    k = 7 * SS
+    for width, colour in ((6 * SS, PAPER), (3 * SS, INK)):
+        draw.line([(u - k, v - k), (u + k, v + k)], fill=colour, width=width)
+        draw.line([(u - k, v + k), (u + k, v - k)], fill=colour, width=width)
+
+
+def _panels(plan: Any, mcap: Path) -> tuple[list[_Panel], dict[str, RGB]]:
+    import mujoco
     from mcap.reader import make_reader
 
     from runner import msgs
 
-    keys = {truth_key(part.name, r.namespace): r.name for part in plan.worlds or [plan] for r in part.robots}
-    paths: dict[str, list[tuple[int, float, float]]] = {}
+    parts = plan.parts()
+    keys = {truth_key(part.name, r.namespace): r.name for part in parts for r in part.robots}
+    rows: dict[str, list[tuple[int, float, float]]] = {}
     with open(mcap, "rb") as f:
         for _s, channel, message in make_reader(f).iter_messages(topics=list(keys)):
             m = msgs.decode(message.data, "nav_msgs/msg/Odometry")
             p = m.pose.pose.position
-            paths.setdefault(keys[channel.topic], []).append((message.log_time, float(p.x), float(p.y)))
-    if not paths:
+            rows.setdefault(keys[channel.topic], []).append((message.log_time, float(p.x), float(p.y)))
+    if not rows:
+        return [], {}
+    models: dict[str, Any] = {}
+    panels = []
+    for part in parts:
+        names = [r.name for r in part.robots]
+        try:
+            model = mujoco.MjModel.from_xml_string(part.mjcf)
+            models[part.name] = model
+            shapes = footprints(model, skip_roots=[b for _n, b in robot_bodies(model, names)])
+        except Exception:  # a model that no longer compiles (its meshes moved): paths only
+            shapes = []
+        specs = [
+            s
+            for s in specs_from_plan(part.assertions)
+            if getattr(s, "robot", None) in names or s.type not in POSE_KINDS
+        ]
+        paths = {n: np.array(rows[n], dtype=float) for n in names if n in rows}
+        if paths:
+            title = part.name if plan.worlds else f"{plan.name}: paths from above"
+            panels.append(_Panel(title, shapes, paths, specs))
+    return panels, run_colours(plan, models)
+
+
+def trajectory_plot(plan: Any, mcap: Path, results: list[Result], out: Path) -> Path | None:
+    """Draw the robots' true paths from `mcap` (their `_truth` topics) over the world, with the
+    assertions; None if the recording holds no path."""
+    from PIL import Image, ImageDraw
+
+    panels, colours = _panels(plan, mcap)
+    if not panels:
         return None
-    specs = specs_from_plan([a for part in plan.worlds or [plan] for a in part.assertions])
-    pts = [np.array([(x, y) for _, x, y in path]) for path in paths.values()]
-    for s in specs:
-        region = getattr(s, "region", None)
-        if region is not None and region.center is not None:
-            c, r = np.array(region.center), region.radius or 0.0
-            pts.append(np.array([c - r, c + r]))
-        elif region is not None and region.min is not None:
-            pts.append(np.array([region.min, region.max]))
-        if getattr(s, "point", None) is not None:
-            pts.append(np.array([s.point]))
-    allpts = np.vstack(pts)
-    lo, hi = allpts.min(axis=0) - 0.3, allpts.max(axis=0) + 0.3
-    canvas = _Canvas(lo, hi)
+    fonts = _fonts()
     by_name = {r.name: r for r in results}
-    for s in specs:
-        ok = by_name.get(s.name)
-        colour = RED if ok is not None and ok.status == "fail" else GREY
+    failed = {r.name for r in results if r.status == "fail"}
+    # sizes: one world gets the whole plot area; several share its width
+    each_w = PLOT_W if len(panels) == 1 else max(320, (PLOT_W + 240) // len(panels))
+    for p in panels:
+        _bounds(p)
+        span = p.hi - p.lo
+        p.scale = min(each_w / span[0], PLOT_H / span[1])
+    robots = [n for p in panels for n in p.paths]
+    legend = [(n, "robot") for n in robots] + [("start", "start"), ("end", "end")]
+    if any(not f.moving for p in panels for f in p.shapes):
+        legend.append(("world model", "solid"))
+    if any(f.moving for p in panels for f in p.shapes):
+        legend.append(("movable model, at start", "loose"))
+    if any(_region_points(s) for p in panels for s in p.specs):
+        legend.append(("assertion region, goal", "region"))
+    if failed:
+        legend.append(("failed assertion", "failed"))
+        legend.append(("where it failed", "cross"))
+    legend_w = 44 + max(fonts["label"].getlength(t) / SS for t, _ in legend)
+    x = LEFT
+    for p in panels:
+        p.origin = (x, TOP)
+        x += p.size[0] + GAP
+    plot_bottom = TOP + max(p.size[1] for p in panels)
+    width = round(x - GAP + LEGEND_PAD + legend_w + 16)
+    height = round(
+        max(
+            plot_bottom + BOTTOM + (16 if any(p.left_out for p in panels) else 0), TOP + 24 * len(legend) + 20
+        )
+    )
+    img = Image.new("RGB", (width * SS, height * SS), PAPER)
+    draw = ImageDraw.Draw(img)
+    for p in panels:
+        _draw_panel(img, draw, p, fonts, colours, by_name, failed)
+    # the legend, right of the plots
+    lx, ly = (x - GAP + LEGEND_PAD) * SS, (TOP + 4) * SS
+    for text, kind in legend:
+        cy = ly + 8 * SS
+        sw = (lx, cy, lx + 28 * SS, cy)
+        ink = INK
+        if kind == "robot":
+            ink = rgb255(colours[text])
+            draw.line([sw[:2], sw[2:]], fill=ink, width=4 * SS)
+        elif kind in ("start", "end"):
+            c = (lx + 14 * SS, cy)
+            r = 5 * SS
+            box = [c[0] - r, c[1] - r, c[0] + r, c[1] + r]
+            draw.ellipse(box, fill=INK if kind == "end" else PAPER, outline=INK, width=2 * SS)
+        elif kind in ("solid", "loose"):
+            draw.rectangle(
+                [lx + 4 * SS, cy - 6 * SS, lx + 24 * SS, cy + 6 * SS],
+                fill=SOLID if kind == "solid" else LOOSE,
+                outline=SOLID_EDGE,
+                width=SS,
+            )
+        elif kind in ("region", "failed"):
+            edge = REGION if kind == "region" else FAILED
+            corners = [(lx + 2 * SS, cy - 6 * SS), (lx + 26 * SS, cy - 6 * SS), (lx + 26 * SS, cy + 6 * SS)]
+            corners += [(lx + 2 * SS, cy + 6 * SS), (lx + 2 * SS, cy - 6 * SS)]
+            _dashed(draw, corners, edge, 2 * SS)
+            ink = FAILED if kind == "failed" else INK
+        elif kind == "cross":
+            _cross(draw, lx + 14 * SS, cy)
+        draw.text((lx + 38 * SS, cy), text, fill=ink, font=fonts["label"], anchor="lm")
+        ly += 24 * SS
+    img = img.reduce(SS)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    img.save(out, optimize=True)
+    return out
+
+
+def _draw_panel(
+    img: Any,
+    draw: Any,
+    p: _Panel,
+    fonts: dict[str, Any],
+    colours: dict[str, RGB],
+    by_name: dict[str, Result],
+    failed: set[str],
+) -> None:
+    from PIL import Image, ImageDraw
+
+    (x0, y0), (w, h) = p.origin, p.size
+    frame = [x0 * SS, y0 * SS, (x0 + w) * SS, (y0 + h) * SS]
+    draw.rectangle(frame, fill=FIELD)
+    step = _nice_step(float(max(p.hi - p.lo)))
+    small = fonts["small"]
+    for axis in (0, 1):
+        first = math.ceil(p.lo[axis] / step - 1e-9)
+        for i in itertools.count(first):
+            v = i * step
+            if v > p.hi[axis] + 1e-9:
+                break
+            label = _tick_label(v)
+            if axis == 0:
+                u, _ = p.px(v, 0)
+                draw.line([(u, frame[1]), (u, frame[3])], fill=GRID, width=SS)
+                draw.line([(u, frame[3]), (u, frame[3] + 5 * SS)], fill=AXIS, width=SS)
+                draw.text((u, frame[3] + 7 * SS), label, fill=INK, font=small, anchor="mt")
+            else:
+                _, vv = p.px(0, v)
+                draw.line([(frame[0], vv), (frame[2], vv)], fill=GRID, width=SS)
+                draw.line([(frame[0] - 5 * SS, vv), (frame[0], vv)], fill=AXIS, width=SS)
+                draw.text((frame[0] - 8 * SS, vv), label, fill=INK, font=small, anchor="rm")
+    label = fonts["label"]
+    draw.text(((x0 + w / 2) * SS, frame[3] + 26 * SS), "x [m]", fill=INK, font=label, anchor="mt")
+    ylab = Image.new("RGB", (round(label.getlength("y [m]")) + 4 * SS, 18 * SS), PAPER)
+    ImageDraw.Draw(ylab).text((2 * SS, 9 * SS), "y [m]", fill=INK, font=label, anchor="lm")
+    ylab = ylab.rotate(90, expand=True)
+    img.paste(ylab, (round((x0 - 58) * SS), round((y0 + h / 2) * SS - ylab.height / 2)))
+    draw.text((x0 * SS, (y0 - 10) * SS), p.title, fill=INK, font=fonts["title"], anchor="ls")
+    if p.left_out:
+        note = (
+            "left out, far beyond the robots: "
+            + ", ".join(p.left_out[:4])
+            + (" ..." if len(p.left_out) > 4 else "")
+        )
+        draw.text((x0 * SS, frame[3] + 46 * SS), note, fill=AXIS, font=small, anchor="lt")
+    # the world
+    for f in sorted(p.shapes, key=lambda f: f.moving):
+        for poly in f.polygons:
+            pts = [p.px(float(x), float(y)) for x, y in poly]
+            fill, edge = (LOOSE, SOLID_EDGE) if f.moving else (SOLID, SOLID_EDGE)
+            if len(f.polygons) > 1:  # a mesh's faces: no edges between them
+                draw.polygon(pts, fill=fill)
+            else:
+                draw.polygon(pts, fill=fill, outline=edge, width=SS)
+    # the assertions' regions and goals
+    for s in p.specs:
+        edge = FAILED if s.name in failed else REGION
         region = getattr(s, "region", None)
+        corner = None
         if region is not None and region.center is not None:
-            canvas.circle(tuple(region.center), region.radius or 0.0, colour)
+            c = p.px(*region.center)
+            r = float(region.radius or 0.0) * p.scale * SS
+            _dashed(draw, _circle_pts(c, r), edge, 2 * SS)
+            corner = (c[0] - r * 0.71, c[1] - r * 0.71)
         elif region is not None and region.min is not None:
-            canvas.box(tuple(region.min), tuple(region.max), colour)
+            (ax, ay), (bx, by) = p.px(*region.min), p.px(*region.max)
+            _dashed(draw, [(ax, ay), (bx, ay), (bx, by), (ax, by), (ax, ay)], edge, 2 * SS)
+            corner = (ax, by)
         if getattr(s, "point", None) is not None:
-            canvas.circle(tuple(s.point), getattr(s, "tolerance", 0.1), colour)
-    for i, (_name, path) in enumerate(sorted(paths.items())):
-        colour = COLOURS[i % len(COLOURS)]
-        for (_, x0, y0), (_, x1, y1) in itertools.pairwise(path):
-            canvas.line((x0, y0), (x1, y1), colour, 1)
-        canvas.dot(*canvas.px(path[0][1], path[0][2]), colour, 4)  # start
-    for s in specs:
+            c = p.px(*s.point)
+            r = float(getattr(s, "tolerance", 0.1) or 0.1) * p.scale * SS
+            _dashed(draw, _circle_pts(c, r), edge, 2 * SS)
+            k = 5 * SS
+            draw.line([(c[0] - k, c[1]), (c[0] + k, c[1])], fill=edge, width=2 * SS)
+            draw.line([(c[0], c[1] - k), (c[0], c[1] + k)], fill=edge, width=2 * SS)
+            corner = (c[0] + r * 0.71, c[1] - r * 0.71)
+        if corner is not None:
+            anchor = "lb"
+            draw.text((corner[0] + 3 * SS, corner[1] - 2 * SS), s.name, fill=edge, font=small, anchor=anchor)
+    # the paths: start (open circle), end (filled)
+    for name, path in p.paths.items():
+        ink = rgb255(colours[name])
+        pts = [p.px(x, y) for _t, x, y in path]
+        if len(pts) > 1:
+            draw.line(pts, fill=ink, width=3 * SS, joint="curve")
+        r = 5 * SS
+        for (u, v), filled in ((pts[0], False), (pts[-1], True)):
+            draw.ellipse(
+                [u - r, v - r, u + r, v + r], fill=ink if filled else PAPER, outline=ink, width=2 * SS
+            )
+    # where pose assertions failed: the robot's place at that time
+    for s in p.specs:
         r = by_name.get(s.name)
         if r is None or r.status != "fail" or r.t_ns is None or s.type not in POSE_KINDS:
             continue
-        path = paths.get(s.robot)
-        if path:
-            _t, x, y = min(path, key=lambda p: abs(p[0] - r.t_ns))
-            canvas.cross((x, y), RED)
-    write_png(out, canvas.img)
-    return out
+        path = p.paths.get(s.robot)
+        if path is not None and len(path):
+            row = path[int(np.argmin(np.abs(path[:, 0] - r.t_ns)))]
+            _cross(draw, *p.px(float(row[1]), float(row[2])))
+    draw.rectangle(frame, outline=AXIS, width=SS)
