@@ -26,7 +26,7 @@ def prefixed_urdf(urdf: str, namespace: str) -> str:
     if not namespace or not urdf:
         return urdf
     try:
-        root = etree.fromstring(urdf.encode("utf-8"), etree.XMLParser(remove_blank_text=False))
+        root = etree.fromstring(urdf.encode("utf-8"))
     except etree.XMLSyntaxError:
         return urdf
     links = {el.get("name") for el in root.iter("link") if el.get("name")}

@@ -102,11 +102,6 @@ def _plan_of(plan_json: str) -> Any:
         return None
 
 
-def _robots(m: mujoco.MjModel, names: set[str] | None = None) -> list[tuple[str, int]]:
-    """(robot name, root body) of each robot (see `runner.pictures.robot_bodies`)."""
-    return robot_bodies(m, names)
-
-
 def colours(m: mujoco.MjModel, rec: Recording) -> dict[str, RGB]:
     """Each robot's colour: the one it has in the trajectory plot and the report (`runner.pictures`)."""
     if rec.plan is not None:
@@ -134,7 +129,7 @@ def _framing(m: mujoco.MjModel, d: mujoco.MjData, rec: Recording) -> tuple[np.nd
         return list(d.geom_xpos[g] + (center + corners * half) @ d.geom_xmat[g].reshape(3, 3).T)
 
     solid = [g for g in range(m.ngeom) if int(m.geom_type[g]) != int(mujoco.mjtGeom.mjGEOM_PLANE)]
-    robots = {b for _, b in _robots(m, rec.robots)}
+    robots = {b for _, b in robot_bodies(m, rec.robots)}
     # geoms of bodies that can move (their root body has joints), seen whole wherever they go: a box
     # pushed to the edge stays in the picture
     moving = [g for g in solid if int(m.body_jntnum[int(m.body_rootid[int(m.geom_bodyid[g])])]) > 0]
@@ -239,7 +234,7 @@ def frames(
     d = mujoco.MjData(m)
     m.vis.global_.offwidth = max(int(m.vis.global_.offwidth), width)
     m.vis.global_.offheight = max(int(m.vis.global_.offheight), height)
-    robots = _robots(m, rec.robots)
+    robots = robot_bodies(m, rec.robots)
     colour = colours(m, rec)
     cam = mujoco.MjvCamera()
     path_radius = 0.02

@@ -169,6 +169,7 @@ def test_the_overview_frames_every_model_and_robot(scenario: str, demo: Path, tm
     from PIL import Image
 
     from runner import replay
+    from runner.pictures import robot_bodies
 
     mcap = demo if scenario == "two_robots.yaml" else _record(tmp_path / "run.mcap", scenario, 2)
     w, h = replay.DEFAULT_SIZE
@@ -182,7 +183,7 @@ def test_the_overview_frames_every_model_and_robot(scenario: str, demo: Path, tm
     m = mujoco.MjModel.from_xml_string(rec.mjcf)
     d = mujoco.MjData(m)
     cam, _span = replay.overview_camera(m, d, rec, w, h)
-    robots = {b: name for name, b in replay._robots(m, rec.robots)}
+    robots = {b: name for name, b in robot_bodies(m, rec.robots)}
     mujoco.mj_kinematics(m, d)  # (the models where they start)
     scene = mujoco.MjvScene(m, maxgeom=2000)
     mujoco.mjv_updateScene(m, d, mujoco.MjvOption(), None, cam, int(mujoco.mjtCatBit.mjCAT_ALL), scene)

@@ -92,7 +92,7 @@ def test_only_the_scenarios_robots_get_paths() -> None:
     """An SDF world's models are named `<model>/...` like robots: the recorded plan tells them apart."""
     import mujoco
 
-    from runner.replay import _robots
+    from runner.pictures import robot_bodies
 
     m = mujoco.MjModel.from_xml_string(
         "<mujoco><worldbody>"
@@ -100,8 +100,8 @@ def test_only_the_scenarios_robots_get_paths() -> None:
         '<body name="r1/base_link"><freejoint/><geom size="0.1"/></body>'
         "</worldbody></mujoco>"
     )
-    assert [name for name, _b in _robots(m)] == ["cafe_table", "r1"]  # without a plan: a guess
-    assert [name for name, _b in _robots(m, {"r1"})] == ["r1"]
+    assert [name for name, _b in robot_bodies(m)] == ["cafe_table", "r1"]  # without a plan: a guess
+    assert [name for name, _b in robot_bodies(m, {"r1"})] == ["r1"]
 
 
 SMALL_WORLD = """

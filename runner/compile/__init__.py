@@ -920,13 +920,13 @@ def _plugin_entries(robot: Robot, model: RobotModel) -> list[_Entry]:
 STATE_PUBLISHER = "robot_state_publisher"
 
 
-def _state_publisher(sc: Scenario, robot: Robot, model: RobotModel) -> list[_Entry]:
+def _state_publisher(sc: Scenario, entries: list[_Entry]) -> list[_Entry]:
     """With `foxglove.scene` (the default), a robot whose scenario and description have no `tf` plugin gets
     one, as a launch file starts robot_state_publisher beside a Gazebo robot: every link's transform on
     the robot's `tf` (moving) and `tf_static` (fixed, sent again every `1/foxglove.rate` s: the transport
     does not latch, and a viewer seeking into a recording needs them near where it lands). A robot whose
-    drive says where it is (odom -> base) is joined to it; any other from `world`."""
-    entries = _plugin_entries(robot, model)
+    drive says where it is (odom -> base) is joined to it; any other from `world`. `entries`: the robot's
+    own plugins (`_plugin_entries`)."""
     if not sc.foxglove.scene or any(e.type == "tf" for e in entries):
         return []
     driven = any(drive_frames(e.type, e.params) for e in entries)
@@ -947,7 +947,8 @@ def _build_plugins(
     plans: list[PluginPlan] = []
     ctx = BuildContext(spec=model.spec, robot=robot.name, namespace=robot.ns, root=model.root)
     names: set[str] = set()
-    for entry in _plugin_entries(robot, model) + _state_publisher(sc, robot, model):
+    entries = _plugin_entries(robot, model)
+    for entry in entries + _state_publisher(sc, entries):
         here: PathKey = ("robots", i, "plugins", entry.scenario_index or 0)
         src = entry.source
         with problems.each():

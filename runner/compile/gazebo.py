@@ -27,6 +27,7 @@ from runner.compile import thirdparty
 from runner.compile.locate import Locator
 from runner.compile.materials import gazebo_material
 from runner.errors import Notices, SourceError
+from runner.frames import frame_id
 
 _NOT_FINITE = {"inf", "-inf", "+inf", "infinity", "-infinity", "nan"}
 
@@ -249,9 +250,7 @@ class GazeboReader:
     def frame(self, frame: str | None) -> str | None:
         if not frame:
             return None
-        frame = frame.strip("/")
-        ns = self.namespace
-        return frame if frame.startswith(ns + "/") else f"{ns}/{frame}"
+        return frame_id(self.namespace, frame.strip("/"))
 
     # ------------------------------------------------------------------------------------------ read
     def read(self) -> GazeboInfo:
