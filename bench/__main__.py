@@ -10,7 +10,7 @@ Sections (in order):
   process taking every message too. Ratio to the limit and × real time.
 - scaling: 1, 2, 4, 8, 16 robots (diff_drive + lidar + imu + joint_states + tf each), world on Zenoh and
   full recorded run: × real time and wall cost per robot-second, relative to one robot.
-- messages: encode cost by type, fixed layout (runner.cdr) vs rosbags, µs per message.
+- messages: encode cost by type, fixed layout (runner.wire.cdr) vs rosbags, µs per message.
 - cameras: the demo plus one 320x240 RGB camera per robot at 10 Hz, recorded.
 - realtime: `rate: realtime` for 60 s (10 s with --quick): the factor overall and over its worst second,
   and the delay from a `cmd_vel` put by another process to the controller acting on it.
@@ -59,9 +59,9 @@ from bench.common import (  # noqa: E402
     table,
     world_on_zenoh,
 )
-from runner.launch import run_plan  # noqa: E402
+from runner.launch.run import run_plan  # noqa: E402
 from runner.plan import RunPlan  # noqa: E402
-from runner.transport import free_port  # noqa: E402
+from runner.wire.transport import free_port  # noqa: E402
 
 SECTIONS = (
     "two_robots",
@@ -94,7 +94,7 @@ def _full_run(plan: RunPlan, tmp: Path, tag: str, listen: list[str] | None = Non
 _SUBSCRIBER = textwrap.dedent(
     """
     import sys, time, zenoh
-    from runner.transport import make_config
+    from runner.wire.transport import make_config
     n = 0
     def on(sample):
         global n
@@ -300,9 +300,9 @@ def messages(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
 
     import numpy as np
 
-    from runner import msgs
     from runner.sim.world import World
-    from runner.transport import MemoryBus
+    from runner.wire import msgs
+    from runner.wire.transport import MemoryBus
 
     plan = plan_from_file(TWO_ROBOTS, seconds=0.2)
     bus = MemoryBus()
@@ -312,7 +312,7 @@ def messages(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     for _key, type_name, payload, _att in bus.sent:
         if msgs.is_known(type_name):  # (not the Foxglove scene: protobuf)
             samples.setdefault(type_name, payload)
-    from runner.cdr import Layout
+    from runner.wire.cdr import Layout
 
     rows = []
     doc_rows = []
@@ -383,8 +383,8 @@ def cameras(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
 _COMMANDER = textwrap.dedent(
     """
     import random, sys, time, zenoh
-    from runner import msgs
-    from runner.transport import make_config, pack_attachment
+    from runner.wire import msgs
+    from runner.wire.transport import make_config, pack_attachment
     key, seconds = sys.argv[2], float(sys.argv[3])
     conf = make_config("client", connect=[sys.argv[1]])
     Twist = msgs.T["geometry_msgs/msg/Twist"]
@@ -416,7 +416,7 @@ def realtime(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
 
     from plugins.diff_drive import WheelDrive
     from runner.sim.world import World
-    from runner.transport import ZenohBus, make_config
+    from runner.wire.transport import ZenohBus, make_config
 
     seconds = 10.0 if args.quick else 60.0
     plan = plan_from_file(TWO_ROBOTS, seconds=seconds)

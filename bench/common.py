@@ -23,11 +23,11 @@ import mujoco  # noqa: E402
 import zenoh  # noqa: E402
 
 from runner.compile import compile_plan  # noqa: E402
-from runner.loader import load_file, load_text  # noqa: E402
 from runner.plan import RunPlan  # noqa: E402
+from runner.scenario.loader import load_file, load_text  # noqa: E402
+from runner.scenario.validate import validate_scenario  # noqa: E402
 from runner.sim.world import World, WorldStats  # noqa: E402
-from runner.transport import ZenohBus, free_port, make_config  # noqa: E402
-from runner.validate import validate_scenario  # noqa: E402
+from runner.wire.transport import ZenohBus, free_port, make_config  # noqa: E402
 
 
 def machine() -> dict[str, Any]:
@@ -91,7 +91,7 @@ def raw_rate(plan: RunPlan, steps: int, *, batched: bool = True) -> float:
 def raw_driving_rate(plan: RunPlan) -> float:
     """Physics steps per second of the same model replaying the controls a run applied (the robots drive,
     turn and touch as in the run), no plugins: what the physics of the run costs by itself."""
-    from runner.transport import MemoryBus
+    from runner.wire.transport import MemoryBus
 
     world = World(plan, MemoryBus())
     controls: list[tuple[int, Any]] = []

@@ -48,11 +48,11 @@ import numpy as np  # noqa: E402
 
 from plugins._render import CameraRenderer, gl_backend_in_use  # noqa: E402
 from runner.compile import compile_plan  # noqa: E402
-from runner.loader import load_file  # noqa: E402
 from runner.plan import RunPlan  # noqa: E402
+from runner.scenario.loader import load_file  # noqa: E402
+from runner.scenario.validate import validate_scenario  # noqa: E402
 from runner.sim.world import World  # noqa: E402
-from runner.transport import MemoryBus  # noqa: E402
-from runner.validate import validate_scenario  # noqa: E402
+from runner.wire.transport import MemoryBus  # noqa: E402
 
 DIFFBOT = REPO / "scenarios" / "robots" / "diffbot.urdf.xacro"
 

@@ -45,8 +45,8 @@ if sys.path and Path(sys.path[0]).resolve() == REPO / "bench":
 
 import zenoh  # noqa: E402
 
-from runner.record import Recorder  # noqa: E402
-from runner.transport import ATTACHMENT, encoding_for, free_port, make_config  # noqa: E402
+from runner.record.recorder import Recorder  # noqa: E402
+from runner.wire.transport import ATTACHMENT, encoding_for, free_port, make_config  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 RESULTS = HERE / "results" / "recorder.json"
@@ -63,7 +63,7 @@ def payload_mix(size: int | None = None) -> list[tuple[str, str, list[bytes]]]:
     """(key suffix, ROS type, payload variants) of the 8 keys the publisher publishes on."""
     import numpy as np
 
-    from runner import msgs
+    from runner.wire import msgs
 
     rng = np.random.default_rng(1)
 

@@ -10,9 +10,9 @@ import mujoco
 import numpy as np
 from pydantic import Field
 
-from runner import msgs
 from runner.geometry import rpy_to_quat
 from runner.plugin import BuildContext, PluginConfigError, PluginParams, Publisher, RatedParams, Topic
+from runner.wire import msgs
 
 
 class MountPose(PluginParams):

@@ -47,7 +47,6 @@ import numpy as np
 from pydantic import Field, PositiveFloat, PositiveInt, model_validator
 
 from plugins._common import MountPose
-from runner import msgs
 from runner.geometry import rpy_to_quat
 from runner.gl import (  # noqa: F401  (re-exported for the camera plugins and tests)
     GL_AUTO_ENV,
@@ -67,6 +66,7 @@ from runner.gl import (  # noqa: F401  (re-exported for the camera plugins and t
     probe_gl_backend,
 )
 from runner.plugin import BuildContext, PluginConfigError, RatedParams
+from runner.wire import msgs
 
 # The compiler gives every world an offscreen framebuffer of at least 1280x960 (runner/compile/__init__.py);
 # a larger camera grows it, up to this (what any GL implementation offers).

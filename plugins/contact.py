@@ -25,8 +25,8 @@ import mujoco
 import numpy as np
 from pydantic import Field
 
-from runner import msgs
 from runner.plugin import BuildContext, Plugin, PluginConfigError, RatedParams, Topic
+from runner.wire import msgs
 
 CONTACTS_TYPE = "gazebo_msgs/msg/ContactsState"
 

@@ -26,8 +26,8 @@ from pydantic import Field
 
 from plugins._render import CAMERA_INFO, IMAGE, POINT_CLOUD, CameraParams, image_msg
 from plugins.camera import Camera
-from runner import msgs
 from runner.plugin import Topic
+from runner.wire import msgs
 
 
 class DepthCameraParams(CameraParams):

@@ -31,8 +31,8 @@ import numpy as np
 from pydantic import Field
 
 from plugins._drift import DriftingBias
-from runner import msgs
 from runner.plugin import BuildContext, Plugin, RatedParams, Topic
+from runner.wire import msgs
 
 Vector3 = tuple[float, float, float]
 

@@ -26,8 +26,8 @@ from pydantic import Field
 
 from plugins._common import MountPose, add_site, pick_link
 from plugins._drift import DriftingBias
-from runner import msgs
 from runner.plugin import BuildContext, Plugin, Publisher, RatedParams, Topic
+from runner.wire import msgs
 
 Vector3 = tuple[float, float, float]
 

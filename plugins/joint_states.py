@@ -9,8 +9,8 @@ import mujoco
 import numpy as np
 from pydantic import Field
 
-from runner import msgs
 from runner.plugin import BuildContext, Plugin, PluginConfigError, RatedParams, Topic
+from runner.wire import msgs
 
 _MOVABLE = {int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)}
 

@@ -30,9 +30,8 @@ from pydantic import Field, PositiveFloat, PositiveInt, model_validator
 
 from plugins._common import MountPose, add_site, pick_link
 from plugins._drift import DriftingBias
-from runner import msgs
-from runner.compile.decompose import PIECES_GROUP, RAY_GROUP
-from runner.plugin import BuildContext, Plugin, RatedParams, Topic
+from runner.plugin import PIECES_GROUP, RAY_GROUP, BuildContext, Plugin, RatedParams, Topic
+from runner.wire import msgs
 
 _EPS = 1e-4
 _HIDDEN_GROUP = 1  # the geom group rays skip (URDF visuals live there already)

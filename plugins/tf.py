@@ -23,8 +23,8 @@ import mujoco
 import numpy as np
 from pydantic import Field
 
-from runner import msgs
 from runner.plugin import BuildContext, Plugin, RatedParams, Topic
+from runner.wire import msgs
 
 TF_TYPE = "tf2_msgs/msg/TFMessage"
 WORLD_FRAME = "world"

@@ -31,10 +31,16 @@ from typing import Any
 
 import zenoh
 
-from runner import msgs
-from runner.graph import GraphTokens
-from runner.plan import topic_key
-from runner.transport import ATTACHMENT, encoding_for, make_config, meta_key, unpack_attachment
+from runner.wire import msgs
+from runner.wire.graph import GraphTokens
+from runner.wire.transport import (
+    ATTACHMENT,
+    encoding_for,
+    make_config,
+    meta_key,
+    topic_key,
+    unpack_attachment,
+)
 
 _WAIT = struct.Struct("<q")  # lockstep: the sim time (ns) this node sleeps until
 NEVER = 2**63 - 1

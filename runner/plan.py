@@ -167,7 +167,7 @@ class RunPlan(BaseModel):
 
     def renders(self) -> bool:
         """Whether any plugin of the run renders (cameras)."""
-        from runner.registry import load
+        from runner.plugin.registry import load
 
         return any(load(p.type).renders for r in self.robots for p in r.plugins)
 
@@ -198,22 +198,3 @@ class RunPlan(BaseModel):
                 seen[(ev.key, "pub")] = TopicPlan(key=ev.key, type=ev.type, direction="pub", owner="timeline")
                 out.append(seen[(ev.key, "pub")])
         return out
-
-
-def hidden_topic(rel: str) -> bool:
-    """The run's own helper topics (`_truth/...`, `_contacts`): a chunk starting with `_`, hidden as ROS
-    hides `_` topics. `rel` is a key without the run's name."""
-    return any(chunk.startswith("_") for chunk in rel.split("/"))
-
-
-def hidden_key(key: str) -> bool:
-    """`hidden_topic` for a full key (`<run>/...`, its first chunk the run's name): what `scenario info`,
-    `topics`, the end-of-run table and the report leave out unless told `--all`."""
-    return hidden_topic(key.split("/", 1)[1] if "/" in key else key)
-
-
-def topic_key(run: str, namespace: str, topic: str) -> str:
-    """`scan` in namespace r1 -> `run/r1/scan`; `/clock` (absolute) -> `run/clock`."""
-    if topic.startswith("/"):
-        return f"{run}{topic}"
-    return f"{run}/{namespace}/{topic}" if namespace else f"{run}/{topic}"

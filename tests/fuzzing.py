@@ -115,7 +115,7 @@ def model_params(model: type[BaseModel], depth: int = 0) -> st.SearchStrategy[di
 
 def plugin_entries() -> st.SearchStrategy[dict[str, Any]]:
     """`{type, params}` for every plugin in the registry (one that fails to load is a type name only)."""
-    from runner.registry import PluginLookupError, available, load
+    from runner.plugin.registry import PluginLookupError, available, load
 
     options = []
     for name in available():
@@ -564,9 +564,9 @@ def check(text: str, compile_it: bool, outcome: Outcome | None = None, file: Pat
     """Read, validate (every matrix variant) and, if asked, compile `text` (as if read from `file`): it must
     succeed or raise a `ScenarioError` whose problems all say where they are. Anything else propagates."""
     from runner.compile import compile_plan
-    from runner.loader import load_text
-    from runner.matrix import variants
-    from runner.validate import validate_scenario
+    from runner.scenario.loader import load_text
+    from runner.scenario.matrix import variants
+    from runner.scenario.validate import validate_scenario
 
     outcome = outcome if outcome is not None else Outcome()
     try:

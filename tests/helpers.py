@@ -5,14 +5,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from runner import msgs
 from runner.compile import compile_plan
 from runner.errors import Notices
-from runner.loader import load_file
 from runner.plan import RunPlan
+from runner.scenario.loader import load_file
+from runner.scenario.validate import validate_scenario
 from runner.sim.world import World
-from runner.transport import MemoryBus, unpack_attachment
-from runner.validate import validate_scenario
+from runner.wire import msgs
+from runner.wire.transport import MemoryBus, unpack_attachment
 
 
 def plan_of(path: Path) -> RunPlan:

@@ -9,11 +9,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from runner import msgs
-from runner.checks.report import judge_for
 from runner.errors import ScenarioError
 from runner.sim.world import World
-from runner.transport import MemoryBus, unpack_attachment
+from runner.tools.report import judge_for
+from runner.wire import msgs
+from runner.wire.transport import MemoryBus, unpack_attachment
 from tests.conftest import run_cli
 from tests.helpers import plan_of
 
@@ -186,8 +186,8 @@ def test_live_and_offline_judgements_agree_and_junit_names_the_failure(write_sce
     assert png.is_file() and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     from PIL import Image
 
-    from runner.checks.plot import FAILED, INK
-    from runner.pictures import rgb255, run_colours
+    from runner.tools.pictures import rgb255, run_colours
+    from runner.tools.plot import FAILED, INK
 
     rgb = np.asarray(Image.open(png).convert("RGB")).astype(int)
     r1, r2 = (rgb255(run_colours(plan_of(path))[n]) for n in ("r1", "r2"))
@@ -236,8 +236,8 @@ def test_stop_on_first_failure_ends_the_run_early(write_scenario, tmp_path: Path
 def test_live_and_recorded_judgements_agree_on_every_example(example: str, tmp_path: Path):
     """Every example, run in-process (cameras shrunk, rates as declared): the judge fed message by message
     as the live run feeds it, and the judge reading the MCAP the real recorder wrote, decide alike."""
-    from runner.checks.report import judge_recording
-    from runner.record import Recorder
+    from runner.record.recorder import Recorder
+    from runner.tools.report import judge_recording
     from tests.test_seeds import _shrunk_plan
 
     plan = _shrunk_plan(example)

@@ -15,9 +15,9 @@ from typing import Any
 import pytest
 import zenoh
 
-from runner import msgs
-from runner.graph import query_graph
-from runner.transport import free_port, make_config, type_from_encoding
+from runner.wire import msgs
+from runner.wire.graph import query_graph
+from runner.wire.transport import free_port, make_config, type_from_encoding
 from tests.conftest import SCENARIOS, read_mcap, run_cli, scenario_cmd
 
 
@@ -289,14 +289,14 @@ def test_a_bridge_file_resolves_under_its_robot(write_scenario) -> None:
         TWO.replace("{bridges}", "{file: bridge.yaml, robot: r2}").replace("{{", "{").replace("}}", "}")
     )
     from runner.compile import compile_plan
-    from runner.loader import load_file
-    from runner.validate import validate_scenario
+    from runner.scenario.loader import load_file
+    from runner.scenario.validate import validate_scenario
 
     doc = load_file(path)
     plan = compile_plan(validate_scenario(doc), doc)
     (b,) = plan.bridges
     assert (b.sim_key, b.key, b.direction, b.lazy) == ("two/r2/scan", "r2/scan", "SIM_TO_ZENOH", True)
-    assert any(n.argv[-2:] == ["-m", "runner.bridge"] and n.required for n in plan.nodes)
+    assert any(n.argv[-2:] == ["-m", "runner.launch.bridge"] and n.required for n in plan.nodes)
 
 
 def test_a_bridge_copy_keeps_its_topics_qos(write_scenario) -> None:
@@ -310,8 +310,8 @@ def test_a_bridge_copy_keeps_its_topics_qos(write_scenario) -> None:
         .replace("}}", "}")
     )
     from runner.compile import compile_plan
-    from runner.loader import load_file
-    from runner.validate import validate_scenario
+    from runner.scenario.loader import load_file
+    from runner.scenario.validate import validate_scenario
 
     doc = load_file(path)
     plan = compile_plan(validate_scenario(doc), doc)

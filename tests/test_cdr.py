@@ -1,4 +1,4 @@
-"""Fixed-layout encoders (runner.cdr) write exactly the bytes rosbags writes for the same message."""
+"""Fixed-layout encoders (runner.wire.cdr) write exactly the bytes rosbags writes for the same message."""
 
 from __future__ import annotations
 
@@ -9,11 +9,11 @@ from typing import Any, ClassVar
 import numpy as np
 import pytest
 
-from runner import msgs, registry
-from runner.cdr import Layout, LayoutError
-from runner.plugin import Plugin, Topic
+from runner.plugin import Plugin, Topic, registry
 from runner.sim.world import World
-from runner.transport import MemoryBus
+from runner.wire import msgs
+from runner.wire.cdr import Layout, LayoutError
+from runner.wire.transport import MemoryBus
 from tests.helpers import messages, plan_of
 
 SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"

@@ -121,8 +121,8 @@ def test_missing_world_file_points_at_the_scenario_line(write_scenario):
 def test_a_record_pattern_that_matches_no_topic_is_warned(tmp_path):
     from runner.compile import compile_plan
     from runner.errors import Notices
-    from runner.loader import load_file
-    from runner.validate import validate_scenario
+    from runner.scenario.loader import load_file
+    from runner.scenario.validate import validate_scenario
     from tests.conftest import DIFFBOT
 
     path = tmp_path / "s.yaml"
@@ -144,8 +144,8 @@ def test_a_record_pattern_that_matches_no_topic_is_warned(tmp_path):
 def test_a_robot_placed_inside_something_is_warned(tmp_path):
     from runner.compile import compile_plan
     from runner.errors import Notices
-    from runner.loader import load_file
-    from runner.validate import validate_scenario
+    from runner.scenario.loader import load_file
+    from runner.scenario.validate import validate_scenario
     from tests.conftest import DIFFBOT
 
     path = tmp_path / "s.yaml"

@@ -9,9 +9,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from runner import msgs
-from runner.record import Recorder
-from runner.transport import unpack_attachment
+from runner.record.recorder import Recorder
+from runner.wire import msgs
+from runner.wire.transport import unpack_attachment
 from tests.conftest import read_mcap
 from tests.helpers import messages, plan_of, simulate
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from runner.checks.expr import ExprError, check_fields, compile_expr
-from runner.msgs import decode, encode, from_data
+from runner.wire.msgs import decode, encode, from_data
 
 INF = float("inf")
 

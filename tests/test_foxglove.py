@@ -17,9 +17,9 @@ from mcap_protobuf.decoder import DecoderFactory as ProtobufDecoders
 from mcap_ros2.decoder import DecoderFactory as Ros2Decoders
 
 from runner.compile import compile_plan
-from runner.loader import load_file
+from runner.scenario.loader import load_file
+from runner.scenario.validate import validate_scenario
 from runner.sim.scene import scene_update
-from runner.validate import validate_scenario
 from tests.conftest import SCENARIOS, scenario_cmd
 
 
@@ -126,7 +126,7 @@ def test_meshes_capsules_and_planes_become_foxglove_primitives() -> None:
     from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
     from mcap_protobuf.decoder import DecoderFactory  # noqa: F401  (protobuf available: decode below)
 
-    from runner.record import foxglove_schema
+    from runner.record.recorder import foxglove_schema
 
     schema = foxglove_schema("foxglove.SceneUpdate")
     pool = descriptor_pool.DescriptorPool()

@@ -10,8 +10,8 @@ import numpy as np
 
 from runner.compile import compile_plan
 from runner.errors import Notices
-from runner.loader import load_file
-from runner.validate import validate_scenario
+from runner.scenario.loader import load_file
+from runner.scenario.validate import validate_scenario
 from tests.helpers import declared, messages, simulate
 
 DATA = Path(__file__).parent / "data" / "gazebo"

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from runner.plan import RunPlan
-from runner.transport import MemoryBus
+from runner.wire.transport import MemoryBus
 from tests.helpers import compile_with_notices, declared, messages, robot_scenario, simulate
 
 IMAGE, INFO, POINTS = "sensor_msgs/msg/Image", "sensor_msgs/msg/CameraInfo", "sensor_msgs/msg/PointCloud2"

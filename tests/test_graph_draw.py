@@ -1,4 +1,4 @@
-"""`runner.graph_draw`: the run's graph as DOT text, as a PNG drawn with Pillow, and as terminal lines.
+"""`runner.tools.graph_draw`: the run's graph as DOT text, as a PNG drawn with Pillow, and as terminal lines.
 
 Plain unit tests on graphs built by hand (no Zenoh session, no network)."""
 
@@ -11,8 +11,7 @@ import numpy as np
 import pytest
 from PIL import Image, ImageDraw
 
-from runner.graph import Endpoint, Graph
-from runner.graph_draw import (
+from runner.tools.graph_draw import (
     EDGE_BACK,
     process_id,
     render_png,
@@ -21,6 +20,7 @@ from runner.graph_draw import (
     to_dot,
     topic_id,
 )
+from runner.wire.graph import Endpoint, Graph
 
 RUN = "demo"
 TYPES = {

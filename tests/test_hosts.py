@@ -231,7 +231,7 @@ def test_a_required_node_lost_on_the_other_host_fails_the_run(
         assert node is not None, "the node did not start"
         # killed once its commands are in the recording (its whole chunks, read as they are written),
         # however long the start took on a loaded machine
-        from runner.record import read_summary
+        from runner.record.recorder import read_summary
 
         while time.monotonic() < deadline + 40:
             counts = {t["topic"]: t["count"] for t in read_summary(mcap)["topics"]} if mcap.exists() else {}
@@ -256,7 +256,7 @@ def test_a_required_node_lost_on_the_other_host_fails_the_run(
 def test_the_main_host_says_which_host_it_waits_for(write_scenario) -> None:
     """A host started by hand may come a while after the main one: the main runner says whom it waits for
     (instead of failing after a short fixed time), and Ctrl-C still ends the wait."""
-    from runner.transport import free_port
+    from runner.wire.transport import free_port
 
     a, b = free_port(), free_port()
     text = SCENE.format(a="127.0.0.1", b="127.0.0.1", diffbot="{diffbot}")
@@ -287,8 +287,8 @@ def test_start_limits_tell_this_host_from_the_others() -> None:
     import threading
     from types import SimpleNamespace
 
-    from runner import launch
     from runner.errors import RunError
+    from runner.launch import run as launch
     from runner.sim import __main__ as world_main
 
     def part(label: str, host: str | None, ready: bool = False) -> SimpleNamespace:

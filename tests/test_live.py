@@ -14,8 +14,8 @@ from typing import Any
 
 import pytest
 
-from runner import msgs
-from runner.transport import free_port
+from runner.wire import msgs
+from runner.wire.transport import free_port
 from tests.conftest import SCENARIOS, scenario_cmd
 
 

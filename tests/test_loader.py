@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from runner.errors import ScenarioError
-from runner.loader import load_file, load_text
+from runner.scenario.loader import load_file, load_text
 
 
 def test_positions_point_at_keys_and_items():

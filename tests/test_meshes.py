@@ -19,8 +19,8 @@ import trimesh
 from runner.compile import compile_plan
 from runner.compile.meshes import MeshError, prepare_mesh
 from runner.errors import Notices, ScenarioError
-from runner.loader import load_file
-from runner.validate import validate_scenario
+from runner.scenario.loader import load_file
+from runner.scenario.validate import validate_scenario
 
 # The visual's mesh is on line 4, the collision's on line 5.
 ROBOT = """<?xml version="1.0"?>

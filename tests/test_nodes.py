@@ -244,7 +244,7 @@ def test_a_required_node_whose_script_is_missing_fails_the_run_without_a_traceba
 def _tail_of(text: str, stopping: bool, capsys: pytest.CaptureFixture[str]) -> str:
     import io
 
-    from runner.nodes import OutputTail
+    from runner.launch.nodes import OutputTail
 
     tail = OutputTail(io.BytesIO(text.encode()), "[n] ")
     tail.stopping = stopping

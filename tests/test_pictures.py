@@ -52,7 +52,7 @@ TWINS = """
 
 
 def test_robots_of_one_colour_are_told_apart_the_same_way_every_time() -> None:
-    from runner.pictures import PALETTE, assign_colours, model_colours
+    from runner.tools.pictures import PALETTE, assign_colours, model_colours
 
     m = mujoco.MjModel.from_xml_string(TWINS)
     colours = model_colours(m)
@@ -69,7 +69,7 @@ def test_robots_of_one_colour_are_told_apart_the_same_way_every_time() -> None:
 
 
 def test_a_colour_too_light_for_paper_keeps_its_hue() -> None:
-    from runner.pictures import MAX_LUMA, assign_colours
+    from runner.tools.pictures import MAX_LUMA, assign_colours
 
     yellow = assign_colours([("r", (1.0, 1.0, 0.0))])["r"]
     assert 0.2126 * yellow[0] + 0.7152 * yellow[1] + 0.0722 * yellow[2] <= MAX_LUMA + 1e-9
@@ -90,10 +90,10 @@ def _hue_mask(img: np.ndarray, rgb: tuple[float, float, float]) -> np.ndarray:
 def test_each_robot_has_one_colour_in_the_plot_the_report_and_the_render(demo: Path, tmp_path: Path) -> None:
     from PIL import Image
 
-    from runner import replay
-    from runner.checks.html import load_plan, write_report
-    from runner.checks.plot import trajectory_plot
-    from runner.pictures import hex_colour, rgb255, run_colours
+    from runner.launch.announce import replay
+    from runner.tools.html import load_plan, write_report
+    from runner.tools.pictures import hex_colour, rgb255, run_colours
+    from runner.tools.plot import trajectory_plot
 
     plan = load_plan(demo)
     colours = run_colours(plan)
@@ -168,8 +168,8 @@ def _model_centres(m: mujoco.MjModel, d: mujoco.MjData, robots: set[int]) -> dic
 def test_the_overview_frames_every_model_and_robot(scenario: str, demo: Path, tmp_path: Path) -> None:
     from PIL import Image
 
-    from runner import replay
-    from runner.pictures import robot_bodies
+    from runner.launch.announce import replay
+    from runner.tools.pictures import robot_bodies
 
     mcap = demo if scenario == "two_robots.yaml" else _record(tmp_path / "run.mcap", scenario, 2)
     w, h = replay.DEFAULT_SIZE
@@ -220,7 +220,7 @@ def test_the_overview_frames_every_model_and_robot(scenario: str, demo: Path, tm
 
 
 def test_the_camera_fit_puts_every_point_in_the_picture_and_fills_it() -> None:
-    from runner.pictures import fit_camera, project
+    from runner.tools.pictures import fit_camera, project
 
     rng = np.random.default_rng(3)
     for spread in ([10, 10, 0.5], [30, 4, 2], [2, 12, 0.2]):
@@ -237,7 +237,7 @@ def test_the_camera_fit_puts_every_point_in_the_picture_and_fills_it() -> None:
 
 
 def test_gif_delays_add_up_to_the_run() -> None:
-    from runner.replay import frame_times, gif_delays
+    from runner.tools.replay import frame_times, gif_delays
 
     assert len(frame_times(6_000_000_000, 5)) == 30 and len(frame_times(20_000_000_000, 15)) == 300
     for fps in (15.0, 7.0, 2.0, 12.5, 30.0, 50.0):

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from runner import registry
+from runner.plugin import registry
 from tests.conftest import read_mcap, run_cli
 
 PACKAGE = Path(__file__).parent / "thirdparty_plugin"

@@ -17,9 +17,9 @@ from mcap.records import MessageIndex
 from mcap_ros2.decoder import DecoderFactory
 
 from bench import recorder as bench
-from runner import msgs
-from runner.record import Recorder, read_summary
-from runner.transport import encoding_for, free_port, make_config, pack_attachment
+from runner.record.recorder import Recorder, read_summary
+from runner.wire import msgs
+from runner.wire.transport import encoding_for, free_port, make_config, pack_attachment
 
 # A regression floor, not the target (50k messages/s, bench/recorder.py): on this 2-core machine both entry
 # points sustain 100-250k messages/s depending on load (the old recorder: 60-100k). 15k stays clear of a
@@ -199,8 +199,8 @@ def test_a_recording_reads_at_every_chunk_while_it_is_written(tmp_path: Path):
 _KILLED_WRITER = """
 import os, signal, sys
 from pathlib import Path
-from runner import msgs
-from runner.record import Recorder
+from runner.wire import msgs
+from runner.record.recorder import Recorder
 
 path = Path(sys.argv[1])
 rec = Recorder(path, ["r/**"], chunk_size=1024, guarded=True)

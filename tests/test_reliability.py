@@ -43,8 +43,8 @@ def test_unstable_physics_stops_the_run_naming_the_joint_and_keeps_the_recording
 GAPPY_NODE = """
 import os, struct, time
 import zenoh
-from runner import msgs
-from runner.transport import encoding_for, make_config
+from runner.wire import msgs
+from runner.wire.transport import encoding_for, make_config
 
 run, endpoint = os.environ["SCENARIO_RUN"], os.environ["SCENARIO_ENDPOINT"]
 with zenoh.open(make_config("client", connect=[endpoint])) as s:
@@ -85,7 +85,7 @@ def test_strict_fails_a_run_that_lost_a_message_and_the_table_says_where(write_s
 def test_best_effort_topics_drop_and_every_other_topic_blocks() -> None:
     import zenoh
 
-    from runner.transport import ZenohBus, make_config
+    from runner.wire.transport import ZenohBus, make_config
 
     with zenoh.open(make_config("peer")) as session:
         bus = ZenohBus(session, best_effort=["run/*/camera/**"])
@@ -118,7 +118,7 @@ def _certificates(folder: Path) -> None:
 def test_a_run_over_tls_and_a_plain_client_that_cannot_join(write_scenario, tmp_path: Path) -> None:
     import zenoh
 
-    from runner.transport import free_port, make_config
+    from runner.wire.transport import free_port, make_config
 
     _certificates(tmp_path)
     endpoint = f"tls/127.0.0.1:{free_port()}"
@@ -182,8 +182,8 @@ def test_a_run_over_tls_and_a_plain_client_that_cannot_join(write_scenario, tmp_
 
 def test_the_router_listens_on_loopback_unless_told_otherwise(write_scenario) -> None:
     from runner.compile import compile_plan
-    from runner.loader import load_file
-    from runner.validate import validate_scenario
+    from runner.scenario.loader import load_file
+    from runner.scenario.validate import validate_scenario
 
     doc = load_file(write_scenario("name: quiet\nduration: 1\n"))
     plan = compile_plan(validate_scenario(doc), doc)
@@ -222,7 +222,7 @@ def test_two_runs_of_one_scenario_record_apart_and_are_told_apart(write_scenario
     from mcap.reader import make_reader
 
     from runner.errors import RunError
-    from runner.tools import find_run, running_runs
+    from runner.launch.announce import find_run, running_runs
 
     path = write_scenario(
         """
@@ -280,7 +280,7 @@ def test_a_stray_publisher_on_cmd_vel_is_rejected_counted_and_never_recorded(
     from mcap.reader import make_reader
     from mcap_ros2.decoder import DecoderFactory
 
-    from runner.transport import free_port, make_config
+    from runner.wire.transport import free_port, make_config
 
     port = free_port()
     path = write_scenario(

@@ -21,7 +21,7 @@ from plugins._render import CameraRenderer, choose_gl_backend, probe_gl_backend
 from plugins.camera import Camera
 from runner import gl
 from runner.sim.world import World
-from runner.transport import MemoryBus
+from runner.wire.transport import MemoryBus
 from tests.helpers import messages, plan_of
 
 REPO = Path(__file__).resolve().parents[1]

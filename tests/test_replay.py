@@ -92,7 +92,7 @@ def test_only_the_scenarios_robots_get_paths() -> None:
     """An SDF world's models are named `<model>/...` like robots: the recorded plan tells them apart."""
     import mujoco
 
-    from runner.pictures import robot_bodies
+    from runner.tools.pictures import robot_bodies
 
     m = mujoco.MjModel.from_xml_string(
         "<mujoco><worldbody>"

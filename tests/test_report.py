@@ -62,7 +62,7 @@ def test_the_report_shows_the_verdict_the_plots_and_the_topics(tmp_path: Path) -
 
 
 def _image(enc: str, w: int, h: int, data: bytes, step: int) -> object:
-    from runner import msgs
+    from runner.wire import msgs
 
     return msgs.from_data(
         "sensor_msgs/msg/Image",
@@ -71,7 +71,7 @@ def _image(enc: str, w: int, h: int, data: bytes, step: int) -> object:
 
 
 def test_camera_images_become_pictures_whatever_their_encoding() -> None:
-    from runner.checks.html import image_rgb
+    from runner.tools.html import image_rgb
 
     px = np.array([[[255, 0, 0], [0, 255, 0]]], np.uint8)  # one row: red, green
     assert (image_rgb(_image("rgb8", 2, 1, px.tobytes(), 6)) == px).all()

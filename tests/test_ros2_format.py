@@ -1,4 +1,4 @@
-"""runner.ros2 writes what rmw_zenoh_cpp writes: topic keys, liveliness tokens, GIDs and attachments.
+"""runner.wire.ros2 writes what rmw_zenoh_cpp writes: topic keys, liveliness tokens, GIDs and attachments.
 
 Golden values and where they come from:
 - Keys and tokens quoted verbatim from ros2/rmw_zenoh, docs/design.md ("Topic and Service name mapping to
@@ -20,8 +20,8 @@ import pytest
 import xxhash
 import zenoh.ext as zext
 
-from runner import ros2
-from runner.ros2 import Qos
+from runner.wire import ros2
+from runner.wire.ros2 import Qos
 
 # ros2/rmw_zenoh, docs/design.md, "Topic and Service name mapping to Zenoh key expressions".
 STRING_HASH = "RIHS01_df668c740482bbd48fb39d76a70dfd4bd59db1288021743503259e948f6b1a18"
@@ -78,7 +78,7 @@ def test_type_hash_golden(ros_type: str, expected: str) -> None:
 
 
 def test_type_hash_form_and_unknown_type() -> None:
-    # the project's extra types (runner.msgs.EXTRA_TYPES) hash too, in the REP-2016 form
+    # the project's extra types (runner.wire.msgs.EXTRA_TYPES) hash too, in the REP-2016 form
     assert re.fullmatch(r"RIHS01_[0-9a-f]{64}", ros2.type_hash("gazebo_msgs/msg/ContactsState"))
     with pytest.raises(KeyError):
         ros2.type_hash("no_such_pkg/msg/Nothing")

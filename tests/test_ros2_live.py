@@ -1,6 +1,6 @@
 """`ros2:`: a run seen the way a ROS 2 system on rmw_zenoh sees it. No ROS here: a plain Zenoh session does
 what rmw_zenoh does (a liveliness query on `@ros2_lv/<domain>/**`, subscribers and publishers on the topic
-keys, with rmw_zenoh's attachments), and checks every byte against `runner.ros2`, whose format is pinned
+keys, with rmw_zenoh's attachments), and checks every byte against `runner.wire.ros2`, whose format is pinned
 by the golden tests of test_ros2_format.py."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 import zenoh
 
-from runner import msgs, ros2
+from runner.wire import msgs, ros2
 from tests.conftest import read_mcap
 from tests.test_bridges import Listener, start_run
 
@@ -124,7 +124,7 @@ def test_a_ros2_system_discovers_reads_and_drives_the_run(write_scenario, tmp_pa
 def test_the_run_joins_a_ros2_router_of_its_own(write_scenario, tmp_path: Path) -> None:
     """`ros2: {router: ...}`: the bridge also joins the ROS 2 side's Zenoh router (rmw_zenohd's role here is
     played by a plain Zenoh router), and a ROS 2 session that knows only that router sees the run."""
-    from runner.transport import free_port, make_config
+    from runner.wire.transport import free_port, make_config
 
     ros_router = f"tcp/127.0.0.1:{free_port()}"
     path = write_scenario(SCENE.replace("ros2: {domain: 7}", f'ros2: {{domain: 3, router: "{ros_router}"}}'))

@@ -18,7 +18,7 @@ import pytest
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 
-from runner.transport import free_port
+from runner.wire.transport import free_port
 from tests.conftest import run_cli
 from tests.test_bridges import start_run
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from runner.transport import free_port
+from runner.wire.transport import free_port
 from tests.conftest import REPO, SCENARIOS, processes_of, read_mcap, run_cli, scenario_cmd
 
 # topic suffix -> rate (sim Hz) in scenarios/two_robots.yaml
@@ -104,8 +104,8 @@ def test_info_lists_topics_and_span(demo_run):
 CLIENT = textwrap.dedent(
     """
     import sys, time, zenoh
-    from runner import msgs
-    from runner.transport import encoding_for, make_config
+    from runner.wire import msgs
+    from runner.wire.transport import encoding_for, make_config
 
     endpoint, run = sys.argv[1], sys.argv[2]
     deadline = time.monotonic() + 20

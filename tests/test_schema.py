@@ -11,8 +11,8 @@ import pytest
 import yaml
 from pydantic import ValidationError
 
-from runner.jsonschema import installed_params, render
-from runner.schema import Scenario
+from runner.scenario.jsonschema import installed_params, render
+from runner.scenario.schema import Scenario
 from tests.conftest import REPO
 
 
@@ -233,7 +233,7 @@ def test_every_installed_plugin_has_its_params_rule_and_its_defaults_pass() -> N
     required keys given) passes its rule; no key is required (the description may give it)."""
     from jsonschema import Draft202012Validator
 
-    from runner.jsonschema import build
+    from runner.scenario.jsonschema import build
 
     schema = build()
     rules = schema["$defs"]["PluginEntry"]["allOf"]
@@ -275,7 +275,7 @@ def test_params_rules_refuse_nothing_the_model_takes(monkeypatch: pytest.MonkeyP
         model_validator,
     )
 
-    import runner.jsonschema as js
+    import runner.scenario.jsonschema as js
 
     class Inner(BaseModel):
         model_config = ConfigDict(extra="forbid")

@@ -15,15 +15,15 @@ from typing import Any
 import numpy as np
 import pytest
 
-from runner import msgs
 from runner.compile import compile_plan
 from runner.errors import Notices
 from runner.geometry import quat_to_yaw
-from runner.loader import load_file
-from runner.schema import PluginEntry, Scenario
+from runner.scenario.loader import load_file
+from runner.scenario.schema import PluginEntry, Scenario
+from runner.scenario.validate import validate_scenario
 from runner.sim.world import World
-from runner.transport import MemoryBus, unpack_attachment
-from runner.validate import validate_scenario
+from runner.wire import msgs
+from runner.wire.transport import MemoryBus, unpack_attachment
 from tests.conftest import SCENARIOS
 
 SEEDS = ["block_robot", "atom_mapping", "lift_robot", "harmonic_nav", "mycar"]

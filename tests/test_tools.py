@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from runner.transport import free_port
+from runner.wire.transport import free_port
 from tests.conftest import run_cli, scenario_cmd
 
 SCENE = """
@@ -119,8 +119,8 @@ def test_graph_draws_every_plugins_topics_and_the_tools(
     from PIL import Image
 
     from runner.compile import compile_plan
-    from runner.loader import load_file
-    from runner.validate import validate_scenario
+    from runner.scenario.loader import load_file
+    from runner.scenario.validate import validate_scenario
 
     doc = load_file(tmp_path / "scenario.yaml")  # the live run's own file
     plan = compile_plan(validate_scenario(doc), doc)
@@ -169,8 +169,8 @@ def test_teleop_key_presses_publish_the_right_twists(live_run: str) -> None:
 
     import zenoh
 
-    from runner import msgs
-    from runner.transport import make_config
+    from runner.wire import msgs
+    from runner.wire.transport import make_config
 
     got: list[tuple[float, float]] = []
 

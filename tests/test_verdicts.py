@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 
-from runner import msgs
-from runner.checks.report import judge_for
 from runner.sim.world import World
-from runner.transport import MemoryBus, unpack_attachment
+from runner.tools.report import judge_for
+from runner.wire import msgs
+from runner.wire.transport import MemoryBus, unpack_attachment
 from tests.conftest import REPO, run_cli, start_cli
 from tests.helpers import plan_of
 

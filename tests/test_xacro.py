@@ -60,8 +60,8 @@ def test_explicit_package_map_wins(tmp_path: Path):
 def test_a_urdf_named_file_that_uses_xacro_is_expanded(tmp_path: Path):
     """Launch files run xacro on `.urdf` files too (nav2's sam_bot): the content decides, not the name."""
     from runner.compile import compile_plan
-    from runner.loader import load_file
-    from runner.validate import validate_scenario
+    from runner.scenario.loader import load_file
+    from runner.scenario.validate import validate_scenario
 
     (tmp_path / "bot.urdf").write_text(
         '<robot name="bot" xmlns:xacro="http://www.ros.org/wiki/xacro">'

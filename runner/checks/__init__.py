@@ -7,8 +7,8 @@ from collections.abc import Sequence
 from typing import Any
 
 from runner.errors import Location, Problem, ScenarioError
-from runner.loader import Document, PathKey
-from runner.schema import MessageCheck, NoCollision, Scenario, TopicRate
+from runner.scenario.loader import Document, PathKey
+from runner.scenario.schema import MessageCheck, NoCollision, Scenario, TopicRate
 
 POSE_KINDS = ("reach", "stay_within", "max_speed", "max_tilt", "distance_traveled")
 
@@ -121,7 +121,7 @@ def specs_from_plan(raw: list[dict[str, Any]]) -> list[Any]:
     """The assertion models back from a RunPlan's plain data."""
     from pydantic import TypeAdapter
 
-    from runner.schema import Assertion
+    from runner.scenario.schema import Assertion
 
     adapter: TypeAdapter[Any] = TypeAdapter(Assertion)
     return [adapter.validate_python(a) for a in raw]

@@ -841,7 +841,7 @@ def check_fields(expr: Expr, type_name: str, condition: bool = True) -> None:
     must give true or false, as `Expr.test` requires. Raises ExprError."""
     from rosbags.typesys.base import Nodetype
 
-    from runner.msgs import TYPESTORE, normalize_type
+    from runner.wire.msgs import TYPESTORE, normalize_type
 
     type_name = normalize_type(type_name)
     if type_name not in TYPESTORE.fielddefs:

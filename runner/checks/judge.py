@@ -17,7 +17,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from runner.schema import (
+from runner.scenario.schema import (
     DistanceTraveled,
     MaxSpeed,
     MaxTilt,
@@ -89,7 +89,7 @@ class Result:
         }
 
 
-# How a run that did not reach its planned end ended (runner.launch's reasons, runner.interrupts.ending)
+# How a run that did not reach its planned end ended (runner.launch.run's reasons, runner.interrupts.ending)
 ENDINGS = {
     "interrupted": "interrupted",
     "terminated": "terminated (SIGTERM)",

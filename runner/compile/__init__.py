@@ -15,7 +15,6 @@ from typing import Any
 import mujoco
 from pydantic import ValidationError
 
-from runner import msgs
 from runner.checks import assertion_keys, check_names, truth_robots
 from runner.checks.judge import TRUTH_RATE, TRUTH_TOPIC, contacts_key
 from runner.compile.gazebo import DescribedPlugin
@@ -27,7 +26,6 @@ from runner.compile.wheels import anisotropic_wheels, check_geometry, wheel_link
 from runner.compile.xacro_expand import expand
 from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError
 from runner.geometry import rpy_to_quat
-from runner.loader import Document, MappedDocument, PathKey
 from runner.plan import (
     FoxglovePlan,
     NodePlan,
@@ -37,14 +35,14 @@ from runner.plan import (
     RunPlan,
     TimelinePlan,
     TopicPlan,
-    hidden_topic,
-    topic_key,
 )
 from runner.plugin import BuildContext, PluginConfigError
-from runner.registry import PluginLookupError, drive_frames, load
-from runner.schema import NoCollision, PluginEntry, Record, Robot, Scenario, WorldModel
-from runner.transport import zenoh_reason
-from runner.validate import validate_model
+from runner.plugin.registry import PluginLookupError, drive_frames, load
+from runner.scenario.loader import Document, MappedDocument, PathKey
+from runner.scenario.schema import NoCollision, PluginEntry, Record, Robot, Scenario, WorldModel
+from runner.scenario.validate import validate_model
+from runner.wire import msgs
+from runner.wire.transport import hidden_topic, topic_key, zenoh_reason
 
 _GEOM = {
     "box": mujoco.mjtGeom.mjGEOM_BOX,
@@ -64,11 +62,11 @@ def load_plan(doc: Document, *, record_path: str | None = None, notices: Notices
     """A document checked and compiled in one pass that reports every independent mistake at once, in the
     file's order: the schema's, the cross-field rules', and compile's (robots, plugins and their
     parameters, timeline data, expressions, bridges, nodes...). Where the schema refuses part of the
-    file, that part is taken out (`runner.validate.prune`) and the rest is checked all the same; what
+    file, that part is taken out (`runner.scenario.validate.prune`) and the rest is checked all the same; what
     follows from the part taken out (a reference to a robot that was taken out) is not reported."""
     from pydantic import ValidationError
 
-    from runner.validate import check_document, problems_from_validation, prune
+    from runner.scenario.validate import check_document, problems_from_validation, prune
 
     check_document(doc)
     problems = Problems(doc.file)
@@ -117,7 +115,7 @@ def _check_and_compile(
 ) -> tuple[RunPlan | None, str | None]:
     """(the plan or None, why the checks stopped early or None); the problems found go to `problems`.
     Two robots or models of one name stop them before compile: compiling those would only add noise."""
-    from runner.validate import consistency_problems
+    from runner.scenario.validate import consistency_problems
 
     rules = consistency_problems(sc, doc)
     problems.add(rules)

@@ -21,11 +21,12 @@ from typing import Any
 
 import zenoh
 
-from runner import msgs
 from runner.errors import Problem, ScenarioError
-from runner.loader import Document, PathKey, load_file
-from runner.plan import BridgePlan, NodePlan, Ros2Plan, RunPlan, hidden_topic, topic_key
-from runner.schema import Bridge, Ros2, Scenario
+from runner.plan import BridgePlan, NodePlan, Ros2Plan, RunPlan
+from runner.scenario.loader import Document, PathKey, load_file
+from runner.scenario.schema import Bridge, Ros2, Scenario
+from runner.wire import msgs
+from runner.wire.transport import hidden_topic, topic_key
 
 _GZ_DIRECTIONS = {"GZ_TO_ROS": "SIM_TO_ZENOH", "ROS_TO_GZ": "ZENOH_TO_SIM", "BIDIRECTIONAL": "BIDIRECTIONAL"}
 _FILE_KEYS = {
@@ -94,7 +95,7 @@ class _Topics:
 
 
 def _ros2_plan(setting: Ros2 | bool | None, default: Ros2 | None, run: str) -> Ros2Plan | None:
-    from runner.ros2 import valid_node_name
+    from runner.wire.ros2 import valid_node_name
 
     if setting is False or (setting is None and default is None):
         return None
@@ -178,7 +179,7 @@ def attach_bridges(plan: RunPlan, sc: Scenario, doc: Document, unchecked: Sequen
         plan.nodes.append(
             NodePlan(
                 name=name,
-                argv=[sys.executable, "-m", "runner.bridge"],
+                argv=[sys.executable, "-m", "runner.launch.bridge"],
                 env={"SCENARIO_BRIDGE": json.dumps(spec)},
                 cwd=str(doc.base_dir),
                 required=True,  # a bridge lost is a run that no longer does what it says

@@ -30,8 +30,6 @@ import numpy as np
 from runner.compile.meshes import mesh_cache
 
 VERSION = 3  # of the algorithm: part of the cache key
-RAY_GROUP = 4  # the mesh itself: no contacts, hit by rays
-PIECES_GROUP = 5  # its pieces: contacts, not hit by rays, never drawn
 THICKNESS = 0.02  # metres behind each face of an open or non-convex part
 _MERGE = 1e-6  # vertices closer than this are one
 _PLANE_ANGLE = 1e-4  # normals this close (1 - cos) are one plane ...

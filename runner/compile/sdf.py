@@ -45,14 +45,15 @@ import mujoco
 import numpy as np
 from lxml import etree
 
-from runner.compile.decompose import PIECES_GROUP, RAY_GROUP, cached_decomposition, decompose_file
+from runner.compile.decompose import cached_decomposition, decompose_file
 from runner.compile.materials import gazebo_material
 from runner.compile.meshes import MeshError, prepare_mesh
 from runner.compile.packages import URI_RE, PackageMap
 from runner.compile.urdf import COLLISION_GROUP
 from runner.errors import Notices, SourceError
 from runner.geometry import rpy_to_quat
-from runner.schema import Ground
+from runner.plugin import PIECES_GROUP, RAY_GROUP
+from runner.scenario.schema import Ground
 
 
 class SdfError(SourceError):

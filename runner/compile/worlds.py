@@ -12,9 +12,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from runner.errors import Notices, Problem, Problems, ScenarioError
-from runner.loader import Document, MappedDocument, PathKey
 from runner.plan import NodePlan, RunPlan
-from runner.schema import NoCollision, Scenario, World
+from runner.scenario.loader import Document, MappedDocument, PathKey
+from runner.scenario.schema import NoCollision, Scenario, World
 
 _ROBOT_KINDS = ("reach", "stay_within", "max_speed", "max_tilt", "distance_traveled")
 _TOPIC_KINDS = ("topic_rate", "message")

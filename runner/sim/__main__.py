@@ -14,14 +14,14 @@ import time
 
 import zenoh
 
-from runner.graph import GraphTokens
 from runner.sim.child import StopFlag, mujoco_warnings_to_stderr, parse, process_name
 from runner.sim.world import World
-from runner.transport import ZenohBus, make_config, meta_key
+from runner.wire.graph import GraphTokens
+from runner.wire.transport import ZenohBus, make_config, meta_key
 
 READY_TIMEOUT_S = 60.0  # the runner (of this host) listening; parts of other hosts may come late
 # every part of the run up, other hosts included: longer than the main runner waits for them
-# (runner.launch.HOST_JOIN_TIMEOUT_S), so that it is the runner that gives up and says why
+# (runner.launch.run.HOST_JOIN_TIMEOUT_S), so that it is the runner that gives up and says why
 START_TIMEOUT_S = 240.0
 END_ACK_TIMEOUT_S = 10.0
 

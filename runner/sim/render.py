@@ -21,10 +21,10 @@ from typing import Any
 
 import zenoh
 
-from runner.graph import GraphTokens
 from runner.sim.child import StopFlag, mujoco_warnings_to_stderr, parse, process_name
 from runner.sim.world import _STATE_HEAD, World
-from runner.transport import ZenohBus, make_config, meta_key
+from runner.wire.graph import GraphTokens
+from runner.wire.transport import ZenohBus, make_config, meta_key
 
 MATCH_TIMEOUT_S = 5.0
 

@@ -22,18 +22,38 @@ the transport has no latching, and a viewer that seeks into a recording needs th
 from __future__ import annotations
 
 import warnings
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import mujoco
 import numpy as np
 
 from plugins._common import tf_transforms
-from runner import msgs
 from runner.frames import prefixed_urdf
-from runner.registry import drive_frames
+from runner.plugin.registry import drive_frames
+from runner.wire import msgs
 
 if TYPE_CHECKING:
-    from runner.sim.world import World
+    from runner.plan import RunPlan
+    from runner.plugin import RobotHandle
+
+
+class Outgoing(Protocol):
+    def publish(self, msg: Any, stamp_ns: int) -> None: ...
+
+    def publish_cdr(self, payload: bytes, stamp_ns: int) -> None: ...
+
+
+class WorldView(Protocol):
+    """What the scene needs of the world process (runner.sim.world.World): its plan, model and data, its
+    robots, and publishers of its own (counted and stamped as the world's)."""
+
+    plan: RunPlan
+    model: mujoco.MjModel
+    data: mujoco.MjData
+    robots: list[RobotHandle]
+
+    def make_publisher(self, key: str, type_name: str) -> Outgoing: ...
+
 
 TF = "tf2_msgs/msg/TFMessage"
 STATE = "std_msgs/msg/Float64MultiArray"
@@ -145,13 +165,13 @@ def _add_geom(fm: Any, m: mujoco.MjModel, g: int, rgba: Any, prims: dict[str, li
 class SceneFeed:
     """The world's hooks for the 3D view (see the module docstring)."""
 
-    def __init__(self, world: World):
+    def __init__(self, world: WorldView):
         plan, m, d = world.plan, world.model, world.data
         self.world = world
         rate = plan.foxglove.rate
         self.period_ns = round(1e9 / rate)
         self.tf_period_ns = round(1e9 / plan.foxglove.tf_rate)
-        make = world._make_publisher
+        make = world.make_publisher
         self.scene_out = make(f"{plan.name}/scene", "foxglove.SceneUpdate")
         self.scene_bytes = scene_update(m, 0)
         self.descriptions = [
@@ -213,20 +233,19 @@ class SceneFeed:
         return [(self.slow, self.period_ns), (self.fast, self.tf_period_ns)]
 
     def slow(self, now_ns: int) -> None:
-        world = self.world
         if now_ns == 0:
-            world.publish(self.model_out, msgs.T["std_msgs/msg/String"](data=self.mjcf), now_ns)
-        world.publish_cdr(self.scene_out, self.scene_bytes, now_ns)
+            self.model_out.publish(msgs.T["std_msgs/msg/String"](data=self.mjcf), now_ns)
+        self.scene_out.publish_cdr(self.scene_bytes, now_ns)
         for out, urdf in self.descriptions:
-            world.publish(out, msgs.T["std_msgs/msg/String"](data=urdf), now_ns)
+            out.publish(msgs.T["std_msgs/msg/String"](data=urdf), now_ns)
         if self.static_out is not None:
-            world.publish(self.static_out, tf_transforms(now_ns, self.static), now_ns)
+            self.static_out.publish(tf_transforms(now_ns, self.static), now_ns)
 
     def fast(self, now_ns: int) -> None:
         d = self.world.data
         state = np.concatenate((d.qpos, d.mocap_pos.reshape(-1), d.mocap_quat.reshape(-1)))
-        self.world.publish(self.state_out, msgs.T[STATE](layout=self._layout, data=state), now_ns)
+        self.state_out.publish(msgs.T[STATE](layout=self._layout, data=state), now_ns)
         if self.tf_out is None:
             return
         entries = [(WORLD, f, d.xpos[b], d.xquat[b]) for f, b in zip(self._frames, self.moving, strict=True)]
-        self.world.publish(self.tf_out, tf_transforms(now_ns, entries), now_ns)  # type: ignore[arg-type]
+        self.tf_out.publish(tf_transforms(now_ns, entries), now_ns)  # type: ignore[arg-type]

@@ -35,64 +35,16 @@ from typing import Any, Literal
 import mujoco
 import numpy as np
 
-from runner import msgs
-from runner.cdr import Layout
-from runner.frames import frame_id
-from runner.plan import RobotPlan, RunPlan, topic_key
-from runner.plugin import Plugin, Publisher, RuntimeContext, overrides
-from runner.registry import load
-from runner.transport import ATTACHMENT as _ATT
-from runner.transport import Bus
+from runner.plan import RunPlan
+from runner.plugin import Plugin, Publisher, RobotHandle, RuntimeContext, overrides
+from runner.plugin.registry import load
+from runner.wire import msgs
+from runner.wire.cdr import Layout
+from runner.wire.transport import ATTACHMENT as _ATT
+from runner.wire.transport import Bus, topic_key
 
 # Without anything due, the loop still stops this often (sim time) to take input and check for a stop.
 MAX_BATCH_NS = 10_000_000
-
-
-class RobotHandle:
-    """A robot inside the compiled world: its MuJoCo ids and its names (prefixed and namespaced)."""
-
-    def __init__(self, model: mujoco.MjModel, plan: RobotPlan):
-        self.model = model
-        self.name = plan.name
-        self.namespace = plan.namespace
-        self.prefix = plan.prefix
-        self.plan = plan
-        self.root_link = plan.root
-        self.root_body = self.body_id(plan.root)
-        self.body_ids = {b for b in range(model.nbody) if (model.body(b).name or "").startswith(self.prefix)}
-        self.geom_ids = np.array(
-            [g for g in range(model.ngeom) if int(model.geom_bodyid[g]) in self.body_ids], dtype=np.int32
-        )
-        free = self._id(mujoco.mjtObj.mjOBJ_JOINT, "root", required=False)
-        self.free_joint = free if free >= 0 else None
-
-    def _id(self, kind: mujoco.mjtObj, name: str, required: bool = True) -> int:
-        i = mujoco.mj_name2id(self.model, kind, self.prefix + name)
-        if i < 0 and required:
-            raise KeyError(f"{kind.name} {self.prefix + name!r} not in the model")
-        return i
-
-    def body_id(self, link: str) -> int:
-        return self._id(mujoco.mjtObj.mjOBJ_BODY, link)
-
-    def joint_id(self, name: str) -> int:
-        return self._id(mujoco.mjtObj.mjOBJ_JOINT, name)
-
-    def site_id(self, name: str) -> int:
-        return self._id(mujoco.mjtObj.mjOBJ_SITE, name)
-
-    def actuator_id(self, name: str) -> int:
-        return self._id(mujoco.mjtObj.mjOBJ_ACTUATOR, name)
-
-    def sensor_slice(self, name: str) -> slice:
-        i = self._id(mujoco.mjtObj.mjOBJ_SENSOR, name)
-        adr = int(self.model.sensor_adr[i])
-        return slice(adr, adr + int(self.model.sensor_dim[i]))
-
-    def frame(self, link: str) -> str:
-        """The TF frame id of a link: `<ns>/<link>` (a link already named `<ns>/...`, as xacro
-        `tf_prefix` descriptions do, is not prefixed twice)."""
-        return frame_id(self.namespace, link)
 
 
 @dataclass
@@ -219,7 +171,7 @@ class World:
         if plan.lockstep and session is not None:
             keys = self._remote_subscribed  # the same set: keys subscribed later count too
             self._lockstep = Lockstep(session, plan.name, plan.lockstep, self._received, keys)
-        self._clock = self._make_publisher(plan.clock_key, "rosgraph_msgs/msg/Clock")
+        self._clock = self.make_publisher(plan.clock_key, "rosgraph_msgs/msg/Clock")
         self._clock_layout = Layout(
             self._clock.type, msgs.T[self._clock.type](clock=msgs.time_msg(0)), ["clock"]
         )
@@ -246,7 +198,7 @@ class World:
         )
 
     # ------------------------------------------------------------------------------------- pub / sub
-    def _make_publisher(self, key: str, type_name: str) -> _Outgoing:
+    def make_publisher(self, key: str, type_name: str) -> _Outgoing:
         out = self._out.get(key)
         if out is None:
             out = _Outgoing(key, type_name, self.bus.publisher(key, type_name))
@@ -265,7 +217,7 @@ class World:
     def _publisher_factory(self, namespace: str) -> Callable[[str, str], Publisher]:
         def make(topic: str, type_name: str) -> Publisher:
             type_name = msgs.normalize_type(type_name)
-            out = self._make_publisher(topic_key(self.plan.name, namespace, topic), type_name)
+            out = self.make_publisher(topic_key(self.plan.name, namespace, topic), type_name)
             return Publisher(out.key, type_name, out.publish, out.publish_cdr)
 
         return make
@@ -319,7 +271,7 @@ class World:
                 h.next_ns = _next_due(h, now)
         while self._timeline_i < len(self._timeline) and self._timeline[self._timeline_i][0] <= now:
             _t, key, type_name, msg = self._timeline[self._timeline_i]
-            self.publish(self._make_publisher(key, type_name), msg, now)
+            self.publish(self.make_publisher(key, type_name), msg, now)
             self._timeline_i += 1
         if self._lockstep is not None:
             # the nodes' answers to the clocks published so far come before their next wait message
@@ -357,7 +309,7 @@ class World:
         self._owner_list: list[int] = self._owner_ids.tolist()
         self._watched_list = [n in watch for n in names]
         self._contact_layouts: dict[tuple[int, ...], Layout] = {}
-        self._contacts = self._make_publisher(contacts_key(self.plan.name), "gazebo_msgs/msg/ContactsState")
+        self._contacts = self.make_publisher(contacts_key(self.plan.name), "gazebo_msgs/msg/ContactsState")
         self._after.append(_Hook(self._publish_contacts, round(1e9 / CONTACTS_RATE)))
 
     def _publish_contacts(self, now: int) -> None:
@@ -562,7 +514,7 @@ class RemoteRender:
     def __init__(self, session: Any, run: str, index: int):
         import zenoh
 
-        from runner.transport import meta_key
+        from runner.wire.transport import meta_key
 
         self.session = session
         self.alive_key = meta_key(run, "render", "alive")
@@ -631,7 +583,7 @@ class Lockstep:
     TIMEOUT_S = 30.0
 
     def __init__(self, session: Any, run: str, names: list[str], received: dict[str, int], keys: set[str]):
-        from runner.transport import meta_key
+        from runner.wire.transport import meta_key
 
         self.waiting: dict[str, int] = {}  # node -> sim time it sleeps until
         self.sent: dict[str, dict[str, int]] = {}  # node -> messages it had published per key by then

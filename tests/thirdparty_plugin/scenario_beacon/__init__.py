@@ -6,8 +6,8 @@ import math
 
 from pydantic import Field
 
-from runner import msgs
 from runner.plugin import BuildContext, Plugin, RatedParams, Topic
+from runner.wire import msgs
 
 
 class BeaconParams(RatedParams):

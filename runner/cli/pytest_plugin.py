@@ -46,7 +46,7 @@ class ScenarioFile(pytest.File):
     _results: dict[str, Any] | None = None
 
     def collect(self) -> Any:
-        from runner.loader import load_file
+        from runner.scenario.loader import load_file
 
         doc = load_file(self.path)
         names = [a.get("name", f"assertion_{i}") for i, a in enumerate(doc.data.get("assertions") or [])]

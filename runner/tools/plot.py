@@ -4,8 +4,8 @@ failure happened; axes in metres, equal aspect, and a legend. Written beside the
 fails, and shown at the top of `scenario report`'s page.
 
 Drawn with Pillow (twice the size, then halved: smooth lines and text); the world comes from the compiled
-model the recording carries (its `_plan`), each robot's colour from `runner.pictures` (the same as in the
-report's plots and in `scenario render`). With several worlds, one panel each.
+model the recording carries (its `_plan`), each robot's colour from `runner.tools.pictures` (the same as in
+the report's plots and in `scenario render`). With several worlds, one panel each.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import numpy as np
 
 from runner.checks import POSE_KINDS, specs_from_plan
 from runner.checks.judge import Result, truth_key
-from runner.pictures import RGB, Footprint, footprints, reach, rgb255, robot_bodies, run_colours
+from runner.tools.pictures import RGB, Footprint, footprints, reach, rgb255, robot_bodies, run_colours
 
 SS = 2  # drawn at this many times the size, then reduced
 PLOT_W, PLOT_H = 760, 600  # the largest plot area of one world (pixels); several worlds share the width
@@ -159,7 +159,7 @@ def _panels(plan: Any, mcap: Path) -> tuple[list[_Panel], dict[str, RGB]]:
     import mujoco
     from mcap.reader import make_reader
 
-    from runner import msgs
+    from runner.wire import msgs
 
     parts = plan.parts()
     keys = {truth_key(part.name, r.namespace): r.name for part in parts for r in part.robots}

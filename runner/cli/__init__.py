@@ -364,7 +364,7 @@ def run(
       scenario run fleet.yaml --host gpu_box
     """
     # Until a run starts its processes (loading, compiling), Ctrl-C and SIGTERM end the command at once:
-    # nothing is started or recorded yet. Then (runner.launch) they stop the run in order, recording kept.
+    # nothing is started or recorded yet. Then (runner.launch.run) they stop the run in order, recording kept.
     interrupts.exit_at_once()
     parsed_rate = _parse_rate(rate)
     for option, values in (("--listen", listen), ("--connect", connect)):
@@ -423,7 +423,7 @@ def run(
         if rc == 130:
             break
     if junit is not None:
-        from runner.checks.report import write_junit
+        from runner.tools.report import write_junit
 
         write_junit(junit, suites)
     if results_json is not None:
@@ -452,8 +452,8 @@ def _warn_windows(plan: Any, duration: float, quiet: bool) -> None:
 def _load_variants(file: Path, record: str | None, variant: int | None) -> list[tuple[str, Any]]:
     """[(label, plan)] of the scenario's matrix variants (one, unlabelled, without a matrix)."""
     from runner.compile import load_plan
-    from runner.loader import load_file
-    from runner.matrix import variants
+    from runner.scenario.loader import load_file
+    from runner.scenario.matrix import variants
 
     found = variants(load_file(file))
     if variant is not None:
@@ -480,11 +480,11 @@ def _run_one(
     show_all: bool = False,
 ) -> tuple[Any, int]:
     from runner.checks.judge import ended_early
-    from runner.checks.report import Suite, _now, judge_for
+    from runner.tools.report import Suite, _now, judge_for
 
     started = _now()
-    from runner.launch import run_plan
-    from runner.transport import free_port, use_run_settings
+    from runner.launch.run import run_plan
+    from runner.wire.transport import free_port, use_run_settings
 
     total = plan.duration_ns / 1e9
     progress = None
@@ -576,7 +576,7 @@ def _run_one(
 
 def _plot(plan: Any, mcap: Path, results: list[Any]) -> None:
     """A failed assertion: the robots' paths, regions and the failure point, as a PNG beside the MCAP."""
-    from runner.checks.plot import trajectory_plot
+    from runner.tools.plot import trajectory_plot
 
     try:
         png = trajectory_plot(plan, mcap, results, mcap.with_suffix(".trajectory.png"))
@@ -638,7 +638,7 @@ def check(
 
     Example: scenario check runs/two_robots.mcap --scenario scenarios/two_robots.yaml
     """
-    from runner.checks.report import Suite, judge_recording, write_junit
+    from runner.tools.report import Suite, judge_recording, write_junit
 
     try:
         plans = _load_variants(scenario, None, variant)
@@ -695,7 +695,7 @@ def test_cmd(
     import subprocess
     import tempfile
 
-    from runner.checks.report import Suite, write_junit
+    from runner.tools.report import Suite, write_junit
 
     files: list[Path] = []
     for p in paths:
@@ -705,8 +705,8 @@ def test_cmd(
     if not no_record:
         out_dir.mkdir(parents=True, exist_ok=True)
 
-    from runner.loader import load_file
-    from runner.matrix import variants
+    from runner.scenario.loader import load_file
+    from runner.scenario.matrix import variants
 
     tasks: list[tuple[Path, int | None, str]] = []
     for f in files:
@@ -740,7 +740,7 @@ def test_cmd(
         suites = list(pool.map(run_one, tasks))
     reports: dict[str, str] = {}
     if not no_record:  # one page per scenario, beside its recording
-        from runner.checks.html import write_report
+        from runner.tools.html import write_report
 
         for s in suites:
             if s.mcap and Path(s.mcap).is_file():
@@ -786,7 +786,7 @@ def test_cmd(
             err.print(f"{s.name}: {s.error}", markup=False, style="red")
         for r in s.results:
             if not r.passed:
-                from runner.checks.report import failure_text
+                from runner.tools.report import failure_text
 
                 err.print(f"{s.name}: {failure_text(r)}", markup=False, style="red")
     if junit is not None:
@@ -797,7 +797,7 @@ def test_cmd(
 
 
 def _print_summary(result: Any, show_all: bool = False) -> None:
-    from runner.plan import hidden_key
+    from runner.wire.transport import hidden_key
 
     table = Table(
         "topic",
@@ -848,8 +848,8 @@ def info(
 
     Example: scenario info runs/two_robots.mcap
     """
-    from runner.plan import hidden_key
-    from runner.record import read_summary, recording_live
+    from runner.record.recorder import read_summary, recording_live
+    from runner.wire.transport import hidden_key
 
     if not mcap.is_file():
         raise _fail(RunError(f"{mcap}: file not found"))
@@ -915,7 +915,7 @@ def report(
 
     Example: scenario report runs/two_robots.mcap -o two_robots.html
     """
-    from runner.checks.html import write_report
+    from runner.tools.html import write_report
 
     if not mcap.is_file():
         raise _fail(RunError(f"{mcap}: file not found"))
@@ -973,7 +973,7 @@ def render(
       scenario render runs/two_robots.mcap -o two_robots.mp4
       scenario render runs/two_robots.mcap -o r1.gif --camera chase:r1 --size 480x360
     """
-    from runner import replay
+    from runner.launch.announce import replay
 
     try:
         w, h = (int(v) for v in size.lower().split("x"))
@@ -1044,7 +1044,7 @@ def recover(
 
     Example: scenario recover runs/two_robots.mcap
     """
-    from runner.record import recover as do_recover
+    from runner.record.recorder import recover as do_recover
 
     if not mcap.is_file():
         raise _fail(RunError(f"{mcap}: file not found"))
@@ -1067,7 +1067,7 @@ def schema(
     check: Annotated[bool, typer.Option(help="Exit 1 if the file differs instead of writing it.")] = False,
 ) -> None:
     """Write the JSON Schema of the scenario format (for editors, via yaml-language-server)."""
-    from runner.jsonschema import render
+    from runner.scenario.jsonschema import render
 
     text = render()
     if check:
@@ -1097,7 +1097,7 @@ def _tool_tokens(session: Any, run: str, tool: str) -> Any:
     the tokens go with the session."""
     import os
 
-    from runner.graph import GraphTokens
+    from runner.wire.graph import GraphTokens
 
     return GraphTokens(session, run, f"{tool}-{os.getpid()}", "tool")
 
@@ -1122,9 +1122,9 @@ def echo(
 
     import yaml
 
-    from runner import msgs
-    from runner.tools import field_of, find_run, joined, key_of
-    from runner.transport import type_from_encoding, unpack_attachment
+    from runner.launch.announce import field_of, find_run, joined, key_of
+    from runner.wire import msgs
+    from runner.wire.transport import type_from_encoding, unpack_attachment
 
     try:
         name, endpoints = find_run(run_name, connect)
@@ -1209,9 +1209,9 @@ def pub(
     import yaml
     import zenoh
 
-    from runner import msgs
-    from runner.tools import find_run, joined, key_of, wait_matched
-    from runner.transport import encoding_for, pack_attachment, unpack_attachment
+    from runner.launch.announce import find_run, joined, key_of, wait_matched
+    from runner.wire import msgs
+    from runner.wire.transport import encoding_for, pack_attachment, unpack_attachment
 
     try:
         full_type = msgs.normalize_type(type_name)
@@ -1281,10 +1281,9 @@ def topics(
     """
     import time
 
-    from runner.graph import query_graph
-    from runner.plan import hidden_key
-    from runner.tools import find_run, joined
-    from runner.transport import type_from_encoding, unpack_attachment
+    from runner.launch.announce import find_run, joined
+    from runner.wire.graph import query_graph
+    from runner.wire.transport import hidden_key, type_from_encoding, unpack_attachment
 
     try:
         name, endpoints = find_run(run_name, connect)
@@ -1367,9 +1366,9 @@ def graph(
       scenario graph
       scenario graph -o docs/two_robots_graph --run two_robots
     """
-    from runner.graph import query_graph
-    from runner.graph_draw import render_png, summary_lines, to_dot
-    from runner.tools import find_run, joined
+    from runner.launch.announce import find_run, joined
+    from runner.tools.graph_draw import render_png, summary_lines, to_dot
+    from runner.wire.graph import query_graph
 
     try:
         name, endpoints = find_run(run_name, connect)
@@ -1436,9 +1435,9 @@ def teleop(
 
     import zenoh
 
-    from runner import msgs
-    from runner.tools import find_run, joined, key_of
-    from runner.transport import encoding_for, pack_attachment
+    from runner.launch.announce import find_run, joined, key_of
+    from runner.wire import msgs
+    from runner.wire.transport import encoding_for, pack_attachment
 
     try:
         name, endpoints = find_run(run_name, connect)
@@ -1529,7 +1528,3 @@ def main() -> None:
     except KeyboardInterrupt:
         err.print("interrupted", markup=False)
         sys.exit(143 if interrupts.terminated() else 130)
-
-
-if __name__ == "__main__":
-    main()

@@ -1,9 +1,9 @@
 """What the pictures of a run share: each robot's colour, the world seen from above, and what is near
 enough to the robots to be framed.
 
-Three pictures show a run's robots: the trajectory plot (`runner.checks.plot`), the report's signal plots
-(`runner.checks.html`) and `scenario render` (`runner.replay`). Each robot has one colour in all three: its
-own, as MuJoCo renders it (the colour of the largest part of the first body of the robot that has a
+Three pictures show a run's robots: the trajectory plot (`runner.tools.plot`), the report's signal plots
+(`runner.tools.html`) and `scenario render` (`runner.tools.replay`). Each robot has one colour in all three:
+its own, as MuJoCo renders it (the colour of the largest part of the first body of the robot that has a
 sizeable one: its base link), unless that colour says nothing (grey, black, white: a URDF without a
 material renders grey) or is the colour an earlier robot already has (two robots from one xacro file);
 then a colour of a fixed palette, taken by the robot's place in the scenario. A colour too light to read

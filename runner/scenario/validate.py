@@ -15,8 +15,8 @@ from typing import Annotated, Any, TypeVar, get_args, get_origin
 from pydantic import BaseModel, ValidationError
 
 from runner.errors import Problem, ScenarioError
-from runner.loader import Document, PathKey
-from runner.schema import PATTERN_WORDS, Scenario
+from runner.scenario.loader import Document, PathKey
+from runner.scenario.schema import PATTERN_WORDS, Scenario
 
 M = TypeVar("M", bound=BaseModel)
 

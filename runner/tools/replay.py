@@ -4,7 +4,7 @@ A recording carries the compiled model (`<run>/_model`, MJCF) and the state (`<r
 mocap poses, at `foxglove.tf_rate`). Each frame poses the model at the last state at or before its time,
 and MuJoCo's offscreen renderer draws it (EGL or OSMesa: on the CPU where there is no GPU), from above the
 whole scene (`overview`: every model and every robot wherever it goes, filling the picture) or following
-a robot (`chase:r1`), with each robot's path so far drawn in the robot's colour (`runner.pictures`: the
+a robot (`chase:r1`), with each robot's path so far drawn in the robot's colour (`runner.tools.pictures`: the
 same as in the trajectory plot and the report).
 
 A video has one frame every 1/fps sim seconds and plays for as long as the run took in sim time. `.mp4` is
@@ -28,7 +28,7 @@ import mujoco
 import numpy as np
 
 from runner.errors import RunError
-from runner.pictures import (
+from runner.tools.pictures import (
     FRAME_REACH_M,
     FRAME_REACH_SPANS,
     PALETTE,
@@ -59,7 +59,7 @@ class Recording:
 def load(mcap: Path, world: str | None = None) -> Recording:
     from mcap.reader import make_reader
 
-    from runner import msgs
+    from runner.wire import msgs
 
     mjcf: dict[str, str] = {}
     states: dict[str, list[tuple[int, np.ndarray]]] = {}
@@ -103,7 +103,7 @@ def _plan_of(plan_json: str) -> Any:
 
 
 def colours(m: mujoco.MjModel, rec: Recording) -> dict[str, RGB]:
-    """Each robot's colour: the one it has in the trajectory plot and the report (`runner.pictures`)."""
+    """Each robot's colour: the one it has in the trajectory plot and the report (`runner.tools.pictures`)."""
     if rec.plan is not None:
         return run_colours(rec.plan, {rec.run: m})
     return model_colours(m, rec.robots)

@@ -24,15 +24,15 @@ from typing import Any
 
 import zenoh
 
-from runner import msgs
 from runner.errors import RunError
-from runner.graph import GraphTokens
 from runner.interrupts import ending, interruptible
-from runner.nodes import NodeError, Nodes, OutputTail
+from runner.launch.announce import announce, update_announcement, withdraw
+from runner.launch.nodes import NodeError, Nodes, OutputTail
 from runner.plan import NodePlan, RunPlan
-from runner.record import Recorder, TopicStats
-from runner.tools import announce, update_announcement, withdraw
-from runner.transport import free_port, make_config, meta_key, unpack_attachment, zenoh_reason
+from runner.record.recorder import Recorder, TopicStats
+from runner.wire import msgs
+from runner.wire.graph import GraphTokens
+from runner.wire.transport import free_port, make_config, meta_key, unpack_attachment, zenoh_reason
 
 STOP_GRACE_S = 1.2  # after SIGINT, how long the world gets before SIGKILL
 DRAIN_TIMEOUT_S = 3.0  # how long the recorder waits for messages still in flight at the end
@@ -263,7 +263,7 @@ def run_plan(
 
     live = None
     if foxglove_port is not None:  # `--foxglove PORT`: the run, live, to Foxglove
-        from runner.live import LiveView
+        from runner.launch.live import LiveView
 
         try:
             live = LiveView(session, plan.name, foxglove_port)
@@ -619,8 +619,8 @@ def _judge_subscribers(
 ) -> list[Any]:
     """Decode what the judge reads and feed it; with `stop_on`, say when the run can end. Keys the recorder
     records come from it, in its order and thread (no subscription of their own); others are subscribed."""
-    from runner import msgs
     from runner.checks.judge import judged_types
+    from runner.wire import msgs
 
     types = judged_types(plan)
     lock = threading.Lock()
@@ -656,7 +656,7 @@ def _world_env(plan: RunPlan) -> dict[str, str]:
     """The world process's environment; with a camera, an OpenGL backend that a test render proved
     (EGL, else OSMesa), unless the user chose one with MUJOCO_GL."""
     from runner import gl
-    from runner.registry import load
+    from runner.plugin.registry import load
 
     env = dict(os.environ)
     if not any(load(p.type).renders for r in plan.robots for p in r.plugins):

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 from rosbags.typesys.base import Nodetype
 
-from runner import msgs
+from runner.wire import msgs
 
 _SIZE = {
     "bool": 1,

@@ -19,8 +19,8 @@ from typing import Any
 
 import numpy as np
 
-from runner import msgs
 from runner.errors import RunError
+from runner.wire import msgs
 
 STYLE = """
 body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;margin:2em auto;max-width:1000px;
@@ -101,7 +101,7 @@ def _camera_frames(mcap: Path, summary: dict[str, Any], n: int = 3) -> tuple[str
     before depth ones); read one message at a time, so a long run's images never sit in memory."""
     from mcap.reader import make_reader
 
-    from runner.plan import hidden_key
+    from runner.wire.transport import hidden_key
 
     cams = [
         t for t in summary["topics"] if t["type"] == "sensor_msgs/msg/Image" and not hidden_key(t["topic"])
@@ -207,11 +207,11 @@ def _png_uri(path_or_rgb: Path | np.ndarray) -> str:
 
 def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
     from runner.checks.judge import truth_key
-    from runner.checks.plot import trajectory_plot
-    from runner.checks.report import judge_recording
-    from runner.pictures import NEUTRAL, hex_colour, run_colours
-    from runner.plan import hidden_key
-    from runner.record import read_summary
+    from runner.record.recorder import read_summary
+    from runner.tools.pictures import NEUTRAL, hex_colour, run_colours
+    from runner.tools.plot import trajectory_plot
+    from runner.tools.report import judge_recording
+    from runner.wire.transport import hidden_key
 
     plan = plan or load_plan(mcap)
     summary = read_summary(mcap)

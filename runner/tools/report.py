@@ -27,7 +27,7 @@ def judge_recording(plan: Any, mcap: Path) -> tuple[list[Result], int, str | Non
     without it (cut, or older) counts as complete only if it reaches the planned duration."""
     from mcap.reader import make_reader
 
-    from runner import msgs
+    from runner.wire import msgs
 
     judge = judge_for(plan)
     if judge is None:

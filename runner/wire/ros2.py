@@ -34,7 +34,7 @@ from functools import cache
 
 import xxhash
 
-from runner.msgs import TYPESTORE, normalize_type
+from runner.wire.msgs import TYPESTORE, normalize_type
 
 ADMIN_SPACE = "@ros2_lv"
 DEFAULT_DEPTH = 10  # what rclcpp/rclpy give a publisher or subscription created with a plain depth
@@ -118,7 +118,7 @@ def ros_type_from_dds(dds: str) -> str | None:
 
 @cache
 def type_hash(ros_type: str) -> str:
-    """The REP-2016 type hash, `RIHS01_` + 64 lowercase hex, of a type in `runner.msgs.TYPESTORE`."""
+    """The REP-2016 type hash, `RIHS01_` + 64 lowercase hex, of a type in `runner.wire.msgs.TYPESTORE`."""
     name = "/".join(_split_type(ros_type))
     try:
         return str(TYPESTORE.hash_rihs01(name))

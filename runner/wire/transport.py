@@ -62,6 +62,25 @@ def meta_key(run: str, *parts: str) -> str:
     return "/".join((run, META, *parts))
 
 
+def hidden_topic(rel: str) -> bool:
+    """The run's own helper topics (`_truth/...`, `_contacts`): a chunk starting with `_`, hidden as ROS
+    hides `_` topics. `rel` is a key without the run's name."""
+    return any(chunk.startswith("_") for chunk in rel.split("/"))
+
+
+def hidden_key(key: str) -> bool:
+    """`hidden_topic` for a full key (`<run>/...`, its first chunk the run's name): what `scenario info`,
+    `topics`, the end-of-run table and the report leave out unless told `--all`."""
+    return hidden_topic(key.split("/", 1)[1] if "/" in key else key)
+
+
+def topic_key(run: str, namespace: str, topic: str) -> str:
+    """`scan` in namespace r1 -> `run/r1/scan`; `/clock` (absolute) -> `run/clock`."""
+    if topic.startswith("/"):
+        return f"{run}{topic}"
+    return f"{run}/{namespace}/{topic}" if namespace else f"{run}/{topic}"
+
+
 def free_port(host: str = "127.0.0.1") -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
         s.bind((host, 0))
@@ -133,7 +152,7 @@ class Bus(Protocol):
 
 
 class ZenohBus:
-    """Publishers and subscribers on a session; with `graph` (a `runner.graph.GraphTokens`), each is also
+    """Publishers and subscribers on a session; with `graph` (a `runner.wire.graph.GraphTokens`), each is also
     announced in the run's graph."""
 
     def __init__(self, session: zenoh.Session, graph: Any = None, best_effort: Sequence[str] = ()):

@@ -24,7 +24,7 @@ from pydantic import BaseModel, PydanticUserError
 from pydantic.json_schema import GenerateJsonSchema, JsonSchemaValue, models_json_schema
 from pydantic_core import CoreSchema, core_schema
 
-from runner.schema import PluginEntry, Scenario
+from runner.scenario.schema import PluginEntry, Scenario
 
 DRAFT = "https://json-schema.org/draft/2020-12/schema"
 REF = "#/$defs/{model}"
@@ -63,7 +63,7 @@ def installed_params() -> list[tuple[str, type[BaseModel]]]:
     """(type, Params model) of every plugin the registry finds, by type name. A plugin that fails to load
     (a broken import, a name registered twice) is left out: the runner refuses it where a scenario uses it,
     and the schema leaves its params open."""
-    from runner import registry
+    from runner.plugin import registry
 
     found: list[tuple[str, type[BaseModel]]] = []
     for name in registry.available():

@@ -23,9 +23,15 @@ import mujoco
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat
 
+from runner.plugin.handle import RobotHandle
+
 if TYPE_CHECKING:
-    from runner.cdr import Layout
-    from runner.sim.world import RobotHandle
+    from runner.wire.cdr import Layout
+
+
+# MuJoCo geom groups with a meaning across the run (compile puts geoms there, sensors read them):
+RAY_GROUP = 4  # a world mesh as drawn: no contacts, hit by rays
+PIECES_GROUP = 5  # its convex pieces: contacts, not hit by rays, never drawn
 
 
 class PluginParams(BaseModel):
@@ -98,7 +104,7 @@ class Publisher:
 
     `publish(msg, stamp)` takes a rosbags message object and encodes it. On hot paths, encode once into a
     fixed layout and send bytes: `layout = pub.layout(template, fields)`, then
-    `pub.publish_cdr(layout.encode(stamp, ...), stamp)` (see `runner.cdr`): a few microseconds a message.
+    `pub.publish_cdr(layout.encode(stamp, ...), stamp)` (see `runner.wire.cdr`): a few microseconds a message.
     """
 
     def __init__(
@@ -121,13 +127,13 @@ class Publisher:
 
     def publish_cdr(self, payload: bytes, stamp_ns: int) -> None:  # type: ignore[no-redef]
         """Publish bytes that are already the CDR encoding of a message of this topic's type."""
-        from runner import msgs
+        from runner.wire import msgs
 
         self.publish(msgs.decode(payload, self.type), stamp_ns)
 
     def layout(self, template: Any, fields: Sequence[str] = ()) -> Layout:
-        """A fixed-layout encoder for this topic's type (see `runner.cdr.Layout`)."""
-        from runner.cdr import Layout
+        """A fixed-layout encoder for this topic's type (see `runner.wire.cdr.Layout`)."""
+        from runner.wire.cdr import Layout
 
         return Layout(self.type, template, fields)
 

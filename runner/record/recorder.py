@@ -38,9 +38,9 @@ from mcap.data_stream import RecordBuilder
 from mcap.opcode import Opcode
 from mcap.records import Channel, ChunkIndex, Header, McapRecord, Schema
 
-from runner import msgs
-from runner.finisher import MAGIC, TRAILER, Guard, Tail
-from runner.transport import ATTACHMENT, type_from_encoding, unpack_attachment
+from runner.record.finisher import MAGIC, TRAILER, Guard, Tail
+from runner.wire import msgs
+from runner.wire.transport import ATTACHMENT, type_from_encoding, unpack_attachment
 
 CHUNK_SIZE = 256 * 1024  # uncompressed bytes per chunk
 ZSTD_LEVEL = 1  # vs the default 3: 10-30% faster here, for the same ratio on sensor data (bench/recorder.py)
@@ -329,7 +329,7 @@ class Recorder:
     chunk_size: int = CHUNK_SIZE
     types: dict[str, str] = field(default_factory=dict)  # the type each known key carries (the plan's)
     inbound: set[str] = field(default_factory=set)  # keys the worlds take from others: checked to decode
-    # a guard process finishes the file if this process dies before it does (kill -9): runner.finisher
+    # a guard process finishes the file if this process dies before it does (kill -9): runner.record.finisher
     guarded: bool = False
 
     def __post_init__(self) -> None:

@@ -21,7 +21,7 @@ from typing import Any
 import zenoh
 
 from runner.errors import RunError
-from runner.transport import make_config, use_run_settings, zenoh_reason
+from runner.wire.transport import make_config, use_run_settings, zenoh_reason
 
 
 def runs_dir() -> Path:

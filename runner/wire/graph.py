@@ -22,8 +22,7 @@ from urllib.parse import quote, unquote
 
 import zenoh
 
-from runner.plan import hidden_topic
-from runner.transport import meta_key
+from runner.wire.transport import hidden_topic, meta_key
 
 ROLES = ("world", "renderer", "node", "bridge", "recorder", "tool")
 

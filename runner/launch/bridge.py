@@ -1,5 +1,5 @@
-"""The bridge process: `python -m runner.bridge`, started by `scenario run` as a node of the run when the
-scenario has `bridges:` or `ros2:`.
+"""The bridge process: `python -m runner.launch.bridge`, started by `scenario run` as a node of the run when
+the scenario has `bridges:` or `ros2:`.
 
 It reads its mappings (`BridgePlan`s, resolved at compile time) from `SCENARIO_BRIDGE` and joins the run
 at `SCENARIO_ENDPOINT` (and a ROS 2 Zenoh router, if one is named). For each mapping:
@@ -9,8 +9,8 @@ at `SCENARIO_ENDPOINT` (and a ROS 2 Zenoh router, if one is named). For each map
 - ZENOH_TO_SIM: a subscriber on the other key (wildcards allowed), a publisher on the sim key; each message
   is checked against the type (JSON is converted to CDR) and stamped with the sim time, as the timeline
   and the command-line tools stamp theirs.
-- with `ros2`, the other side speaks rmw_zenoh (`runner.ros2`): its key, liveliness tokens for the node and
-  each publisher/subscription (so `ros2 topic list` sees them), its attachment on every message.
+- with `ros2`, the other side speaks rmw_zenoh (`runner.wire.ros2`): its key, liveliness tokens for the node
+  and each publisher/subscription (so `ros2 topic list` sees them), its attachment on every message.
 
 Subscriptions take only messages from other processes, so a BIDIRECTIONAL mapping never feeds itself.
 The process is ready (and the run starts) once everything is declared: nothing the world publishes first
@@ -33,10 +33,17 @@ from typing import Any
 import zenoh
 import zenoh.ext
 
-from runner import msgs, ros2
-from runner.graph import GraphTokens
-from runner.plan import BridgePlan, Ros2Plan, hidden_topic
-from runner.transport import encoding_for, make_config, meta_key, pack_attachment, unpack_attachment
+from runner.plan import BridgePlan, Ros2Plan
+from runner.wire import msgs, ros2
+from runner.wire.graph import GraphTokens
+from runner.wire.transport import (
+    encoding_for,
+    hidden_topic,
+    make_config,
+    meta_key,
+    pack_attachment,
+    unpack_attachment,
+)
 
 REMOTE = zenoh.Locality.REMOTE
 LINGER_QUIET_S = 0.2  # on stop, leave once nothing was forwarded for this long...
@@ -152,7 +159,7 @@ class Bridge:
     def mirror_nodes(self, ros: Ros2Plan) -> None:
         """`ros2: {topics: all}`: the topics nodes publish and subscribe to (announced in the run's graph as
         the nodes start) appear to ROS 2 too, as `/<ns>/<topic>`."""
-        from runner.graph import Graph
+        from runner.wire.graph import Graph
 
         def on_token(sample: zenoh.Sample) -> None:
             if sample.kind != zenoh.SampleKind.PUT:
@@ -382,7 +389,9 @@ def main() -> int:
         spec = json.loads(os.environ["SCENARIO_BRIDGE"])
         endpoint = os.environ["SCENARIO_ENDPOINT"]
     except (KeyError, ValueError):
-        print("runner.bridge is started by `scenario run` (SCENARIO_BRIDGE is not set)", file=sys.stderr)
+        print(
+            "runner.launch.bridge is started by `scenario run` (SCENARIO_BRIDGE is not set)", file=sys.stderr
+        )
         return 2
     plans = [BridgePlan.model_validate(b) for b in spec["bridges"]]
     routers = sorted({p.ros2.router for p in plans if p.ros2 is not None and p.ros2.router})

@@ -1,5 +1,5 @@
-"""Draw a run's graph (`runner.graph.Graph`) the way rqt_graph does for ROS: processes, topics, and arrows
-publisher -> topic -> subscriber.
+"""Draw a run's graph (`runner.wire.graph.Graph`) the way rqt_graph does for ROS: processes, topics, and
+arrows publisher -> topic -> subscriber.
 
 - `to_dot(graph)`: Graphviz DOT text, for `dot -Tsvg` where Graphviz is installed;
 - `render_png(graph, path)`: a PNG drawn with Pillow alone, in three columns: processes that mostly
@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from runner.graph import Graph
+from runner.wire.graph import Graph
 
 # role -> (fill, outline); anything else (a process only seen through its endpoints) is grey
 ROLE_COLORS: dict[str, tuple[str, str]] = {

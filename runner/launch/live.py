@@ -4,8 +4,8 @@ Every key of the run becomes a channel the first time it carries a message: ROS 
 their `ros2msg` schema, the scene as `protobuf`; each message is logged with its sim time. Open Foxglove,
 connect to `ws://127.0.0.1:PORT` and the 3D view, plots and images follow the run as it goes; the server
 advertises the `time` capability and sends the sim time, so the viewer's clock is the sim clock. The port
-takes both names of the protocol (`foxglove.websocket.v1`, `foxglove.sdk.v1`: runner.live_gate). The server
-listens on loopback unless a host is given.
+takes both names of the protocol (`foxglove.websocket.v1`, `foxglove.sdk.v1`: runner.launch.live_gate). The
+server listens on loopback unless a host is given.
 """
 
 from __future__ import annotations
@@ -18,9 +18,9 @@ from typing import Any
 
 import zenoh
 
-from runner import msgs
 from runner.errors import RunError
-from runner.transport import type_from_encoding, unpack_attachment
+from runner.wire import msgs
+from runner.wire.transport import type_from_encoding, unpack_attachment
 
 TIME_PERIOD_S = 0.02  # how often viewers are told the sim time, at most (wall)
 
@@ -32,7 +32,7 @@ class LiveView:
             import foxglove
         from foxglove.websocket import Capability
 
-        from runner.live_gate import SubprotocolGate
+        from runner.launch.live_gate import SubprotocolGate
 
         self._fox = foxglove
         self.context = foxglove.Context()
@@ -66,7 +66,7 @@ class LiveView:
             if ch is None:
                 fox = self._fox
                 if type_name.startswith("foxglove."):
-                    from runner.record import foxglove_schema
+                    from runner.record.recorder import foxglove_schema
 
                     s = foxglove_schema(type_name)
                     schema, encoding = fox.Schema(name=s.name, encoding="protobuf", data=s.data), "protobuf"

@@ -32,7 +32,7 @@ IDENT_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")  # world names, ROS 2 node na
 NODE_NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_-]*$")  # nodes and hosts
 
 # What each pattern means, in words, and the characters it allows besides letters, digits and '_'
-# (for error messages: runner.validate).
+# (for error messages: runner.scenario.validate).
 PATTERN_WORDS: dict[str, tuple[str, str]] = {
     RUN_NAME_RE.pattern: (
         "letters, digits, '_', '-' and '.', not starting with '-' or '.' (e.g. my_run)",

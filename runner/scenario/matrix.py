@@ -20,7 +20,7 @@ import re
 from typing import Any
 
 from runner.errors import Problem, ScenarioError
-from runner.loader import Document
+from runner.scenario.loader import Document
 
 _PART = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(-?\d+)\]")
 

@@ -1,0 +1,5 @@
+"""`python -m runner.cli ...`: the `scenario` command."""
+
+from runner.cli import main
+
+main()

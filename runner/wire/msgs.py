@@ -1,0 +1,206 @@
+"""ROS 2 message types: build from YAML data, CDR encode/decode, `ros2msg` schema text.
+
+Backed by the `rosbags` typestore (ROS 2 Jazzy definitions), so the bytes on the wire, in the MCAP file
+and in a ROS 2 node are the same.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from typing import Any
+
+import numpy as np
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+from rosbags.typesys.base import Nodetype
+
+TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
+T = TYPESTORE.types
+
+# Types that ROS 2 Jazzy's store lacks but plugins publish: name -> `.msg` text (as in their ROS packages).
+EXTRA_TYPES = {
+    # gazebo_msgs (gazebo_ros_pkgs, ROS 2): what gazebo_ros_bumper publishes
+    "gazebo_msgs/msg/ContactState": """\
+string info
+string collision1_name
+string collision2_name
+geometry_msgs/Wrench[] wrenches
+geometry_msgs/Wrench total_wrench
+geometry_msgs/Vector3[] contact_positions
+geometry_msgs/Vector3[] contact_normals
+float64[] depths
+""",
+    "gazebo_msgs/msg/ContactsState": """\
+std_msgs/Header header
+gazebo_msgs/ContactState[] states
+""",
+}
+
+
+def _register_extra_types() -> None:
+    """Add `EXTRA_TYPES` to the typestore, so CDR encoding/decoding and `msgdef()` work as for built-ins."""
+    types: dict[str, Any] = {}
+    for name, text in EXTRA_TYPES.items():
+        types.update(get_types_from_msg(text, name))
+    TYPESTORE.register(types)
+
+
+_register_extra_types()
+
+_NUMPY = {
+    "bool": np.bool_,
+    "byte": np.uint8,
+    "char": np.uint8,
+    "int8": np.int8,
+    "uint8": np.uint8,
+    "int16": np.int16,
+    "uint16": np.uint16,
+    "int32": np.int32,
+    "uint32": np.uint32,
+    "int64": np.int64,
+    "uint64": np.uint64,
+    "float32": np.float32,
+    "float64": np.float64,
+}
+
+
+class MessageDataError(ValueError):
+    """Message data (from YAML) does not fit the type. `path` is the field path inside the message."""
+
+    def __init__(self, message: str, path: tuple[str | int, ...] = (), hint: str | None = None):
+        super().__init__(message)
+        self.path = path
+        self.hint = hint
+
+
+def normalize_type(name: str) -> str:
+    """`geometry_msgs/Twist` -> `geometry_msgs/msg/Twist` (the ROS 2 full name)."""
+    parts = name.strip().split("/")
+    if len(parts) == 2:
+        return f"{parts[0]}/msg/{parts[1]}"
+    return name.strip()
+
+
+def is_known(type_name: str) -> bool:
+    return normalize_type(type_name) in T
+
+
+def similar_types(type_name: str, n: int = 3) -> list[str]:
+    import difflib
+
+    return difflib.get_close_matches(normalize_type(type_name), list(T), n=n, cutoff=0.5)
+
+
+def encode(msg: Any, type_name: str) -> bytes:
+    return bytes(TYPESTORE.serialize_cdr(msg, type_name))
+
+
+def decode(data: bytes | memoryview, type_name: str) -> Any:
+    return TYPESTORE.deserialize_cdr(data, type_name)
+
+
+@cache
+def msgdef(type_name: str) -> str:
+    """The `ros2msg` schema text of a type, with its dependencies (as MCAP and Foxglove expect)."""
+    text, _ = TYPESTORE.generate_msgdef(type_name, ros_version=2)
+    return text
+
+
+def time_msg(ns: int) -> Any:
+    return T["builtin_interfaces/msg/Time"](sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+
+
+def header(ns: int, frame_id: str) -> Any:
+    return T["std_msgs/msg/Header"](stamp=time_msg(ns), frame_id=frame_id)
+
+
+# ---------------------------------------------------------------------------------------------- from data
+def _base_value(kind: str, value: Any, path: tuple[str | int, ...]) -> Any:
+    if kind == "string" or kind == "wstring":
+        if not isinstance(value, str):
+            raise MessageDataError(f"expected a string, found {value!r}", path)
+        return value
+    if kind == "bool":
+        if not isinstance(value, bool):
+            raise MessageDataError(f"expected true or false, found {value!r}", path)
+        return value
+    if kind.startswith("float"):
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise MessageDataError(f"expected a number ({kind}), found {value!r}", path)
+        return float(value)
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise MessageDataError(f"expected an integer ({kind}), found {value!r}", path)
+    info = np.iinfo(_NUMPY[kind])
+    if not info.min <= value <= info.max:
+        raise MessageDataError(f"{value} is out of range for {kind} ({info.min}..{info.max})", path)
+    return value
+
+
+def _default_base(kind: str) -> Any:
+    if kind in ("string", "wstring"):
+        return ""
+    if kind == "bool":
+        return False
+    if kind.startswith("float"):
+        return 0.0
+    return 0
+
+
+def _field_value(desc: tuple[Any, Any], value: Any, path: tuple[str | int, ...]) -> Any:
+    node, detail = desc
+    if node == Nodetype.BASE:
+        kind = detail[0]
+        return _default_base(kind) if value is None else _base_value(kind, value, path)
+    if node == Nodetype.NAME:
+        return from_data(detail, value if value is not None else {}, path)
+    # ARRAY (fixed length) or SEQUENCE
+    (inner_node, inner_detail), length = detail
+    items = [] if value is None else value
+    if not isinstance(items, list):
+        raise MessageDataError(f"expected a list, found {value!r}", path)
+    if node == Nodetype.ARRAY and value is not None and len(items) != length:
+        raise MessageDataError(f"expected {length} items, found {len(items)}", path)
+    if inner_node == Nodetype.BASE and inner_detail[0] in _NUMPY:
+        kind = inner_detail[0]
+        vals = [_base_value(kind, v, (*path, i)) for i, v in enumerate(items)]
+        if node == Nodetype.ARRAY and value is None:
+            return np.zeros(length, dtype=_NUMPY[kind])
+        return np.array(vals, dtype=_NUMPY[kind])
+    if node == Nodetype.ARRAY and value is None:
+        items = [None] * length
+    return [_field_value((inner_node, inner_detail), v, (*path, i)) for i, v in enumerate(items)]
+
+
+def from_data(type_name: str, data: Any, path: tuple[str | int, ...] = ()) -> Any:
+    """Build a message from plain data (a YAML mapping); missing fields are zero/empty."""
+    type_name = normalize_type(type_name)
+    if type_name not in T:
+        raise MessageDataError(f"unknown message type {type_name!r}", path)
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise MessageDataError(f"expected a mapping of fields for {type_name}, found {data!r}", path)
+    _, fields = TYPESTORE.fielddefs[type_name]
+    names = [f[0] for f in fields]
+    for key in data:
+        if key not in names:
+            import difflib
+
+            close = difflib.get_close_matches(str(key), names, n=1)
+            raise MessageDataError(
+                f"{type_name} has no field {key!r} (fields: {', '.join(names)})",
+                (*path, key),
+                hint=f"did you mean {close[0]!r}?" if close else None,
+            )
+    kwargs = {name: _field_value(desc, data.get(name), (*path, name)) for name, desc in fields}
+    return T[type_name](**kwargs)
+
+
+def to_data(msg: Any) -> Any:
+    """A message as plain data (for printing and tests)."""
+    if hasattr(msg, "__dataclass_fields__"):
+        return {k: to_data(getattr(msg, k)) for k in msg.__dataclass_fields__ if k != "__msgtype__"}
+    if isinstance(msg, np.ndarray):
+        return msg.tolist()
+    if isinstance(msg, list):
+        return [to_data(x) for x in msg]
+    return msg
