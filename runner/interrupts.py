@@ -1,9 +1,11 @@
-"""Ctrl-C and SIGTERM, in the two states a command can be in.
+"""Ctrl-C and SIGTERM, in the three phases a command goes through.
 
 - Nothing started and nothing recorded yet (importing, loading, compiling): `exit_at_once` ends the process
   with 130 (Ctrl-C) or 143 (SIGTERM), without a KeyboardInterrupt traceback from wherever Python was.
-- Processes started or a recording open: `interruptible` makes both raise KeyboardInterrupt, which the run
-  loop (and each command) handles in order; `terminated()` then tells SIGTERM (143) from Ctrl-C (130).
+- A run going (runner.launch.supervisor): the supervisor's own handlers turn either signal into a
+  transition of the run (stop in order, keep the recording) and `note` which one came.
+- Otherwise (a command's own work, before or after a run): `interruptible` makes both raise
+  KeyboardInterrupt, which each command handles; `terminated()` then tells SIGTERM (143) from Ctrl-C (130).
 
 Kept free of heavy imports: `runner/__init__` uses it before anything else is loaded.
 """
@@ -28,6 +30,12 @@ def interruptible() -> None:
         return  # only the main thread may set handlers (a run started from a test's thread keeps its own)
     signal.signal(signal.SIGINT, signal.default_int_handler)
     signal.signal(signal.SIGTERM, _on_term)
+
+
+def note(signum: int) -> None:
+    """A handler that does not raise (the run's supervisor) notes which signal came, for `terminated()`."""
+    if signum == signal.SIGTERM:
+        _state["terminated"] = True
 
 
 def terminated() -> bool:

@@ -288,7 +288,7 @@ def test_start_limits_tell_this_host_from_the_others() -> None:
     from types import SimpleNamespace
 
     from runner.errors import RunError
-    from runner.launch import run as launch
+    from runner.launch import worlds as launch
     from runner.sim import __main__ as world_main
 
     def part(label: str, host: str | None, ready: bool = False) -> SimpleNamespace:

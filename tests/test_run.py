@@ -268,7 +268,7 @@ def test_unwritable_recording_is_a_clear_error(tmp_path: Path):
 def _kill_outright(proc: subprocess.Popen[str], *, guard_too: bool = False) -> list[int]:
     """kill -9 the runner (and its recording's guard, with `guard_too`); returns its world processes."""
     worlds = processes_of(proc.pid, r"runner\.sim /", direct=True)
-    guards = processes_of(proc.pid, r"runner/finisher\.py", direct=True)
+    guards = processes_of(proc.pid, r"runner/record/finisher\.py", direct=True)
     assert len(guards) == 1, "a recording run has one guard"
     if guard_too:
         os.kill(guards[0], signal.SIGKILL)

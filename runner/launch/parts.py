@@ -1,0 +1,293 @@
+"""What the supervisor runs besides the worlds, each behind one small interface (`Part`): the nodes of this
+host, the required nodes of other hosts (watched), the bridge, the recorder, the judge and the live view.
+
+A part is started, asked whether it is ready, polled while the run goes (where it may end the run: one
+call to `Supervisor.end`), stopped, finished and closed, in that order; a part that has nothing to do at a
+step inherits the no-op. The worlds are parts too (runner.launch.worlds), with the run's time in them.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Protocol
+
+import zenoh
+
+from runner.errors import RunError
+from runner.launch.nodes import NodeError, Nodes
+from runner.plan import NodePlan, RunPlan
+from runner.record.recorder import Recorder
+from runner.wire import msgs
+from runner.wire.graph import GraphTokens
+from runner.wire.transport import meta_key, unpack_attachment
+
+if TYPE_CHECKING:
+    from runner.launch.worlds import WorldPart
+
+DRAIN_TIMEOUT_S = 3.0  # how long the recorder waits for messages still in flight at the end
+DRAIN_HURRIED_S = 0.5  # ... when the run was interrupted (the 2 s a stop may take)
+
+
+class Run(Protocol):
+    """What a part sees of the run that supervises it (runner.launch.supervisor.Supervisor)."""
+
+    plan: RunPlan
+    session: Any  # the runner's Zenoh session
+    subs: list[Any]  # what to undeclare once the run is done
+    worlds: list[WorldPart]
+    recorder: RecorderPart | None
+    reason: str
+    error: str | None
+    hurry: threading.Event  # a second signal: stop waiting
+
+    def end(self, reason: str, error: str | None = None, say: str | None = None) -> None: ...
+
+    def announce(self, **changes: str) -> None: ...
+
+    def wait(self, event: threading.Event, timeout_s: float) -> bool: ...
+
+    def clock(self) -> float: ...
+
+    def reached(self) -> int: ...
+
+    def ending(self) -> str: ...
+
+
+class Part:
+    """One supervised part of a run. Every method is a step of the run; the defaults do nothing."""
+
+    label = "part"
+    poll_order = -1  # polled before the worlds (< 0) or after them (> 0), in this order
+
+    def start(self, run: Run) -> None:
+        """Start processes, subscribe: the run is STARTING."""
+
+    def ready(self) -> bool:
+        """Up and listening: the worlds step once every part is."""
+        return True
+
+    def poll(self, run: Run) -> None:
+        """Called every tick while the run goes (STARTING, RUNNING, STOPPING); may end the run."""
+
+    def stop(self) -> None:
+        """Asked to stop (the run is STOPPING)."""
+
+    def close(self, run: Run) -> None:
+        """Release what it holds (DONE): always called, however the run ended, once started or not."""
+
+
+class NodesPart(Part):
+    """The nodes of this host: started before the worlds (they connect and subscribe while the worlds
+    start; lockstep nodes are waited for by the world itself), stopped after them."""
+
+    label = "nodes"
+    poll_order = -3
+
+    def __init__(self, plan: RunPlan, endpoint: str):
+        self.nodes = Nodes(plan, endpoint, host=None)
+
+    def start(self, run: Run) -> None:
+        try:
+            self.nodes.start()
+        except NodeError as e:
+            raise RunError(str(e)) from None
+
+    def poll(self, run: Run) -> None:
+        # once the worlds have ended, nodes leave on their own (runner.node sees the end): no failure
+        if run.error is not None or run.reason != "completed" or any(w.ended.is_set() for w in run.worlds):
+            return
+        ended_by = self.nodes.check()
+        if ended_by is not None:
+            reason, message = ended_by
+            run.end(reason, message if reason == "failed" else None, say=message)
+
+    def close(self, run: Run) -> None:
+        self.nodes.stop()
+
+
+class RemoteNodesPart(Part):
+    """Required nodes of other hosts: their runner supervises them; here, their liveliness is watched."""
+
+    label = "remote nodes"
+    poll_order = -2
+
+    def __init__(self, nodes: list[NodePlan]):
+        self.nodes = nodes
+        self.lost: list[str] = []
+
+    def start(self, run: Run) -> None:
+        plan = run.plan
+        for n in self.nodes:
+            world = next((w for w in plan.worlds if n.world and w.name.endswith("/" + n.world)), plan)
+
+            def on_node(sample: zenoh.Sample, n: NodePlan = n) -> None:
+                if sample.kind != zenoh.SampleKind.PUT:
+                    self.lost.append(f"required node {n.name!r} on host {n.host!r} went away")
+
+            alive_key = meta_key(world.name, "node", n.name)
+            run.subs.append(run.session.liveliness().declare_subscriber(alive_key, on_node))
+
+    def poll(self, run: Run) -> None:
+        all_completed = all(w.end_info.get("reason") == "completed" for w in run.worlds)
+        if self.lost and run.error is None and run.reason == "completed" and not all_completed:
+            run.end("failed", self.lost[0])
+
+
+class BridgePart(Part):
+    """The bridge process is a node; its liveliness token says it has subscribed, so the worlds start only
+    then and it misses nothing."""
+
+    label = "bridge"
+
+    def __init__(self) -> None:
+        self.up = threading.Event()
+
+    def start(self, run: Run) -> None:
+        def on_bridge(sample: zenoh.Sample) -> None:
+            if sample.kind == zenoh.SampleKind.PUT:
+                self.up.set()
+
+        key = meta_key(run.plan.name, "bridge", "alive")
+        run.subs.append(run.session.liveliness().declare_subscriber(key, on_bridge, history=True))
+
+    def ready(self) -> bool:
+        return self.up.is_set()
+
+
+class RecorderPart(Part):
+    """The MCAP recording: every key of the run, the compiled plan first; flushed as it goes (a kill loses
+    at most a second), drained at the end until it holds what the worlds say they published, and closed
+    with a note of how the run ended."""
+
+    label = "recorder"
+    poll_order = -4
+
+    def __init__(self, plan: RunPlan, types: dict[str, str], inbound: set[str]):
+        try:
+            self.recorder = Recorder(
+                Path(plan.record.path),
+                plan.record.include,
+                plan.record.exclude,
+                types=types,
+                inbound=inbound,
+                guarded=True,
+            )
+        except OSError as e:
+            raise RunError(f"cannot write the recording {plan.record.path}: {e.strerror or e}") from None
+
+    def start(self, run: Run) -> None:
+        plan, recorder = run.plan, self.recorder
+        if recorder.path != recorder.asked:
+            print(
+                f"another run is recording to {recorder.asked}: this one records to {recorder.path}",
+                file=sys.stderr,
+                flush=True,
+            )
+            plan.record.path = str(recorder.path)
+            run.announce(recording=str(recorder.path))
+        # the recorder's own FIFO subscriber, drained by its thread; undeclared (after recording what it
+        # still queued) by recorder.close()
+        recorder.subscribe(run.session, f"{plan.name}/**")
+        # the scenario as compiled, so the recording can be judged and reported on by itself
+        text = msgs.T["std_msgs/msg/String"](data=plan.model_dump_json())
+        recorder.write(
+            f"{plan.name}/_plan", "std_msgs/msg/String", msgs.encode(text, "std_msgs/msg/String"), (0, 0)
+        )
+        graph = GraphTokens(run.session, plan.name, "recorder", "recorder")
+        graph.subscriber(f"{plan.name}/**")
+        run.subs.append(graph)
+
+    def poll(self, run: Run) -> None:
+        recorder = self.recorder
+        recorder.flush_stale(1.0)  # killed outright, the file loses at most a second
+        if recorder.error is not None and run.error is None:
+            # the disk is full (or the file cannot be written): nothing more can be kept
+            why = recorder.error.strerror or str(recorder.error)
+            run.end("failed", f"the recording stopped: {why} ({recorder.path})")
+
+    def drain(self, run: Run) -> None:
+        """Wait until the recorder holds every message each world says it published (or a timeout; a
+        shorter one once interrupted, and none at all after a second signal)."""
+        recorder = self.recorder
+        hurried = run.reason == "interrupted"
+        for world in run.worlds:
+            if world.child is None and world.remote_host is None:
+                continue  # never started (stopped while starting)
+            if not run.wait(world.ended, 0.5) or run.hurry.is_set():
+                continue
+            published: dict[str, int] = world.end_info.get("published", {})
+            deadline = run.clock() + (DRAIN_HURRIED_S if hurried else DRAIN_TIMEOUT_S)
+            while run.clock() < deadline and not run.hurry.is_set():
+                got = recorder.counts()
+                if all(got.get(k, 0) >= n for k, n in published.items() if recorder.wanted(k)):
+                    break
+                run.hurry.wait(0.01)
+
+    def close(self, run: Run) -> None:
+        # how the run ended, for judging the recording by itself later (`scenario check`)
+        self.recorder.end_note(ended=run.ending(), sim_ns=str(run.reached()))
+        self.recorder.close()
+
+
+class JudgePart(Part):
+    """The live judge: fed every message it asks for, decoded (from the recorder, in its order and thread,
+    for the keys it records; subscribed otherwise); with `stop_on`, it ends the run early."""
+
+    label = "judge"
+    poll_order = 1
+
+    def __init__(self, judge: Any):
+        self.judge = judge
+        self.decided = threading.Event()
+
+    def start(self, run: Run) -> None:
+        from runner.checks.judge import judged_types
+
+        plan, judge = run.plan, self.judge
+        types = judged_types(plan)
+        lock = threading.Lock()
+
+        def feed(key: str, stamp_ns: int, payload: bytes) -> None:
+            msg = msgs.decode(payload, types[key])
+            with lock:
+                judge.feed(key, stamp_ns, msg)
+                if (plan.stop_on == "first_failure" and judge.failed()) or (
+                    plan.stop_on == "all_decided" and judge.all_decided()
+                ):
+                    self.decided.set()
+
+        keys = sorted(judge.keys)
+        if run.recorder is not None:
+            tapped = [k for k in keys if run.recorder.recorder.wanted(k)]
+            run.recorder.recorder.tap(tapped, feed)
+            keys = [k for k in keys if k not in tapped]
+        for key in keys:
+
+            def on_sample(sample: zenoh.Sample) -> None:
+                att = sample.attachment
+                parsed = unpack_attachment(att.to_bytes()) if att is not None else None
+                if parsed is not None:
+                    feed(str(sample.key_expr), parsed[1], sample.payload.to_bytes())
+
+            run.subs.append(run.session.declare_subscriber(key, on_sample))
+
+    def poll(self, run: Run) -> None:
+        if self.decided.is_set() and run.reason == "completed":
+            run.end("stopped")
+
+
+class LiveViewPart(Part):
+    """`--foxglove PORT`: the run, live, to Foxglove (runner.launch.live)."""
+
+    label = "live view"
+
+    def __init__(self, session: zenoh.Session, run: str, port: int):
+        from runner.launch.live import LiveView
+
+        self.view = LiveView(session, run, port)
+        print(f"Foxglove: connect to ws://127.0.0.1:{self.view.port}", file=sys.stderr, flush=True)
+
+    def close(self, run: Run) -> None:
+        self.view.close()
