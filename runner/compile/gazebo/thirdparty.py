@@ -293,7 +293,7 @@ def sensor_plugin(
     kind: str,
     context: str,
 ) -> tuple[dict[str, Any], tuple[str, ...]]:
-    """A plugin of `SENSOR_PLUGINS` inside a sensor: what `ReaderBase._sensor_plugins` finds (`topic`,
+    """A plugin of `SENSOR_PLUGINS` inside a sensor: what `sensor_plugins.read_sensor_plugins` finds (`topic`,
     `frame`, `noise`, and `params` for the sensor's plugin), and the rate tags the plugin reads."""
     if base in _VELODYNE:
         return _velodyne(g, r, remap, kind, context), ()
