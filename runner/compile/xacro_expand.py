@@ -12,8 +12,10 @@ import io
 import re
 import threading
 import xml.parsers.expat
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import xacro
 import xacro.substitution_args as _sa
@@ -49,6 +51,42 @@ class Expanded:
 
 def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
     """Run xacro on `path` with `args` (`$(arg name)`); return the URDF text and the files it read."""
+    find = _package_finder(path, packages)
+    real_parse = xacro.parse
+    with _lock:
+        saved = _sa._eval_find, _sa._eval_dict.get("find")
+        _sa._eval_find = find
+        _sa._eval_dict["find"] = find
+        xacro.parse = _cycle_guard(real_parse)
+        stderr = io.StringIO()
+        xacro.all_includes = []
+        try:
+            with contextlib.redirect_stderr(stderr):
+                doc = xacro.process_file(str(path), mappings={k: str(v) for k, v in args.items()})
+            sources = [path] + [Path(f) for f in dict.fromkeys(xacro.all_includes)]
+            _check_readable(sources, path, packages)
+            return Expanded(doc.toprettyxml(indent="  "), sources)
+        except (MissingPackage, IncludeCycle, OutsidePackages):
+            raise
+        except xml.parsers.expat.ExpatError as e:
+            raise XacroError(
+                f"not well-formed XML: {xml.parsers.expat.errors.messages.get(e.code, e)}",
+                _current_file(path),
+                e.lineno,
+                hint="look for an unclosed tag, a stray '<' or '&'",
+            ) from None
+        except Exception as e:
+            raise _xacro_error(e, path) from None
+        finally:
+            xacro.parse = real_parse
+            _sa._eval_find, found = saved
+            if found is not None:
+                _sa._eval_dict["find"] = found
+
+
+def _package_finder(path: Path, packages: PackageMap) -> Callable[[str], str]:
+    """xacro's `$(find pkg)` through our package map: the package's folder, or `MissingPackage` at the
+    line that asks for it."""
 
     def find(pkg: str) -> str:
         root = packages.find(pkg)
@@ -64,11 +102,15 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
             )
         return str(root)
 
-    real_parse = xacro.parse
+    return find
+
+
+def _cycle_guard(real_parse: Callable[..., Any]) -> Callable[..., Any]:
+    """xacro's `parse`, stopping an include cycle (a includes b includes a) at the first file that is
+    already being read: xacro itself recurses without end."""
 
     def parse(inp, filename=None):  # type: ignore[no-untyped-def]
-        # xacro recurses without end on an include cycle (a includes b includes a): stop at the first
-        # file that is already being read. xacro has pushed `filename` on its stack before parsing it.
+        # xacro has pushed `filename` on its stack before parsing it.
         stack = list(getattr(xacro, "filestack", None) or [])
         if inp is None and filename and len(stack) > 1:
             again = _same_file_index(stack[:-1], filename)
@@ -84,80 +126,62 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
                 )
         return real_parse(inp, filename)
 
-    with _lock:
-        saved = _sa._eval_find, _sa._eval_dict.get("find")
-        _sa._eval_find = find
-        _sa._eval_dict["find"] = find
-        xacro.parse = parse
-        stderr = io.StringIO()
-        xacro.all_includes = []
-        try:
-            with contextlib.redirect_stderr(stderr):
-                doc = xacro.process_file(str(path), mappings={k: str(v) for k, v in args.items()})
-            sources = [path] + [Path(f) for f in dict.fromkeys(xacro.all_includes)]
-            for read in sources[1:]:
-                if not packages.readable(read, path):
-                    holder = next((f for f in sources if _line_of(f, read.name)), path)
-                    raise OutsidePackages(
-                        f"{read} is outside the scenario's folder and packages",
-                        holder,
-                        _line_of(holder, read.name),
-                        hint="a robot description may read files of the scenario's folder, its own folder "
-                        "and the packages (`packages:`, SCENARIO_PACKAGE_PATH); list other folders the "
-                        "scenario trusts under `allow_paths:`",
-                    )
-            return Expanded(doc.toprettyxml(indent="  "), sources)
-        except (MissingPackage, IncludeCycle, OutsidePackages):
-            raise
-        except xml.parsers.expat.ExpatError as e:
-            raise XacroError(
-                f"not well-formed XML: {xml.parsers.expat.errors.messages.get(e.code, e)}",
-                _current_file(path),
-                e.lineno,
-                hint="look for an unclosed tag, a stray '<' or '&'",
-            ) from None
-        except Exception as e:
-            cause = e.__cause__ or e.__context__
-            if isinstance(cause, MissingPackage):
-                raise cause from None
-            if isinstance(cause, IncludeCycle):
-                raise cause from None
-            message = " ".join(str(e).split())
-            missing = getattr(e, "exc", None)
-            if isinstance(missing, FileNotFoundError) and missing.filename:
-                message = f"included file not found: {missing.filename}"
-            file = _current_file(path)
-            sources = [path, *map(Path, xacro.all_includes)]
-            macros = getattr(e, "macros", None) or []
-            name = macros[0].body.getAttribute("name") if macros and hasattr(macros[0], "body") else ""
-            if message.startswith("Undefined parameters") and name:
-                # the call that lacks them: `<xacro:wheel .../>` (not the definition, `<xacro:macro ...>`)
-                message = f"the call of macro {name!r} does not give {message.removeprefix('Undefined ')}"
-                for candidate in dict.fromkeys([file, *sources]):
-                    line = _line_of(candidate, f"<xacro:{name}")
-                    if line is not None:
-                        raise XacroError(
-                            message,
-                            candidate,
-                            line,
-                            hint="give them at the call, or defaults in the macro's params "
-                            '(params="radius:=0.05")',
-                        ) from None
-            if isinstance(e, RecursionError) or "maximum recursion depth" in message:
-                loop = _self_calling_macro(sources)
-                raise XacroError(
-                    f"macro {loop[0]!r} calls itself without end" if loop else "xacro recursed without end",
-                    loop[1] if loop else file,
-                    loop[2] if loop else None,
-                    hint="a macro that calls itself needs an <xacro:if> that stops it",
-                ) from None
-            file, line = _locate_message(message, file, sources)
-            raise XacroError(message, file, line, hint=_hint(message)) from None
-        finally:
-            xacro.parse = real_parse
-            _sa._eval_find, found = saved
-            if found is not None:
-                _sa._eval_dict["find"] = found
+    return parse
+
+
+def _check_readable(sources: list[Path], path: Path, packages: PackageMap) -> None:
+    """Every file the expansion read (`<xacro:include>`, `xacro.load_yaml`) is one the scenario trusts."""
+    for read in sources[1:]:
+        if not packages.readable(read, path):
+            holder = next((f for f in sources if _line_of(f, read.name)), path)
+            raise OutsidePackages(
+                f"{read} is outside the scenario's folder and packages",
+                holder,
+                _line_of(holder, read.name),
+                hint="a robot description may read files of the scenario's folder, its own folder "
+                "and the packages (`packages:`, SCENARIO_PACKAGE_PATH); list other folders the "
+                "scenario trusts under `allow_paths:`",
+            )
+
+
+def _xacro_error(e: Exception, path: Path) -> XacroError:
+    """What xacro raised, as an error at the file and line it is about (called while xacro's file stack
+    still says which file it was reading)."""
+    cause = e.__cause__ or e.__context__
+    if isinstance(cause, MissingPackage):
+        return cause
+    if isinstance(cause, IncludeCycle):
+        return cause
+    message = " ".join(str(e).split())
+    missing = getattr(e, "exc", None)
+    if isinstance(missing, FileNotFoundError) and missing.filename:
+        message = f"included file not found: {missing.filename}"
+    file = _current_file(path)
+    sources = [path, *map(Path, xacro.all_includes)]
+    macros = getattr(e, "macros", None) or []
+    name = macros[0].body.getAttribute("name") if macros and hasattr(macros[0], "body") else ""
+    if message.startswith("Undefined parameters") and name:
+        # the call that lacks them: `<xacro:wheel .../>` (not the definition, `<xacro:macro ...>`)
+        message = f"the call of macro {name!r} does not give {message.removeprefix('Undefined ')}"
+        for candidate in dict.fromkeys([file, *sources]):
+            line = _line_of(candidate, f"<xacro:{name}")
+            if line is not None:
+                return XacroError(
+                    message,
+                    candidate,
+                    line,
+                    hint='give them at the call, or defaults in the macro\'s params (params="radius:=0.05")',
+                )
+    if isinstance(e, RecursionError) or "maximum recursion depth" in message:
+        loop = _self_calling_macro(sources)
+        return XacroError(
+            f"macro {loop[0]!r} calls itself without end" if loop else "xacro recursed without end",
+            loop[1] if loop else file,
+            loop[2] if loop else None,
+            hint="a macro that calls itself needs an <xacro:if> that stops it",
+        )
+    file, line = _locate_message(message, file, sources)
+    return XacroError(message, file, line, hint=_hint(message))
 
 
 def _line_of(file: Path, needle: str, also: str = "") -> int | None:

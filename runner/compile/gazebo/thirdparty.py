@@ -17,17 +17,18 @@
 - hector's sonar, `libhector_gazebo_ros_sonar.so` (a sensor plugin in a `ray` sensor): only a
   sensor_msgs/Range on `<topicName>` (`sonar`) at `<updateRate>` (10 Hz) -> `lidar` with a `range_topic`.
 
-Handlers have the signatures of those in `runner.compile.gazebo`, whose helpers they import when called
-(that module imports this one).
+Handlers have the signatures of those in runner.compile.gazebo.model_plugins and .sensor_plugins: they
+are given the reader as its base (runner.compile.gazebo.base), which those modules and the reader import.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-if TYPE_CHECKING:
-    from runner.compile.gazebo import GazeboReader, _Reader
+from runner.compile.gazebo.base import ReaderBase
+from runner.compile.gazebo.noise import noise_spec
+from runner.compile.gazebo.tags import TagReader, floats, is_zero, join_topic, plugin_base, ros_topic
 
 # hector's defaults (hector_gazebo_plugins/src/gazebo_ros_gps.cpp, sensor_model.h)
 _HECTOR_REFERENCE = {"latitude": 49.9, "longitude": 8.9, "heading": 0.0, "altitude": 0.0}
@@ -41,7 +42,7 @@ SENSOR_PLUGINS = {*_VELODYNE, "hector_gazebo_ros_sonar"}
 SENSOR_KINDS = {"gps"}
 
 
-def _root_link(g: GazeboReader) -> str | None:
+def _root_link(g: ReaderBase) -> str | None:
     """The URDF's root link: hector's plugins without `<bodyName>` use the model's first (canonical) link."""
     children = {j.find("child").get("link") for j in g.root.findall("joint") if j.find("child") is not None}
     for link in g.root.findall("link"):
@@ -50,7 +51,7 @@ def _root_link(g: GazeboReader) -> str | None:
     return None
 
 
-def _vector(g: GazeboReader, r: _Reader, tag: str) -> list[float] | None:
+def _vector(g: ReaderBase, r: TagReader, tag: str) -> list[float] | None:
     """A vector parameter of hector's (`"0.1 0.1 0.1"`); one number stands for all three axes."""
     text = r.text(tag)
     if text is None:
@@ -68,26 +69,20 @@ def _vector(g: GazeboReader, r: _Reader, tag: str) -> list[float] | None:
     return values
 
 
-def _rate(g: GazeboReader, r: _Reader) -> float | None:
+def _rate(g: ReaderBase, r: TagReader) -> float | None:
     """hector's UpdateTimer: `<updateRate>` (Hz) or `<updatePeriod>` (s); 0 or neither: every world step."""
     rate = r.float("updateRate")
     period = r.float("updatePeriod")
     if period and period > 0:
         rate = 1.0 / period
     offset = r.child("updateOffset")
-    if offset is not None and not _is_zero(offset.text):
+    if offset is not None and not is_zero(offset.text):
         g.note(offset, "<updateOffset> is ignored: readings are taken at multiples of the period")
     return rate if rate and rate > 0 else None
 
 
-def _is_zero(text: str | None) -> bool:
-    from runner.compile.gazebo import _zero
-
-    return _zero(text)
-
-
 def _hector_model(
-    g: GazeboReader, r: _Reader, prefix: str, what: str, unit: str, per_axis: bool
+    g: ReaderBase, r: TagReader, prefix: str, what: str, unit: str, per_axis: bool
 ) -> tuple[list[float], list[float], list[float], list[float]]:
     """hector's SensorModel parameters `<prefix>Offset`, `Drift`, `DriftFrequency`, `GaussianNoise` (or
     without a prefix: `offset`, `drift`...): offset, drift, drift frequency, white noise, per axis. A
@@ -114,7 +109,7 @@ def _hector_model(
     return offset, drift, frequency, noise
 
 
-def hector_imu(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str, dict[str, Any]] | None:
+def hector_imu(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> tuple[str, dict[str, Any]] | None:
     """hector_gazebo_plugins' IMU (`libhector_gazebo_ros_imu.so`). Its parameters -> `imu`:
 
     | hector | ours |
@@ -131,18 +126,16 @@ def hector_imu(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str,
     | yawOffset, yawDrift, yawDriftFrequency | yaw_bias, yaw_bias_stddev, yaw_bias_drift_frequency |
     | (always) | orientation_tilt_from_bias: true |
     """
-    from runner.compile.gazebo import _floats, _topic
-
     filename = r.el.get("filename")
     topic_text = r.text("topicName")
     if topic_text is not None and not topic_text.strip():
         g.note(r.el, f"{filename!r} has an empty <topicName>: it publishes nothing (as in Gazebo)")
         r.mark(*[c.tag for c in r.el if isinstance(c.tag, str)])
         return None
-    topic = _topic(topic_text) or "imu"
+    topic = ros_topic(topic_text) or "imu"
     topic = remap.get(topic) or topic  # the ROS 2 port's node remaps its topics
     bias_text = r.text("biasTopicName")
-    bias_topic = (_topic(bias_text) if bias_text is not None else f"{topic}/bias") or None
+    bias_topic = (ros_topic(bias_text) if bias_text is not None else f"{topic}/bias") or None
     link = r.text("bodyName") or _root_link(g)
     params: dict[str, Any] = {
         "link": link,
@@ -159,6 +152,14 @@ def hector_imu(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str,
             "the imu plugin's 100 Hz",
             hint="add <updateRate> (or set `rate` in the scenario's plugin params)",
         )
+    _hector_imu_errors(g, r, params)
+    _hector_imu_yaw(g, r, params)
+    _hector_imu_unused(g, r, filename)
+    return "imu", params
+
+
+def _hector_imu_errors(g: ReaderBase, r: TagReader, params: dict[str, Any]) -> None:
+    """The accelerometer's and the gyro's error models (offset, drifting bias, white noise) -> `params`."""
     legacy = r.float("gaussianNoise")
     for prefix, key, what, unit in (
         ("accel", "linear_acceleration", "accelerations", "m/s²"),
@@ -175,6 +176,10 @@ def hector_imu(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str,
         if max(drift):
             params[f"{key}_bias_stddev"] = max(drift)
             params[f"{key}_bias_drift_frequency"] = max(frequency)
+
+
+def _hector_imu_yaw(g: ReaderBase, r: TagReader, params: dict[str, Any]) -> None:
+    """The heading's offset and drift -> `params`; its white noise only fills a covariance (said)."""
     # `heading*`: the same parameters in hector's releases before 0.3.6
     yaw_offset = r.float("yawOffset", "headingOffset") or 0.0
     yaw_drift = r.float("yawDrift", "headingDrift") or 0.0
@@ -187,26 +192,29 @@ def hector_imu(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str,
             yaw_frequency if yaw_frequency is not None else _HECTOR_DRIFT_FREQUENCY
         )
     yaw_noise = r.child("yawGaussianNoise", "headingGaussianNoise")
-    if yaw_noise is not None and not _is_zero(yaw_noise.text):
+    if yaw_noise is not None and not is_zero(yaw_noise.text):
         g.note(
             yaw_noise,
             f"<{yaw_noise.tag}> only fills hector's orientation covariance, which is not reproduced here "
             "(the orientation itself is the same)",
         )
     r.mark("yawScaleError", "headingScaleError")  # read by hector, used for nothing
+
+
+def _hector_imu_unused(g: ReaderBase, r: TagReader, filename: str | None) -> None:
+    """hector's IMU parameters that change nothing here: the mounting offsets and the random seed."""
     rpy = r.child("rpyOffset")
-    if rpy is not None and any(_floats(rpy.text, 3) or [1.0]):
+    if rpy is not None and any(floats(rpy.text, 3) or [1.0]):
         g.note(rpy, f"<rpyOffset> in {filename!r} is not applied (the IMU is mounted as its link)")
     xyz = r.child("xyzOffset")
-    if xyz is not None and any(_floats(xyz.text, 3) or [1.0]):
+    if xyz is not None and any(floats(xyz.text, 3) or [1.0]):
         g.note(xyz, f"<xyzOffset> is read and not applied by {filename!r}: Gazebo ignores it too")
     seed = r.child("randomEngineSeed")
     if seed is not None:
         g.note(seed, "<randomEngineSeed> is ignored: noise is drawn from the scenario's `seed`")
-    return "imu", params
 
 
-def hector_gps(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str, dict[str, Any]]:
+def hector_gps(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> tuple[str, dict[str, Any]]:
     """hector_gazebo_plugins' GPS (`libhector_gazebo_ros_gps.so`). Its parameters -> `gps`:
 
     | hector | ours |
@@ -222,10 +230,8 @@ def hector_gps(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> tuple[str,
     | velocityOffset, velocityDrift, ... (m/s) | velocity_offset, velocity_drift, ... |
     | (velocity north, west, up) | velocity_axes: NWU |
     """
-    from runner.compile.gazebo import _topic
-
-    topic = _topic(r.text("topicName")) or "fix"
-    velocity = _topic(r.text("velocityTopicName")) or "fix_velocity"
+    topic = ros_topic(r.text("topicName")) or "fix"
+    velocity = ros_topic(r.text("velocityTopicName")) or "fix_velocity"
     frame = r.text("frameId")
     params: dict[str, Any] = {
         "link": r.text("bodyName") or _root_link(g),
@@ -279,22 +285,22 @@ MODEL_PLUGINS = {
 
 # ------------------------------------------------------------------------------------------ sensor plugins
 def sensor_plugin(
-    g: GazeboReader,
-    r: _Reader,
+    g: ReaderBase,
+    r: TagReader,
     base: str,
     remap: dict[str, str],
     sensor: str,
     kind: str,
     context: str,
 ) -> tuple[dict[str, Any], tuple[str, ...]]:
-    """A plugin of `SENSOR_PLUGINS` inside a sensor: what `GazeboReader._sensor_plugins` finds (`topic`,
+    """A plugin of `SENSOR_PLUGINS` inside a sensor: what `sensor_plugins.read_sensor_plugins` finds (`topic`,
     `frame`, `noise`, and `params` for the sensor's plugin), and the rate tags the plugin reads."""
     if base in _VELODYNE:
         return _velodyne(g, r, remap, kind, context), ()
     return _hector_sonar(g, r, remap), ("updateRate",)
 
 
-def _hector_sonar(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> dict[str, Any]:
+def _hector_sonar(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> dict[str, Any]:
     """hector_gazebo_plugins' sonar (`libhector_gazebo_ros_sonar.so`, in a `ray` sensor): only a
     sensor_msgs/Range, the nearest of the sensor's rays, with hector's error model:
 
@@ -306,9 +312,7 @@ def _hector_sonar(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> dict[st
     | offset, drift, driftFrequency, gaussianNoise (m) | range_offset, range_drift, ... |
     | (ULTRASOUND; min of the sensor's angular spans) | radiation_type, range_field_of_view |
     """
-    from runner.compile.gazebo import _topic
-
-    topic = _topic(r.text("topicName")) or "sonar"
+    topic = ros_topic(r.text("topicName")) or "sonar"
     topic = remap.get(topic) or topic
     frame = r.text("frameId") or "sonar_link"
     params: dict[str, Any] = {
@@ -339,7 +343,7 @@ def _hector_sonar(g: GazeboReader, r: _Reader, remap: dict[str, str]) -> dict[st
     return {"topic": topic, "frame": g.frame(frame), "params": params}
 
 
-def _velodyne(g: GazeboReader, r: _Reader, remap: dict[str, str], kind: str, context: str) -> dict[str, Any]:
+def _velodyne(g: ReaderBase, r: TagReader, remap: dict[str, str], kind: str, context: str) -> dict[str, Any]:
     """velodyne_simulator's plugin (Dataspeed; 1.0.10+ point layout). It publishes only a PointCloud2:
 
     | velodyne_simulator | ours (lidar) |
@@ -353,8 +357,6 @@ def _velodyne(g: GazeboReader, r: _Reader, remap: dict[str, str], kind: str, con
 
     The ROS 2 plugin is told by `<ros>`, `<frame_name>`, `<gaussian_noise>` or `<tf_prefix>`, or by the
     absence of the ROS 1 tags; each reads only its own spellings (the other's are reported)."""
-    from runner.compile.gazebo import _join, _topic
-
     p = r.el
     filename = p.get("filename")
     ros2 = any(p.find(t) is not None for t in ("ros", *_VELODYNE_ROS2)) or not any(
@@ -362,8 +364,8 @@ def _velodyne(g: GazeboReader, r: _Reader, remap: dict[str, str], kind: str, con
     )
     found: dict[str, Any] = {}
     if ros2:
-        name = _topic(p.get("name")) or "gazebo_ros_velodyne_laser"
-        topic = remap.get("out") or _join(name, "out")
+        name = ros_topic(p.get("name")) or "gazebo_ros_velodyne_laser"
+        topic = remap.get("out") or join_topic(name, "out")
         frame = r.text("frame_name")
         found["frame"] = g.frame(frame) if frame else None
         noise = r.float("gaussian_noise")
@@ -372,7 +374,7 @@ def _velodyne(g: GazeboReader, r: _Reader, remap: dict[str, str], kind: str, con
             g.note(prefix, "<tf_prefix> is ignored: frames are under the robot's namespace")
         own, other = _VELODYNE_ROS2, _VELODYNE_ROS1
     else:
-        topic = _topic(r.text("topicName")) or "points"
+        topic = ros_topic(r.text("topicName")) or "points"
         frame = r.text("frameName")
         # tf::resolve leaves the default `/world` (absolute) alone
         found["frame"] = g.frame(frame) if frame and frame.strip("/") != "world" else "world"
@@ -426,8 +428,8 @@ def _number(el: Any, paths: tuple[str, ...]) -> float | None:
 
 # ------------------------------------------------------------------------------------------ sensors
 def sensor(
-    g: GazeboReader,
-    r: _Reader,
+    g: ReaderBase,
+    r: TagReader,
     el: Any,
     common: dict[str, Any],
     plugins: list[Any],
@@ -450,14 +452,12 @@ def sensor(
     | the world's spherical coordinates (Gazebo's default: 0 deg, 0 deg, 0 m; ENU) | reference_* |
     | status FIX, service GPS | status 0, service 1 |
     """
-    from runner.compile.gazebo import _plugin_base, _Reader, _topic
-
     params: dict[str, Any] = {**common, "reference_heading": 90.0, "velocity_axes": "ENU"}
     gps = r.child("gps")
     if gps is not None:
         for block, key in (("position_sensing", "position"), ("velocity_sensing", "velocity")):
-            h = g._noise_spec(gps.find(f"{block}/horizontal"))
-            v = g._noise_spec(gps.find(f"{block}/vertical"))
+            h = noise_spec(g, gps.find(f"{block}/horizontal"))
+            v = noise_spec(g, gps.find(f"{block}/vertical"))
             sd = [h.stddev if h else 0.0] * 2 + [v.stddev if v else 0.0]
             if any(sd):
                 params[f"{key}_noise_stddev"] = sd
@@ -474,7 +474,7 @@ def sensor(
     topic, velocity = base_topic or "fix", None
     for p in plugins:
         filename = p.get("filename", "")
-        if _plugin_base(filename) != "gazebo_ros_gps_sensor":
+        if plugin_base(filename) != "gazebo_ros_gps_sensor":
             g.note(
                 p,
                 f"plugin {filename!r} in {context} is not supported and is ignored",
@@ -482,9 +482,9 @@ def sensor(
             )
             continue
         found = True
-        pr = _Reader(p)
-        remap = g._ros_block(pr)["remap"]
-        plugin = _topic(p.get("name")) or "gazebo_ros_gps_sensor"
+        pr = TagReader(p)
+        remap = g.ros_block(pr)["remap"]
+        plugin = ros_topic(p.get("name")) or "gazebo_ros_gps_sensor"
         topic = remap.get("out") or f"{plugin}/out"
         velocity = remap.get("vel") or f"{plugin}/vel"
         frame_name = pr.text("frame_name")

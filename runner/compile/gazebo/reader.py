@@ -1,0 +1,261 @@
+"""`GazeboReader`: reads the `<gazebo>` blocks of a URDF (Gazebo classic and Harmonic) into a `GazeboInfo`.
+
+A `<gazebo reference="link">` block gives the link's material, friction (`mu1`/`mu2`, `fdir1`), contact
+stiffness (`kp`), gravity and self-collision, and its sensors (runner.compile.gazebo.sensors); a `<gazebo>`
+block without a reference gives the model's plugins (runner.compile.gazebo.model_plugins), `<static>` and
+`<self_collide>`. Then, as Gazebo does: the scenario's controllers files are run, a sensor without a ROS
+plugin that another publisher shadows is left out, and so is a plugin naming a link or joint the robot
+lacks."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Any
+
+from lxml import etree
+
+from runner.compile.gazebo.base import ReaderBase
+from runner.compile.gazebo.controllers import run_controllers
+from runner.compile.gazebo.info import DescribedPlugin, GazeboInfo, LinkProps
+from runner.compile.gazebo.model_plugins import read_model_plugin
+from runner.compile.gazebo.sensors import read_sensor
+from runner.compile.gazebo.tables import JOINT_LIST_PARAMS, JOINT_PARAMS
+from runner.compile.gazebo.tags import TagReader, floats, plugin_base
+from runner.compile.materials import gazebo_material
+from runner.errors import Notices, SourceError
+
+_NOT_FINITE = {"inf", "-inf", "+inf", "infinity", "-infinity", "nan"}
+
+
+class GazeboReader(ReaderBase):
+    def read(self) -> GazeboInfo:
+        """Every `<gazebo>` block of the description, then the controllers files, then what Gazebo drops."""
+        self._learn_robot()
+        for gz in self.root.findall("gazebo"):
+            ref = gz.get("reference")
+            try:
+                if ref:
+                    if ref not in self.link_names | self.joint_names | self.fixed_joints:
+                        self.drop(
+                            self.where(gz),
+                            f'<gazebo reference="{ref}"> names a link or joint the robot does not have: '
+                            "it is left out",
+                            "Gazebo drops such a block too; xacro arguments may have left the link out",
+                        )
+                        continue
+                    self._reference(gz, ref)
+                else:
+                    self._model(gz)
+            except (ValueError, OverflowError) as e:  # float("many"), int(float("inf")) in a tag's text
+                raise self._not_a_number(gz, e) from None
+        for path in self.controller_files:  # the scenario's `controllers:` (what a launch file would load)
+            run_controllers(self, path, (path, None))
+        self._drop_shadowed()
+        self._drop_missing_targets()
+        return self.info
+
+    def _learn_robot(self) -> None:
+        """The links and joints of the robot, whether it is described for Harmonic, and its lumped links."""
+        self.link_names = {el.get("name") for el in self.root.findall("link")}
+        # a description for Gazebo Harmonic (gz-sim systems): its sensors publish as gz-sensors does
+        self.harmonic = any(
+            plugin_base(el.get("filename") or "").startswith("gz-sim")
+            for gz in self.root.findall("gazebo")
+            for el in gz.iter("plugin")
+        )
+        # the Gazebo link each URDF link becomes: links joined by fixed joints are lumped into the upper one
+        upper = {
+            j.find("child").get("link"): j.find("parent").get("link")
+            for j in self.root.findall("joint")
+            if j.get("type") == "fixed" and j.find("child") is not None and j.find("parent") is not None
+        }
+        self.lumped_into = {}
+        for link in self.link_names:
+            top, seen = link, {link}
+            while top in upper and upper[top] not in seen:
+                top = upper[top]
+                seen.add(top)
+            self.lumped_into[link] = top
+        self.joint_names = {el.get("name") for el in self.root.findall("joint") if el.get("type") != "fixed"}
+        self.fixed_joints = {el.get("name") for el in self.root.findall("joint") if el.get("type") == "fixed"}
+
+    def _drop_missing_targets(self) -> None:
+        """A plugin naming a link or joint the expanded URDF lacks (an `enable_imu:=false` xacro argument
+        took it out) does not load in Gazebo, which goes on without it: so do we. A joint list (a joint
+        state publisher's) loses only the joints that are missing."""
+        keep: list[DescribedPlugin] = []
+
+        def named(joint: str) -> str:
+            fixed = " (fixed: Gazebo lumps it into its parent link)" if joint in self.fixed_joints else ""
+            return f"joint {joint!r}{fixed}"
+
+        for p in self.info.plugins:
+            missing: list[str] = []
+            for key, value in p.params.items():
+                if key == "link" and isinstance(value, str) and value not in self.link_names:
+                    missing.append(f"link {value!r}")
+                elif key in JOINT_PARAMS and isinstance(value, str) and value not in self.joint_names:
+                    missing.append(named(value))
+                elif key in JOINT_LIST_PARAMS and isinstance(value, list):
+                    gone = [j for j in value if j not in self.joint_names]
+                    if gone and key == "joints" and len(gone) < len(value):
+                        p.params[key] = [j for j in value if j in self.joint_names]
+                        gone_names = ", ".join(named(j) for j in gone)
+                        self.drop(
+                            (p.file, p.line),
+                            f"{p.type} plugin {p.name!r} names joint(s) the robot does not have: "
+                            f"{gone_names}: they are left out",
+                        )
+                    else:
+                        missing += [named(j) for j in gone]
+            if missing:
+                self.drop(
+                    (p.file, p.line),
+                    f"{p.type} plugin {p.name!r} names {', '.join(missing)}, which the robot does not have: "
+                    "it is left out",
+                    "Gazebo does not load such a plugin either; xacro arguments may have left the link out",
+                )
+                continue
+            keep.append(p)
+        self.info.plugins = keep
+
+    def _not_a_number(self, gz: Any, e: Exception) -> SourceError:
+        """A tag whose text should be a number and is not: the error at that tag's line."""
+        m = re.search(r": '(.*)'$", str(e))
+        text = m.group(1) if m else None
+        bad = next(
+            (
+                el
+                for el in gz.iter()
+                if isinstance(el.tag, str)
+                and el.text is not None
+                and (el.text.strip() == text or (text is None and el.text.strip().lower() in _NOT_FINITE))
+            ),
+            None,
+        )
+        el = bad if bad is not None else gz
+        shown = repr(el.text.strip()) if bad is not None and el.text else "a value"
+        return SourceError(
+            f"<{el.tag}> {shown} is not a number that fits here ({e})",
+            *self.where(el),
+            hint="Gazebo tags take plain numbers (an integer for counts such as <samples>)",
+        )
+
+    def _drop_shadowed(self) -> None:
+        """A classic sensor without a ROS plugin (e.g. TurtleBot3's imu sensor) publishes nothing in
+        Gazebo; a model plugin (libgazebo_ros_imu) does it. Keep one publisher per topic."""
+        topics: dict[tuple[str, str], DescribedPlugin] = {}
+        keep: list[DescribedPlugin] = []
+        for p in sorted(self.info.plugins, key=lambda p: p.implicit):
+            key = (p.type, str(p.params.get("topic") or p.params.get("image_topic") or p.name))
+            other = topics.get(key)
+            if other is not None and p.implicit:
+                self.notices.add(
+                    f"{p.type} sensor {p.name!r} has no ROS plugin and publishes on the same topic as "
+                    f"{other.name!r}: it is left out",
+                    p.file,
+                    p.line,
+                )
+                continue
+            topics[key] = p
+            keep.append(p)
+        self.info.plugins = [p for p in self.info.plugins if p in keep]
+
+    def _reference(self, gz: Any, link: str) -> None:
+        r = TagReader(gz, attr_values=True)
+        props = self.info.links.setdefault(link, LinkProps())
+        mat = r.child("material")
+        if mat is not None:
+            props.rgba = self._material(mat) or props.rgba
+        visual = r.child("visual")
+        if visual is not None:
+            vm = visual.find("material")
+            if vm is not None:
+                props.rgba = self._material(vm) or props.rgba
+        mu1, mu2 = r.float("mu1"), r.float("mu2")
+        mu = [v for v in (mu1, mu2, r.float("mu")) if v is not None]
+        if mu:
+            props.friction = min(mu)
+        props.mu1, props.mu2 = mu1, mu2
+        fdir = floats(r.text("fdir1"), 3)
+        if fdir is not None and any(fdir):
+            props.fdir1 = (fdir[0], fdir[1], fdir[2])
+        props.kp = r.float("kp")
+        r.mark("kd")
+        if r.float("kd") is not None:
+            self.note(
+                gz.find("kd"),
+                f'<kd> in <gazebo reference="{link}"> is ignored (contacts are critically '
+                "damped; <kp> sets their stiffness)",
+            )
+        if r.bool("turnGravityOff"):
+            props.gravity_off = True
+        self_collide = r.bool("selfCollide", "self_collide")
+        if self_collide is not None:
+            props.self_collide = self_collide
+            props.self_collide_at = self.where(r.child("selfCollide", "self_collide"))
+        gravity = r.bool("gravity")
+        if gravity is False:
+            props.gravity_off = True
+        for sensor in r.children("sensor"):
+            read_sensor(self, sensor, link)
+        for plugin in r.children("plugin"):  # a model plugin written inside a reference block
+            read_model_plugin(self, plugin, link)
+        self.ignored(r, f'<gazebo reference="{link}">')
+
+    def _material(self, el: Any) -> tuple[float, float, float, float] | None:
+        name = el.get("value") or el.text  # <material value="Gazebo/Red"/> is <material>Gazebo/Red</material>
+        if name and name.strip():
+            rgba = gazebo_material(name)
+            if rgba is None:
+                self.note(el, f"unknown Gazebo material {name.strip()!r}; the URDF colour is kept")
+            return rgba
+        script = el.find("script/name")
+        if script is not None and script.text:
+            rgba = gazebo_material(script.text)
+            if rgba is None:
+                self.note(el, f"unknown Gazebo material {script.text.strip()!r}; the URDF colour is kept")
+            return rgba
+        for tag in ("diffuse", "ambient"):
+            vals = floats(el.findtext(tag), 4) or (floats(el.findtext(tag), 3) or [])
+            if len(vals) == 3:
+                vals = [*vals, 1.0]
+            if len(vals) == 4:
+                return (vals[0], vals[1], vals[2], vals[3])
+        return None
+
+    def _model(self, gz: Any) -> None:
+        r = TagReader(gz, attr_values=True)
+        if r.bool("static"):
+            self.info.static = True
+        self_collide = r.bool("self_collide", "selfCollide")
+        if self_collide is not None:
+            self.info.self_collide = self_collide
+            self.info.self_collide_at = self.where(r.child("self_collide", "selfCollide"))
+        for plugin in r.children("plugin"):
+            read_model_plugin(self, plugin, None)
+        for sensor in r.children("sensor"):
+            read_sensor(self, sensor, None)
+        self.ignored(r, "<gazebo>")
+
+
+def read_gazebo(
+    root: Any,
+    file: Path | None,
+    *,
+    sources: list[Path] | None = None,
+    expanded: bool = False,
+    namespace: str,
+    model: str | None = None,
+    notices: Notices,
+    controllers: list[Path] | None = None,
+) -> GazeboInfo:
+    reader = GazeboReader(root, file, sources or [], expanded, namespace, notices, model)
+    reader.controller_files = list(controllers or [])
+    return reader.read()
+
+
+def parse(text: str) -> Any:
+    parser = etree.XMLParser(remove_comments=True)
+    return etree.fromstring(text.encode(), parser)

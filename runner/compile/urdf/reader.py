@@ -1,0 +1,180 @@
+"""`urdf_to_model`: URDF text -> MuJoCo `MjSpec` of one robot (`RobotModel`): the URDF is checked and
+repaired (.checks, .inertia), its meshes found (.mesh_files), its `<gazebo>` tags read
+(runner.compile.gazebo) and its transmissions collected (.transmissions); MuJoCo loads what is left, with
+fixed links kept and visuals kept, and the Gazebo link properties are applied to the result
+(.link_props)."""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import mujoco
+from lxml import etree
+
+from runner.compile.gazebo import GazeboInfo, parse, read_gazebo
+from runner.compile.locate import Locator
+from runner.compile.packages import PackageMap
+from runner.compile.urdf.checks import DescriptionError, check_numbers, check_structure, drop_empty_shapes
+from runner.compile.urdf.inertia import repair_inertias
+from runner.compile.urdf.link_props import apply_link_props, self_collision
+from runner.compile.urdf.mesh_files import rewrite_mesh
+from runner.compile.urdf.transmissions import Transmission, read_transmissions
+from runner.errors import Notices
+from runner.plan import ParityLine
+
+# URDF visuals are geom group 1 (MuJoCo's import); collisions go to group 3, which cameras do not draw
+# (MuJoCo renders groups 0-2 by default), as in MuJoCo Menagerie models.
+COLLISION_GROUP = 3
+
+
+@dataclass
+class RobotModel:
+    spec: mujoco.MjSpec
+    root: str
+    urdf: str
+    links: list[str] = field(default_factory=list)
+    joints: list[str] = field(default_factory=list)
+    gazebo: GazeboInfo = field(default_factory=GazeboInfo)
+    transmissions: list[Transmission] = field(default_factory=list)
+    adjusted: list[ParityLine] = field(default_factory=list)  # what was changed or left out to load it
+    self_collision: list[str] = field(default_factory=list)  # links that collide with the robot's others
+
+
+def urdf_to_model(
+    urdf: str,
+    file: Path | None,
+    packages: PackageMap,
+    *,
+    fixed: bool = False,
+    namespace: str = "robot",
+    model: str | None = None,
+    notices: Notices | None = None,
+    sources: list[Path] | None = None,
+    expanded: bool = False,
+    timestep: float = 0.002,
+    controllers: list[Path] | None = None,
+) -> RobotModel:
+    notices = notices if notices is not None else Notices()
+    base_dir = file.parent if file else Path.cwd()
+    where = Locator(file, sources or ([file] if file else []), expanded)
+    root = _parse(urdf, file, expanded, where)
+    root_link = check_structure(root, where)
+    check_numbers(root, where)
+    adjusted: list[ParityLine] = []
+    repair_inertias(root, where, notices, adjusted)
+    drop_empty_shapes(root, where, notices, adjusted)
+
+    shell: set[str] = set()  # mesh files without a volume (flat or tiny): MuJoCo weighs them as shells
+    meshes = [m for m in root.iter("mesh") if m.getparent() is not None and m.getparent().tag == "geometry"]
+    for mesh in meshes:  # a list: a mesh that cannot be had takes its <visual> out of the tree
+        rewrite_mesh(mesh, packages, base_dir, where, notices, shell)
+
+    gazebo = read_gazebo(
+        root,
+        file,
+        sources=sources or ([file] if file else []),
+        expanded=expanded,
+        namespace=namespace,
+        model=model or namespace,
+        notices=notices,
+        controllers=controllers,
+    )
+    transmissions = read_transmissions(root, where, notices)
+    spec = _load(root, where, file, shell)
+    apply_link_props(spec, gazebo, timestep)
+    collide = self_collision(root, spec, gazebo)
+    body = spec.body(root_link)
+    if not (fixed or gazebo.static):
+        body.add_freejoint(name="root")
+    links = [b.name for b in spec.bodies if b.name and b.name != "world"]
+    joints = [j.name for j in spec.joints if j.name and j.name != "root"]
+    for message, (src, line) in gazebo.dropped:
+        adjusted.append(ParityLine(kind="dropped", text=message, file=str(src) if src else None, line=line))
+    return RobotModel(spec, root_link, urdf, links, joints, gazebo, transmissions, adjusted, collide)
+
+
+def _parse(urdf: str, file: Path | None, expanded: bool, where: Any) -> Any:
+    """The URDF's `<robot>` element, or an error at the line of what is not well-formed."""
+    try:
+        root = parse(urdf)
+    except etree.XMLSyntaxError as e:
+        raise DescriptionError(
+            f"not well-formed XML: {e.msg}", file, None if expanded else e.lineno
+        ) from None
+    if root.tag != "robot":
+        raise DescriptionError(f"the top element is <{root.tag}>, expected <robot>", *where(root))
+    return root
+
+
+def _load(root: Any, where: Any, file: Path | None, shell: set[str]) -> mujoco.MjSpec:
+    """MuJoCo's spec of the URDF tree, with the tags it does not know taken out, fixed links and visuals
+    kept, shell inertia for the meshes without a volume and collisions in `COLLISION_GROUP`."""
+    # MuJoCo's URDF defaults fuse fixed links away and drop visuals: turn both off.
+    for old in root.findall("mujoco"):
+        root.remove(old)
+    for tag in ("gazebo", "transmission", "ros2_control"):
+        for el in root.findall(tag):
+            root.remove(el)
+    mj = etree.Element("mujoco")
+    etree.SubElement(mj, "compiler", discardvisual="false", fusestatic="false", strippath="false")
+    root.insert(0, mj)
+    _unique_shape_names(root)
+    text = etree.tostring(root, encoding="unicode")
+    try:
+        spec = mujoco.MjSpec.from_string(text)
+    except ValueError as e:
+        raise _mujoco_error(e, root, text, where, file) from None
+
+    for mesh_asset in spec.meshes:
+        if mesh_asset.file in shell:
+            # its volume is zero: MuJoCo's default (volume) inertia refuses it, a shell's does not
+            mesh_asset.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
+    for geom in spec.geoms:
+        if geom.contype or geom.conaffinity:
+            geom.group = COLLISION_GROUP
+    return spec
+
+
+def _mujoco_error(e: ValueError, root: Any, text: str, where: Any, file: Path | None) -> DescriptionError:
+    """MuJoCo's "XML Error: ... Element 'x', line N" is about the text we gave it: point at the element
+    in the user's file instead (the trees are the same, element for element)."""
+    message = " ".join(str(e).split("\n")[0].split()).removeprefix("XML Error: ")
+    m = re.search(r"Element '([^']*)', line (\d+)", str(e))
+    if m:
+        tag, line = m.group(1), int(m.group(2))
+        ours = [el for el in root.iter() if isinstance(el.tag, str)]
+        given = [el for el in etree.fromstring(text.encode()).iter() if isinstance(el.tag, str)]
+        for mine, theirs in zip(ours, given, strict=False):
+            if theirs.sourceline == line and theirs.tag == tag:
+                return DescriptionError(
+                    f"MuJoCo cannot load this URDF: {message} (in <{tag}>)",
+                    *where(mine),
+                    hint="check that element's attributes: names, numbers and required children",
+                )
+    return DescriptionError(f"MuJoCo cannot load this URDF: {message}", file)
+
+
+def _unique_shape_names(root: Any) -> None:
+    """Every `<visual>`/`<collision>` gets a unique name, as MuJoCo wants for its geoms: an unnamed one is
+    named as Gazebo's URDF reader does (`<link>_collision`, `<link>_collision_1`...), a name another link
+    already used (macros call them all "base_visual") gets its link's name before it. Left unnamed, MuJoCo's
+    URDF reader carries the link's visual name over to its unnamed collision and prints a warning for each.
+    """
+    taken = {el.get("name") for tag in ("collision", "visual") for el in root.iter(tag) if el.get("name")}
+    seen: set[str] = set()
+    for link in root.findall("link"):
+        lname = link.get("name")
+        for tag in ("collision", "visual"):
+            for k, el in enumerate(link.findall(tag)):
+                given = el.get("name")
+                name = given if given and given not in seen else None
+                if name is None:
+                    stem = f"{lname}/{given}" if given else f"{lname}_{tag}" + (f"_{k}" if k else "")
+                    name, n = stem, 1
+                    while name in seen or (name in taken and not given):
+                        name, n = f"{stem}_{n}", n + 1
+                    el.set("name", name)
+                seen.add(name)
