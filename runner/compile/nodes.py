@@ -6,9 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from runner.errors import Problem, ScenarioError
-from runner.plan import (
-    NodePlan,
-)
+from runner.plan import NodePlan
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import Scenario
 

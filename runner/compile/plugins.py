@@ -13,10 +13,7 @@ from pydantic import ValidationError
 from runner.compile.gazebo import DescribedPlugin
 from runner.compile.urdf import RobotModel
 from runner.errors import Location, Problem, Problems, ScenarioError
-from runner.plan import (
-    PluginPlan,
-    TopicPlan,
-)
+from runner.plan import PluginPlan, TopicPlan
 from runner.plugin import BuildContext, PluginConfigError
 from runner.plugin.registry import PluginLookupError, drive_frames, load
 from runner.scenario.loader import Document, PathKey

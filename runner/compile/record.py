@@ -8,10 +8,7 @@ from pathlib import Path
 from runner.checks.judge import contacts_key
 from runner.compile.network import check_expr, full_expr
 from runner.errors import Notices
-from runner.plan import (
-    RecordPlan,
-    RunPlan,
-)
+from runner.plan import RecordPlan, RunPlan
 from runner.scenario.loader import Document
 from runner.scenario.schema import Record, Scenario
 from runner.wire.transport import hidden_topic, topic_key

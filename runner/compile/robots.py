@@ -19,9 +19,7 @@ from runner.compile.wheels import anisotropic_wheels, wheel_links
 from runner.compile.xacro_expand import expand
 from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError
 from runner.geometry import rpy_to_quat
-from runner.plan import (
-    RobotPlan,
-)
+from runner.plan import RobotPlan
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import PluginEntry, Robot, Scenario
 

@@ -10,9 +10,7 @@ from typing import Any
 import mujoco
 
 from runner.errors import Notices
-from runner.plan import (
-    RunPlan,
-)
+from runner.plan import RunPlan
 from runner.scenario.loader import Document
 from runner.scenario.schema import Scenario
 

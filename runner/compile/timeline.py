@@ -4,10 +4,7 @@ type against the one its topic's subscriber takes."""
 from __future__ import annotations
 
 from runner.errors import Problem, Problems, ScenarioError
-from runner.plan import (
-    RobotPlan,
-    TimelinePlan,
-)
+from runner.plan import RobotPlan, TimelinePlan
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import Scenario
 from runner.wire import msgs

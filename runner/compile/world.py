@@ -20,12 +20,7 @@ from runner.compile.timeline import compile_timeline
 from runner.compile.wheels import check_geometry
 from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError
 from runner.geometry import rpy_to_quat
-from runner.plan import (
-    NodePlan,
-    RecordPlan,
-    RobotPlan,
-    RunPlan,
-)
+from runner.plan import NodePlan, RecordPlan, RobotPlan, RunPlan
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import NoCollision, Scenario, WorldModel
 from runner.wire import msgs
@@ -35,11 +30,7 @@ _GEOM = {
     "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
     "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
 }
-
-
 _CONE = {"elliptic": mujoco.mjtCone.mjCONE_ELLIPTIC, "pyramidal": mujoco.mjtCone.mjCONE_PYRAMIDAL}
-
-
 _INTEGRATOR = {
     "euler": mujoco.mjtIntegrator.mjINT_EULER,
     "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
