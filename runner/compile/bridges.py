@@ -15,9 +15,9 @@ from __future__ import annotations
 
 import json
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import zenoh
 
@@ -374,6 +374,20 @@ def _from_file(
     return out
 
 
+class _FileEntry(NamedTuple):
+    """The fields of one entry of a ros_gz_bridge file, as written (checked for presence and form)."""
+
+    gz_name: Any
+    ros_name: Any
+    ros_type: Any
+    gz_type: Any
+    direction: str
+    lazy: bool
+
+
+_Report = Callable[..., None]  # problem(message, key=None, **Problem's keywords) at an entry (and key)
+
+
 def _file_entry(
     entry: Any,
     j: int,
@@ -384,10 +398,46 @@ def _file_entry(
     ros2: Ros2Plan | None,
     problems: list[Problem],
 ) -> BridgePlan | None:
+    """Entry `j` of the ros_gz_bridge file of bridge `b` as a bridge (None: its problems are reported)."""
+
     def problem(message: str, key: str | None = None, **kw: Any) -> None:
         at: PathKey = (j, key) if key else (j,)
         problems.append(Problem(message, fdoc.locate(at), at, **kw))
 
+    fields = _entry_fields(entry, problem, problems)
+    if fields is None:
+        return None
+    full = _entry_type(fields, problem)
+    if full is None:
+        return None
+    ours = _GZ_DIRECTIONS[fields.direction]
+    at: PathKey = (j, "gz_topic_name" if "gz_topic_name" in entry else "topic_name")
+    key = _sim_key(str(fields.gz_name), namespace, ours, False, topics, fdoc, at, problems)
+    if key is None:
+        return None
+    known = topics.table.get(key, (None, set()))[0]
+    if known is not None and known != full:
+        problem(
+            f"the sim topic {key[len(topics.run) + 1 :]} is {known}, not {full}",
+            "ros_type_name",
+            expected=known,
+            found=full,
+        )
+        return None
+    fq = _qualify(str(fields.ros_name), namespace)
+    common = {"where": f"{fdoc.locate((j,))} ({b.file} entry {j})", "sim_key": key, "type": full}
+    common |= {"direction": ours, "lazy": fields.lazy, "rate": b.rate}
+    if ros2 is not None:
+        return BridgePlan(**common, ros_topic=fq, ros2=ros2)
+    other = fq.strip("/")
+    if not _key_ok(other, ours, topics.run, fdoc, (j,), problems):
+        return None
+    return BridgePlan(**common, key=other, encoding=b.encoding)
+
+
+def _entry_fields(entry: Any, problem: _Report, problems: list[Problem]) -> _FileEntry | None:
+    """An entry's keys known, its topic named (`topic_name`, or both sides'), both types, its direction and
+    `lazy` of the right form; None when any is not (each reported)."""
     if not isinstance(entry, dict):
         problem("an entry is a mapping", expected="ros_topic_name, gz_topic_name, ros_type_name, ...")
         return None
@@ -433,6 +483,13 @@ def _file_entry(
         problem("lazy is true or false", "lazy", found=repr(lazy))
     if len(problems) > n:
         return None
+    return _FileEntry(gz_name, ros_name, ros_type, gz_type, direction, lazy)
+
+
+def _entry_type(fields: _FileEntry, problem: _Report) -> str | None:
+    """The entry's ROS type in full, when it is known and ros_gz_bridge converts it to the Gazebo type the
+    entry names; None when not (reported)."""
+    ros_type, gz_type = fields.ros_type, fields.gz_type
     full = msgs.normalize_type(str(ros_type))
     if not msgs.is_known(full):
         near = msgs.similar_types(full)
@@ -455,29 +512,7 @@ def _file_entry(
             found=str(gz_type),
         )
         return None
-    ours = _GZ_DIRECTIONS[direction]
-    at: PathKey = (j, "gz_topic_name" if "gz_topic_name" in entry else "topic_name")
-    key = _sim_key(str(gz_name), namespace, ours, False, topics, fdoc, at, problems)
-    if key is None:
-        return None
-    known = topics.table.get(key, (None, set()))[0]
-    if known is not None and known != full:
-        problem(
-            f"the sim topic {key[len(topics.run) + 1 :]} is {known}, not {full}",
-            "ros_type_name",
-            expected=known,
-            found=full,
-        )
-        return None
-    fq = _qualify(str(ros_name), namespace)
-    common = {"where": f"{fdoc.locate((j,))} ({b.file} entry {j})", "sim_key": key, "type": full}
-    common |= {"direction": ours, "lazy": lazy, "rate": b.rate}
-    if ros2 is not None:
-        return BridgePlan(**common, ros_topic=fq, ros2=ros2)
-    other = fq.strip("/")
-    if not _key_ok(other, ours, topics.run, fdoc, (j,), problems):
-        return None
-    return BridgePlan(**common, key=other, encoding=b.encoding)
+    return full
 
 
 TF = "tf2_msgs/msg/TFMessage"

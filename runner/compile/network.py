@@ -1,0 +1,100 @@
+"""The run on the network: Zenoh key expressions of the scenario (QoS topics, record patterns) made full
+and checked by Zenoh itself, and the `zenoh:` settings (config file, settings, listen endpoints)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from runner.errors import Problem, ScenarioError
+from runner.scenario.loader import Document, PathKey
+from runner.scenario.schema import Scenario
+from runner.wire.transport import zenoh_reason
+
+
+def full_expr(run: str, expr: str) -> str:
+    return f"{run}/{expr.lstrip('/')}"
+
+
+def check_expr(expr: str, doc: Document, where: PathKey, written: str | None = None) -> None:
+    """`expr` is a Zenoh key expression; the error quotes `written` (what the user wrote) and Zenoh's
+    reason."""
+    import re
+
+    import zenoh
+
+    try:
+        zenoh.KeyExpr(expr)
+    except Exception as err:
+        # zenoh's text: "Invalid Key Expr `...`: <why> at <its source file>:<line>."
+        why = re.search(r"`: (.*?)(?: at \S+:\d+\.?)?$", str(err).strip())
+        raise ScenarioError(
+            Problem(
+                f"{(written if written is not None else expr)!r} is not a valid key expression"
+                + (f": {why.group(1)}" if why else ""),
+                doc.locate(where),
+                where,
+                expected="chunks separated by '/' (none empty), '*' for one chunk, '**' for any number "
+                "(e.g. `r1/**`, `*/scan`)",
+                hint="patterns are relative to the run: `r1/scan` is the key <run>/r1/scan",
+            )
+        ) from None
+
+
+def zenoh_settings(sc: Scenario, doc: Document) -> dict[str, Any]:
+    """`zenoh:` checked against Zenoh itself (each setting inserted into a config), paths made absolute."""
+    import json
+
+    import zenoh
+
+    assert sc.zenoh is not None
+    base = doc.base_dir
+    file = None
+    if sc.zenoh.config is not None:
+        path = base / sc.zenoh.config
+        where: PathKey = ("zenoh", "config")
+        if not path.is_file():
+            raise ScenarioError(
+                Problem(
+                    f"file not found: {sc.zenoh.config}",
+                    doc.locate(where),
+                    where,
+                    hint="relative to the scenario",
+                )
+            )
+        try:
+            zenoh.Config.from_file(str(path))
+        except Exception as e:
+            raise ScenarioError(
+                Problem(f"Zenoh cannot read this configuration: {zenoh_reason(e)}", doc.locate(where), where)
+            ) from None
+        file = str(path.resolve())
+    settings: dict[str, Any] = {}
+    probe = zenoh.Config()
+    for key, value in sc.zenoh.settings.items():
+        where = ("zenoh", "settings", key)
+        if isinstance(value, str) and (base / value).exists():
+            value = str((base / value).resolve())  # a certificate, a key, an ACL file: beside the scenario
+        try:
+            probe.insert_json5(key, json.dumps(value))
+        except Exception as e:
+            raise ScenarioError(
+                Problem(
+                    f"Zenoh refuses the setting {key!r}: {zenoh_reason(e)}",
+                    doc.locate(where),
+                    where,
+                    hint="a path in Zenoh's configuration, e.g. transport/link/tls/root_ca_certificate",
+                )
+            ) from None
+        settings[key] = value
+    for i, endpoint in enumerate(sc.zenoh.listen):
+        if "/" not in endpoint:
+            where = ("zenoh", "listen", i)
+            raise ScenarioError(
+                Problem(
+                    f"{endpoint!r} is not a Zenoh endpoint",
+                    doc.locate(where),
+                    where,
+                    expected="<protocol>/<address>:<port>, e.g. tcp/127.0.0.1:7447 or tls/127.0.0.1:7447",
+                )
+            )
+    return {"file": file, "settings": settings}

@@ -1,0 +1,107 @@
+"""`nodes:`: each node's command split and found, its folder checked, names unique, `lockstep` names
+nodes of the scenario; and `host:` names that must be among `hosts:`."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from runner.errors import Problem, ScenarioError
+from runner.plan import NodePlan
+from runner.scenario.loader import Document, PathKey
+from runner.scenario.schema import Scenario
+
+
+def compile_nodes(sc: Scenario, doc: Document, base: Path) -> list[NodePlan]:
+    """Nodes with their commands resolved; names unique; `lockstep` names nodes of the scenario."""
+    import shlex
+    import shutil
+    import sys
+
+    problems: list[Problem] = []
+    out: list[NodePlan] = []
+    seen: set[str] = set()
+    for i, node in enumerate(sc.nodes):
+        if node.name in seen:
+            where: PathKey = ("nodes", i, "name")
+            problems.append(Problem(f"two nodes named {node.name!r}", doc.locate(where), where))
+        seen.add(node.name)
+        try:
+            argv = shlex.split(node.cmd) if isinstance(node.cmd, str) else list(node.cmd)
+        except ValueError as e:
+            where = ("nodes", i, "cmd")
+            problems.append(Problem(f"cannot split the command: {e}", doc.locate(where), where))
+            continue
+        if not argv:
+            where = ("nodes", i, "cmd")
+            problems.append(
+                Problem("the command is empty", doc.locate(where), where, hint="cmd: python my_node.py")
+            )
+            continue
+        if argv[0] in ("python", "python3"):
+            argv[0] = sys.executable  # the interpreter the runner (and its packages) run in
+        cwd = (base / node.cwd) if node.cwd else base
+        exe = argv[0]
+        if cwd.is_dir() and shutil.which(exe) is None and shutil.which(str(cwd / exe)) is None:
+            where = ("nodes", i, "cmd")
+            problems.append(
+                Problem(
+                    f"command {exe!r} not found",
+                    doc.locate(where),
+                    where,
+                    expected="a program on PATH, or an executable file relative to the node's cwd",
+                    hint="for a Python script: cmd: python my_node.py",
+                )
+            )
+        if not cwd.is_dir():
+            where = ("nodes", i, "cwd")
+            problems.append(
+                Problem(
+                    f"folder {str(cwd)!r} does not exist",
+                    doc.locate(where),
+                    where,
+                    hint="relative to the scenario",
+                )
+            )
+        out.append(
+            NodePlan(
+                name=node.name,
+                argv=argv + list(node.args),
+                env=dict(node.env),
+                cwd=str(cwd.resolve()),
+                namespace=node.namespace,
+                respawn=node.respawn,
+                respawn_limit=node.respawn_limit,
+                required=node.required,
+                host=host_of(sc, doc, node.host, ("nodes", i, "host")),
+            )
+        )
+    for j, name in enumerate(sc.lockstep):
+        if name not in seen:
+            where = ("lockstep", j)
+            problems.append(
+                Problem(
+                    f"no node named {name!r}",
+                    doc.locate(where),
+                    where,
+                    expected="one of: " + ", ".join(sorted(seen))
+                    if seen
+                    else "a node of this scenario (nodes:)",
+                )
+            )
+    if problems:
+        raise ScenarioError(problems)
+    return out
+
+
+def host_of(sc: Scenario, doc: Document, name: str | None, where: PathKey) -> str | None:
+    """A `host:` that must name one of `hosts:`."""
+    if name is not None and name not in sc.hosts:
+        raise ScenarioError(
+            Problem(
+                f"no host named {name!r}",
+                doc.locate(where),
+                where,
+                expected="one of: " + ", ".join(sc.hosts) if sc.hosts else "a host declared in `hosts:`",
+            )
+        )
+    return name

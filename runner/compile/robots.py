@@ -1,0 +1,225 @@
+"""A robot's description into the world: the URDF or xacro file found and read (`runner.compile.urdf`),
+its plugins built, `<transmission>`s given actuators, its Gazebo parity summed up, and the model attached
+under the robot's namespace at its pose."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import mujoco
+
+from runner.checks import truth_robots
+from runner.checks.judge import TRUTH_RATE, TRUTH_TOPIC
+from runner.compile.packages import PackageMap
+from runner.compile.parity import summarize
+from runner.compile.plugins import build_plugins
+from runner.compile.urdf import RobotModel, urdf_to_model
+from runner.compile.wheels import anisotropic_wheels, wheel_links
+from runner.compile.xacro_expand import expand
+from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError
+from runner.geometry import rpy_to_quat
+from runner.plan import RobotPlan
+from runner.scenario.loader import Document, PathKey
+from runner.scenario.schema import PluginEntry, Robot, Scenario
+
+
+def add_robots(
+    world: mujoco.MjSpec,
+    sc: Scenario,
+    doc: Document,
+    packages: PackageMap,
+    notices: Notices,
+    problems: Problems,
+    unloaded: list[str],
+) -> list[RobotPlan]:
+    """The scenario's robots loaded and attached to `world`, each on its own: the mistakes of one go to
+    `problems`, and its key prefix to `unloaded` (which topics it has is then not known)."""
+    watched = truth_robots(sc)
+    robots: list[RobotPlan] = []
+    for i, robot in enumerate(sc.robots):
+        if robot.name in watched:
+            # the judge reads the robot's true pose; recorded, so `scenario check` can judge the file
+            extra = PluginEntry(
+                type="ground_truth", name="_truth", params={"topic": TRUTH_TOPIC, "rate": TRUTH_RATE}
+            )
+            robot = robot.model_copy(update={"plugins": [*robot.plugins, extra]})
+        found = len(problems)
+        with problems.each():
+            robots.append(add_robot(world, sc, robot, i, doc, packages, notices, problems))
+        if len(problems) > found:  # not loaded, or a plugin left out: which topics it has is not known
+            unloaded.append(f"{sc.name}/{robot.ns}/")
+    return robots
+
+
+def add_robot(
+    world: mujoco.MjSpec,
+    sc: Scenario,
+    robot: Robot,
+    i: int,
+    doc: Document,
+    packages: PackageMap,
+    notices: Notices,
+    problems: Problems,
+) -> RobotPlan:
+    """Robot `i` (`robots[i]`) read, its plugins built (each one's mistakes to `problems`, left out),
+    attached to `world` under `<ns>/` at its pose."""
+    before = len(notices)
+    model = robot_model(robot, i, doc, packages, notices, sc.world.physics.timestep)
+    plugins = build_plugins(sc, robot, i, model, doc, problems)
+    add_transmissions(model, notices)
+    parity = summarize(model, plugins, notices.items[before:], f"{sc.name}/{robot.ns}/")
+    pos = robot.pose.xyz
+    frame = world.worldbody.add_frame(pos=list(pos), quat=list(rpy_to_quat(robot.pose.rpy)))
+    prefix = f"{robot.ns}/"
+    wheels = wheel_links(plugins, model.spec)
+    world.attach(model.spec, prefix=prefix, frame=frame)
+    anisotropic_wheels(world, prefix, wheels, model.gazebo, notices)
+    # a robot's camera may have grown its framebuffer: the world's is the one cameras render into
+    g, rg = world.visual.global_, model.spec.visual.global_
+    g.offwidth, g.offheight = max(g.offwidth, rg.offwidth), max(g.offheight, rg.offheight)
+    return RobotPlan(
+        name=robot.name,
+        namespace=robot.ns,
+        prefix=prefix,
+        root=model.root,
+        fixed=robot.fixed,
+        description_file=str(description_path(robot, doc.base_dir)),
+        links=model.links,
+        joints=model.joints,
+        plugins=plugins,
+        urdf=model.urdf,
+        gazebo=parity,
+    )
+
+
+def description_path(robot: Robot, base: Path) -> Path:
+    return (base / robot.desc.file).resolve()
+
+
+def _needs_file(path: Path, doc: Document, where: PathKey, what: str, kind: str) -> None:
+    if not path.is_file():
+        raise ScenarioError(
+            Problem(
+                f"{what} file not found",
+                doc.locate(where),
+                where,
+                expected=f"{kind} (relative to the scenario's folder)",
+                found=str(path),
+            )
+        )
+
+
+def _looks_like_xacro(path: Path) -> bool:
+    """A file whatever its name that uses xacro (launch files run xacro on `.urdf` files too: nav2's
+    sam_bot is one): it declares the xacro namespace or uses xacro elements."""
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return False
+    return "xmlns:xacro" in text or "<xacro:" in text
+
+
+def robot_model(
+    robot: Robot, i: int, doc: Document, packages: PackageMap, notices: Notices, timestep: float
+) -> RobotModel:
+    desc_path: PathKey = ("robots", i, "description")
+    if isinstance(robot.description, str):
+        file_path: PathKey = desc_path
+    else:
+        file_path = (*desc_path, "file")
+    path = description_path(robot, doc.base_dir)
+    _needs_file(path, doc, file_path, "robot description", "a URDF or xacro file")
+    controllers = []
+    for k, name in enumerate(robot.controllers):
+        found = doc.base_dir / name
+        _needs_file(found, doc, ("robots", i, "controllers", k), "controllers", "a ros_control YAML file")
+        controllers.append(found)
+    try:
+        if path.suffix == ".xacro" or _looks_like_xacro(path):
+            args = {k: _xacro_str(v) for k, v in robot.desc.args.items()}
+            result = expand(path, args, packages)
+            return urdf_to_model(
+                result.urdf,
+                path,
+                packages,
+                fixed=robot.fixed,
+                namespace=robot.ns,
+                model=robot.name,
+                notices=notices,
+                sources=result.sources,
+                expanded=True,
+                timestep=timestep,
+                controllers=controllers,
+            )
+        else:
+            if robot.desc.args:
+                raise ScenarioError(
+                    Problem(
+                        "`args` are given but the description is not a xacro file",
+                        doc.locate((*desc_path, "args")),
+                        (*desc_path, "args"),
+                        hint="xacro arguments apply to .xacro files only",
+                    )
+                )
+            urdf = path.read_text(encoding="utf-8")
+            return urdf_to_model(
+                urdf,
+                path,
+                packages,
+                fixed=robot.fixed,
+                namespace=robot.ns,
+                model=robot.name,
+                notices=notices,
+                timestep=timestep,
+                controllers=controllers,
+            )
+    except SourceError as e:
+        where = Location(e.file, e.line) if e.file else doc.locate(file_path)
+        hint = e.hint
+        problems = [Problem(str(e), where, hint=hint)]
+        if e.file != doc.file:
+            problems.append(
+                Problem(
+                    f"while loading robot {robot.name!r}",
+                    doc.locate(file_path),
+                    file_path,
+                )
+            )
+        raise ScenarioError(problems) from None
+
+
+def _xacro_str(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    return str(v)
+
+
+def add_transmissions(model: RobotModel, notices: Notices) -> None:
+    """`<transmission>` joints get an actuator, unless a plugin already drives them (a diff_drive's
+    wheels, a joint_controller's lift). Velocity -> velocity servo, position -> position servo,
+    effort -> motor; the mechanical reduction is the gear."""
+    spec = model.spec
+    driven = {a.target for a in spec.actuators}
+    for tr in model.transmissions:
+        joint = spec.joint(tr.joint)
+        if joint is None:
+            notices.add(f"a transmission names joint {tr.joint!r}, which the robot does not have")
+            continue
+        if tr.joint in driven:
+            continue
+        act = spec.add_actuator(
+            name=f"{tr.joint}/{tr.interface}", target=tr.joint, trntype=mujoco.mjtTrn.mjTRN_JOINT
+        )
+        if tr.interface == "velocity":
+            act.set_to_velocity(kv=1.0)
+        elif tr.interface == "position":
+            act.set_to_position(kp=100.0, kv=10.0)
+        else:
+            act.set_to_motor()
+        act.gear = [tr.reduction, 0, 0, 0, 0, 0]
+        frc = list(joint.actfrcrange)
+        if frc[1] > frc[0]:
+            act.forcelimited = True
+            act.forcerange = frc
+        driven.add(tr.joint)

@@ -1,0 +1,79 @@
+"""The `timeline:`: each entry's message type and data checked against the message definitions, and its
+type against the one its topic's subscriber takes."""
+
+from __future__ import annotations
+
+from runner.errors import Problem, Problems, ScenarioError
+from runner.plan import RobotPlan, TimelinePlan
+from runner.scenario.loader import Document, PathKey
+from runner.scenario.schema import Scenario
+from runner.wire import msgs
+
+
+def compile_timeline(
+    sc: Scenario, doc: Document, robots: list[RobotPlan], problems: Problems
+) -> list[TimelinePlan]:
+    """The timeline's entries checked (each on its own: its mistakes to `problems`), in time order."""
+    ordered: list[tuple[int, TimelinePlan]] = []
+    for i in range(len(sc.timeline)):
+        with problems.each():
+            ordered.append((i, timeline_entry(sc, i, doc)))
+    with problems.each():
+        check_timeline_types(ordered, robots, sc, doc)
+    return sorted((ev for _, ev in ordered), key=lambda ev: ev.t_ns)
+
+
+def timeline_entry(sc: Scenario, i: int, doc: Document) -> TimelinePlan:
+    ev = sc.timeline[i]
+    here: PathKey = ("timeline", i)
+    type_name = msgs.normalize_type(ev.type)
+    if not msgs.is_known(type_name):
+        close = msgs.similar_types(ev.type)
+        raise ScenarioError(
+            Problem(
+                f"unknown message type {ev.type!r}",
+                doc.locate((*here, "type")),
+                (*here, "type"),
+                expected="a ROS 2 message type such as geometry_msgs/msg/Twist",
+                hint=f"did you mean {close[0]!r}?" if close else None,
+            )
+        )
+    try:
+        msgs.from_data(type_name, ev.data)
+    except msgs.MessageDataError as e:
+        where: PathKey = (*here, "data", *e.path)
+        raise ScenarioError(Problem(str(e), doc.locate(where), where, hint=e.hint)) from None
+    topic = ev.topic
+    key = f"{sc.name}/{topic.lstrip('/')}"
+    return TimelinePlan(t_ns=round(ev.t * 1e9), key=key, type=type_name, data=ev.data)
+
+
+def check_timeline_types(
+    timeline: list[tuple[int, TimelinePlan]], robots: list[RobotPlan], sc: Scenario, doc: Document
+) -> None:
+    """A timeline entry must carry the type its topic's subscriber takes: a `std_msgs/msg/String` on a
+    drive's `cmd_vel` would reach the world (and a ROS client) as garbage."""
+    takes = {
+        t.key: (t.type, f"{p.type} {p.name!r} of robot {r.name!r}")
+        for r in robots
+        for p in r.plugins
+        for t in p.topics
+        if t.direction == "sub"
+    }
+    problems = []
+    for i, ev in timeline:  # (the index in the scenario, the entry)
+        wanted = takes.get(ev.key)
+        if wanted is not None and msgs.normalize_type(wanted[0]) != ev.type:
+            where: PathKey = ("timeline", i, "type")
+            problems.append(
+                Problem(
+                    f"{sc.timeline[i].topic} is taken by {wanted[1]} as {wanted[0]}",
+                    doc.locate(where),
+                    where,
+                    expected=wanted[0],
+                    found=ev.type,
+                    hint=f"write `type: {wanted[0]}` (and its fields under `data:`)",
+                )
+            )
+    if problems:
+        raise ScenarioError(problems)
