@@ -68,7 +68,7 @@ from runner.gl import (  # noqa: F401  (re-exported for the camera plugins and t
 from runner.plugin import BuildContext, PluginConfigError, RatedParams
 from runner.wire import msgs
 
-# The compiler gives every world an offscreen framebuffer of at least 1280x960 (runner/compile/__init__.py);
+# The compiler gives every world an offscreen framebuffer of at least 1280x960 (runner/compile/world.py);
 # a larger camera grows it, up to this (what any GL implementation offers).
 OFFSCREEN_MAX = (8192, 8192)
 
