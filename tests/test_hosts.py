@@ -168,7 +168,14 @@ def test_a_world_lost_on_the_other_host_fails_the_run(two_namespaces, write_scen
             mine = processes_of(far.pid, r"runner\.sim /", direct=True)
             far_world = mine[0] if mine else None
         assert far_world is not None, "the far world did not start"
-        time.sleep(1.0)
+        # killed once it steps (its clock in the recording's whole chunks), however long the start took
+        from runner.record.recorder import read_summary
+
+        while time.monotonic() < deadline:
+            counts = {t["topic"]: t["count"] for t in read_summary(mcap)["topics"]} if mcap.exists() else {}
+            if counts.get("spread/yonder/clock", 0) > 0:
+                break
+            time.sleep(0.2)
         killed = time.monotonic()
         os.kill(far_world, signal.SIGKILL)
         main_out, main_err = main.communicate(timeout=30)
