@@ -1,5 +1,5 @@
-"""Assertions: compile-time checks and wiring (here), the judge (`judge.py`), safe expressions (`expr.py`),
-JUnit XML (`junit.py`)."""
+"""Assertions: compile-time checks and wiring (here), the judge (`judge.py`), safe expressions (`expr/`).
+Their results as JUnit XML are written by `runner.tools.report`."""
 
 from __future__ import annotations
 

@@ -1,434 +1,38 @@
-"""Pydantic validation errors -> `ScenarioError`s that point at the file and line.
+"""Checking a scenario document against the format: `validate_scenario` (the model of a document, or a
+`ScenarioError` naming every problem with its file and line), the checks before the schema
+(`check_document`: a mapping, no NUL in any text) and after it (`consistency_problems`: unique names and
+namespaces, a timeline within the run), and `prune`, which takes out what the schema refused so that the
+rest of a file can still be checked in the same pass.
 
-Used for the scenario itself and for every plugin's `Params` (with a path prefix such as
-`robots[1].plugins[0].params`), so the two read the same.
+How a pydantic error becomes a `Problem` is `runner.scenario.problems`.
 """
 
 from __future__ import annotations
 
 import copy
 import dataclasses
-import difflib
-import re
-from typing import Annotated, Any, TypeVar, get_args, get_origin
+from typing import Any, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
 from runner.errors import Problem, ScenarioError
 from runner.scenario.loader import Document, PathKey
-from runner.scenario.schema import PATTERN_WORDS, Scenario
+from runner.scenario.model_paths import resolve
+from runner.scenario.problems import problems_from_validation, short
+from runner.scenario.schema import Scenario
+
+__all__ = [
+    "Pruned",
+    "check_consistency",
+    "check_document",
+    "consistency_problems",
+    "problems_from_validation",
+    "prune",
+    "validate_model",
+    "validate_scenario",
+]
 
 M = TypeVar("M", bound=BaseModel)
-
-
-def _resolve(data: Any, loc: tuple[Any, ...], about_keys: bool) -> tuple[PathKey, Any, bool]:
-    """Walk pydantic's `loc` through the data. Union branch names in `loc` ('str', 'Description')
-    do not exist in the data and are skipped. Returns (path in the data, the value there, whether the
-    last element was missing from a mapping)."""
-    path: list[str | int] = []
-    cur = data
-    missing = False
-    for i, el in enumerate(loc):
-        last = i == len(loc) - 1
-        in_dict = isinstance(cur, dict) and _has_key(cur, el)
-        in_list = isinstance(cur, list) and isinstance(el, int) and 0 <= el < len(cur)
-        if in_dict or in_list:
-            path.append(el)
-            cur = cur[el]
-        elif last and about_keys and isinstance(cur, dict) and isinstance(el, str):
-            path.append(el)
-            missing = True
-        # else: a union branch tag, '[key]', or an item missing from a too short list; skip it
-    return tuple(path), cur, missing
-
-
-def _has_key(d: dict[Any, Any], el: Any) -> bool:
-    try:
-        return el in d
-    except TypeError:  # an unhashable element of `loc`
-        return False
-
-
-def _model_at(root: type[BaseModel], path: PathKey, data: Any = None) -> type[BaseModel] | None:
-    """The model class that holds the value at `path` (for listing the keys it accepts); in a union
-    tagged by `type`, the member the data names."""
-    tp: Any = root
-    cur = data
-    for el in path:
-        tp = _pick_member(tp, cur)
-        tp = _unwrap_model(tp, el)
-        cur = _step(cur, el)
-        if tp is None:
-            return None
-    return _unwrap_model(_pick_member(tp, cur), None)
-
-
-def _step(cur: Any, el: Any) -> Any:
-    if isinstance(cur, dict):
-        return cur.get(el)
-    if isinstance(cur, list) and isinstance(el, int) and 0 <= el < len(cur):
-        return cur[el]
-    return None
-
-
-def _pick_member(tp: Any, cur: Any) -> Any:
-    """Of a union of models, the one whose `type` literal matches the data's `type`."""
-    if not isinstance(cur, dict) or "type" not in cur:
-        return tp
-    for arg in _flatten(tp):
-        is_model = isinstance(arg, type) and issubclass(arg, BaseModel) and "type" in arg.model_fields
-        if is_model and cur["type"] in get_args(arg.model_fields["type"].annotation):
-            return arg
-    return tp
-
-
-def _flatten(tp: Any) -> list[Any]:
-    args = get_args(tp)
-    if not args:
-        return [tp]
-    out: list[Any] = []
-    for a in args:
-        out += _flatten(a)
-    return out
-
-
-def _unwrap_model(tp: Any, el: Any) -> Any:
-    """Step one element down a type: a field of a model, an item of a list/dict, a branch of a union."""
-    if el is None:
-        if isinstance(tp, type) and issubclass(tp, BaseModel):
-            return tp
-        for arg in get_args(tp):
-            found = _unwrap_model(arg, None)
-            if found is not None:
-                return found
-        return None
-    if isinstance(tp, type) and issubclass(tp, BaseModel):
-        field = tp.model_fields.get(el) if isinstance(el, str) else None
-        return field.annotation if field else None
-    origin = get_origin(tp)
-    if origin in (list, tuple) and isinstance(el, int):
-        args = get_args(tp)
-        return args[0] if args else None
-    if origin is dict:
-        args = get_args(tp)
-        return args[1] if len(args) == 2 else None
-    for arg in get_args(tp):  # union / Annotated
-        found = _unwrap_model(arg, el)
-        if found is not None:
-            return found
-    return None
-
-
-def _type_at(root: type[BaseModel], path: PathKey, data: Any = None) -> Any:
-    """The annotation of the value at `path` (None when it cannot be followed)."""
-    tp: Any = root
-    cur = data
-    for el in path:
-        tp = _unwrap_model(_pick_member(tp, cur), el)
-        cur = _step(cur, el)
-        if tp is None:
-            return None
-    return tp
-
-
-def _tuple_len(tp: Any) -> int | None:
-    """The number of items of a fixed-length tuple type (also inside `| None`)."""
-    for arg in [tp, *get_args(tp)]:
-        while get_origin(arg) is Annotated:
-            arg = get_args(arg)[0]
-        if get_origin(arg) is tuple:
-            args = get_args(arg)
-            if args and Ellipsis not in args:
-                return len(args)
-    return None
-
-
-def _tags(tp: Any) -> list[str]:
-    """The `type` literals of a union of models tagged by `type`."""
-    out: list[str] = []
-    for arg in _flatten(tp):
-        if isinstance(arg, type) and issubclass(arg, BaseModel) and "type" in arg.model_fields:
-            out += [str(t) for t in get_args(arg.model_fields["type"].annotation)]
-    return out
-
-
-def _pattern_problem(value: Any, pattern: str) -> tuple[str, str | None]:
-    """(what the pattern allows, in words; why the value does not fit) for a string_pattern_mismatch."""
-    words, extra = PATTERN_WORDS.get(pattern, (f"text matching the pattern {pattern}", ""))
-    if not isinstance(value, str):
-        return words, None
-    if value == "":
-        return words, "it is empty"
-    reserved = sorted({c for c in value if c in "*$?#"})
-    if reserved:
-        return words, (
-            "not allowed: "
-            + ", ".join(repr(c) for c in reserved)
-            + " (wildcards and reserved characters of Zenoh key expressions: names become key chunks)"
-        )
-    bad = sorted({c for c in value if not (c.isascii() and (c.isalnum() or c == "_")) and c not in extra})
-    if bad:
-        return words, "not allowed: " + ", ".join(repr(c) for c in bad)
-    if "/" in extra and ("//" in value or value.endswith("/") or value.startswith("//")):
-        return words, "an empty chunk: no doubled or trailing '/'"
-    if value.startswith("/") and re.fullmatch(pattern, "/a") is None:
-        return words, "no leading '/' here"
-    chunks = value.split("/") if "/" in extra else [value]
-    if any(c[:1].isdigit() for c in chunks if c):
-        return words, "a name (or a chunk of it) starts with a digit"
-    if value[:1] in "-.":
-        return words, f"it starts with {value[0]!r}"
-    return words, None
-
-
-def _short(value: Any, limit: int = 60) -> str:
-    text = repr(value)
-    return text if len(text) <= limit else text[: limit - 3] + "..."
-
-
-def _kind(value: Any) -> str:
-    """What a YAML reader calls the value's type."""
-    if value is None:
-        return "null"
-    return {
-        dict: "mapping",
-        list: "list",
-        str: "string",
-        bool: "boolean",
-        int: "integer",
-        float: "number",
-    }.get(type(value), type(value).__name__)
-
-
-_TYPE_WORDS = {
-    "string_type": "a string",
-    "model_type": "a mapping",
-    "model_attributes_type": "a mapping",
-    "dict_type": "a mapping",
-    "list_type": "a list",
-    "tuple_type": "a list",
-    "float_type": "a number",
-    "int_type": "an integer",
-    "bool_type": "true or false",
-}
-
-
-def problems_from_validation(
-    err: ValidationError,
-    data: Any,
-    doc: Document,
-    model: type[BaseModel],
-    prefix: PathKey = (),
-) -> list[Problem]:
-    grouped: dict[PathKey, list[tuple[dict[str, Any], Any, bool]]] = {}
-    for e in err.errors(include_url=False):
-        about_keys = e["type"] in ("missing", "extra_forbidden")
-        path, value, missing = _resolve(data, tuple(e["loc"]), about_keys)
-        grouped.setdefault(path, []).append((e, value, missing))
-
-    # A misspelt required key is both "unknown key 'descripton'" and "missing key 'description'": say it once.
-    unknown = {
-        (p[:-1], str(p[-1]))
-        for p, errs in grouped.items()
-        for e, _, _ in errs
-        if e["type"] == "extra_forbidden"
-    }
-    for path in list(grouped):
-        if path and all(e["type"] == "missing" for e, _, _ in grouped[path]):
-            typos = [k for parent, k in unknown if parent == path[:-1]]
-            if difflib.get_close_matches(str(path[-1]), typos, n=1):
-                del grouped[path]
-
-    problems: list[Problem] = []
-    for path, errs in grouped.items():
-        deeper = any(len(other) > len(path) and other[: len(path)] == path for other in grouped)
-        if deeper and all(x[0]["type"].endswith("_type") for x in errs):
-            continue  # `description: str | {file, args}`: the mapping's own errors say more
-        # Several errors on one path come from the branches of a union. Errors inside the branch the
-        # user meant (e.g. an unknown key inside a mapping) are worth more than "not a string".
-        specific = [x for x in errs if not x[0]["type"].endswith("_type")]
-        if specific:
-            errs = specific
-        elif len(errs) > 1:
-            words = sorted({_TYPE_WORDS.get(x[0]["type"], x[0]["type"]) for x in errs})
-            _e0, value, _ = errs[0]
-            problems.append(
-                Problem(
-                    "wrong type",
-                    doc.locate(prefix + path),
-                    prefix + path,
-                    expected=" or ".join(words),
-                    found=f"{_kind(value)} {_short(value)}",
-                )
-            )
-            continue
-        for e, value, missing in errs:
-            problems.append(_with_hint(_problem(e, value, missing, path, doc, model, prefix, data), value))
-    return problems
-
-
-def _problem(
-    e: dict[str, Any],
-    value: Any,
-    missing: bool,
-    path: PathKey,
-    doc: Document,
-    model: type[BaseModel],
-    prefix: PathKey,
-    data: Any = None,
-) -> Problem:
-    full = prefix + path
-    kind = e["type"]
-    msg: str = e["msg"]
-    if kind == "extra_forbidden":
-        key = path[-1]
-        holder = _model_at(model, path[:-1], data)
-        allowed = sorted(holder.model_fields) if holder else []
-        close = difflib.get_close_matches(str(key), allowed, n=1)
-        return Problem(
-            f"unknown key {key!r}",
-            doc.locate(full),
-            full,
-            expected="one of: " + ", ".join(allowed) if allowed else None,
-            hint=f"did you mean {close[0]!r}?" if close else "remove it, or check its indentation",
-        )
-    if kind == "union_tag_invalid":
-        ctx = e.get("ctx") or {}
-        tags = [t.strip(" '") for t in str(ctx.get("expected_tags", "")).split(",") if t.strip()]
-        found = str(ctx.get("tag", ""))
-        close = difflib.get_close_matches(found, tags, n=1)
-        where = (*full, str(ctx.get("discriminator", "type")).strip("'"))
-        return Problem(
-            f"unknown {ctx.get('discriminator', 'type')} {found!r}".replace("'type'", "type"),
-            doc.locate(where),
-            where,
-            expected="one of: " + ", ".join(tags),
-            hint=f"did you mean {close[0]!r}?" if close else None,
-        )
-    loc = tuple(e["loc"])
-    if kind == "invalid_key" or (kind.endswith("_type") and loc and loc[-1] == "[key]"):
-        key = e.get("input")
-        parent = path[:-1] if path and (path[-1] is key or path[-1] == key) else path
-        return Problem(
-            f"the key {key!r} is not text",
-            doc.locate((*prefix, *parent, key)),
-            prefix + parent,
-            expected="a name",
-            found=f"{_kind(key)} {_short(key)}",
-            hint="quote it if it is meant as text (`'1': ...`)",
-        )
-    if kind == "union_tag_not_found":
-        where = (*full, "type")
-        tags = _tags(_type_at(model, path, data))
-        return Problem(
-            "missing required key 'type'",
-            doc.locate(full),
-            where,
-            expected="one of: " + ", ".join(tags) if tags else None,
-            hint="add `type:` to say which kind this is",
-        )
-    if kind == "string_pattern_mismatch":
-        words, why = _pattern_problem(value, str((e.get("ctx") or {}).get("pattern", "")))
-        return Problem(
-            "not a valid name", doc.locate(full), full, expected=words, found=_short(value), hint=why
-        )
-    if kind in ("too_short", "too_long") or (kind == "missing" and isinstance(e["loc"][-1], int)):
-        n = _tuple_len(_type_at(model, path, data))
-        ctx = e.get("ctx") or {}
-        if n is not None:
-            expected = f"a list of {n} numbers"
-        elif kind == "too_short":
-            expected = f"at least {ctx.get('min_length')} item(s)"
-        else:
-            expected = f"at most {ctx.get('max_length')} item(s)"
-        count = len(value) if isinstance(value, list | tuple | str | dict) else None
-        return Problem(
-            f"expected {n} items, found {count}" if n is not None else "wrong number of items",
-            doc.locate(full),
-            full,
-            expected=expected,
-            found=_short(value),
-        )
-    if kind.endswith("_type") and kind in _TYPE_WORDS:
-        expected = _TYPE_WORDS[kind]
-        if kind == "tuple_type":
-            n = _tuple_len(_type_at(model, path, data))
-            expected = f"a list of {n} numbers" if n else expected
-        return Problem(
-            "wrong type", doc.locate(full), full, expected=expected, found=f"{_kind(value)} {_short(value)}"
-        )
-    if kind == "missing":
-        key = path[-1]
-        holder = _model_at(model, path[:-1], data)
-        desc = holder.model_fields[key].description if holder and key in holder.model_fields else None
-        return Problem(
-            f"missing required key {key!r}",
-            doc.locate(full),
-            full,
-            hint=f"add `{key}:` ({desc})" if desc else f"add `{key}:`",
-        )
-    if kind == "value_error":
-        return Problem(msg.removeprefix("Value error, "), doc.locate(full), full, found=_short(value))
-    expected = msg.removeprefix("Input should be ") if msg.startswith("Input should be ") else None
-    if expected:
-        expected = expected.split(", unable to parse")[0]
-        return Problem("wrong value", doc.locate(full), full, expected=expected, found=_short(value))
-    return Problem(msg, doc.locate(full), full, found=_short(value))
-
-
-# Units people write after numbers, and what the scenario wants instead (SI: seconds, metres, radians)
-_UNITS = {
-    "ms": ("seconds", 1e-3),
-    "s": ("seconds", 1.0),
-    "sec": ("seconds", 1.0),
-    "us": ("seconds", 1e-6),
-    "mm": ("metres", 1e-3),
-    "cm": ("metres", 1e-2),
-    "m": ("metres", 1.0),
-    "km": ("metres", 1e3),
-    "deg": ("radians", 3.141592653589793 / 180),
-    "°": ("radians", 3.141592653589793 / 180),
-    "rad": ("radians", 1.0),
-    "hz": ("Hz", 1.0),
-    "kg": ("kilograms", 1.0),
-    "g": ("kilograms", 1e-3),
-}
-_SYNONYMS = {"cube": "box", "ball": "sphere", "tube": "cylinder", "rect": "box"}
-_NUMBER_WITH_UNIT = re.compile(r"^\s*([-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)\s*([a-zA-Z°]+)\s*$")
-
-
-def _with_hint(problem: Problem, value: Any) -> Problem:
-    """Every problem says what to do: a number written with its unit gets the plain number in SI units,
-    a word close to (or meaning) an allowed one gets it, and anything else a hint from what was expected."""
-    if problem.hint:
-        return problem
-    if ": write " in problem.message:  # a validator's own advice: "<what is wrong>: write <the fix>"
-        what, fix = problem.message.split(": write ", 1)
-        return dataclasses.replace(problem, message=what, hint=f"write {fix}")
-    expected = problem.expected or ""
-    hint = None
-    if isinstance(value, str) and "number" in expected:
-        m = _NUMBER_WITH_UNIT.match(value)
-        if m and m.group(2).lower() in _UNITS:
-            unit, factor = _UNITS[m.group(2).lower()]
-            hint = f"numbers are plain, in {unit}: write {float(m.group(1)) * factor:g}"
-        else:
-            hint = "write a plain number (SI units: metres, seconds, radians), without quotes"
-    elif isinstance(value, str) and expected:
-        options = re.findall(r"'([^']+)'", expected)
-        word = value.strip().lower()
-        close = [_SYNONYMS[word]] if _SYNONYMS.get(word) in options else []
-        close = close or difflib.get_close_matches(word, options, n=1)
-        hint = (
-            f"did you mean {close[0]!r}?"
-            if close
-            else (f"use one of: {', '.join(options)}" if options else None)
-        )
-    if hint is None and expected:
-        hint = f"give {expected}"
-    if hint is None:
-        hint = "see the scenario's JSON schema (`scenario schema`) for what this key takes"
-    return dataclasses.replace(problem, hint=hint)
 
 
 def validate_model(model: type[M], data: Any, doc: Document, prefix: PathKey = ()) -> M:
@@ -470,7 +74,7 @@ def _check_text(value: Any, doc: Document, path: PathKey) -> None:
                 "this text holds a NUL character",
                 doc.locate(path),
                 path,
-                found=_short(value),
+                found=short(value),
                 hint="remove the \\0 (or \\x00) escape",
             )
         )
@@ -602,7 +206,7 @@ def prune(model: type[BaseModel], data: Any, rounds: int = 6) -> tuple[BaseModel
             cut: dict[PathKey, str] = {}  # data path -> "key" (drop the key) or "item" (drop the list item)
             for e in err.errors(include_url=False):
                 about_keys = e["type"] in ("missing", "extra_forbidden")
-                path, _value, missing = _resolve(pruned.data, tuple(e["loc"]), about_keys)
+                path, _value, missing = resolve(pruned.data, tuple(e["loc"]), about_keys)
                 short = e["type"] == "missing" and isinstance(e["loc"][-1], int)  # a list too short
                 if (short or e["type"] != "missing") and path and not missing and isinstance(path[-1], str):
                     cut[path] = "key"  # (a default, if the field has one; else "missing" next round)

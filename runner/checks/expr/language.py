@@ -1,0 +1,145 @@
+"""What the expression language is made of, shared by its parts (checking, evaluating, checking by
+type): the operators, functions and reducers it allows, the error it raises (`ExprError`, with a caret
+under the column), where in the user's text a node of the tree stands (`Source`) and the field paths an
+expression reads (`FieldPath`)."""
+
+from __future__ import annotations
+
+import ast
+import dataclasses
+import difflib
+
+REDUCERS = ("min", "max", "mean", "sum", "std")
+FUNCTIONS = ("abs", "len", "min", "max")
+CALLS_ALLOWED = "abs, len, min, max and .min() .max() .mean() .sum() .std()"
+ALLOWED = (
+    "field paths (pose.position.x, ranges[0]), numbers, strings, True/False, + - * / %, "
+    "comparisons < <= > >= == !=, and/or/not, " + CALLS_ALLOWED
+)
+MAX_DEPTH = 100  # nesting of the tree; keeps the interpreter's recursion bounded
+
+# The operators and comparisons allowed, by their symbol (as messages name them).
+BINOPS: dict[type[ast.operator], str] = {
+    ast.Add: "+",
+    ast.Sub: "-",
+    ast.Mult: "*",
+    ast.Div: "/",
+    ast.Mod: "%",
+}
+CMPOPS: dict[type[ast.cmpop], str] = {
+    ast.Lt: "<",
+    ast.LtE: "<=",
+    ast.Gt: ">",
+    ast.GtE: ">=",
+    ast.Eq: "==",
+    ast.NotEq: "!=",
+}
+
+
+class ExprError(ValueError):
+    """An expression that is not allowed, names a field the message lacks, or cannot be evaluated.
+
+    `message` says what was found and what is allowed; `column` is the 1-based position in the expression
+    text where the problem is (None when it is not about one place); `hint` may suggest a fix; `text` is the
+    expression, when known. `str(error)` is the message."""
+
+    def __init__(
+        self, message: str, column: int | None = None, hint: str | None = None, text: str | None = None
+    ):
+        super().__init__(message)
+        self.message = message
+        self.column = column
+        self.hint = hint
+        self.text = text
+
+    def render(self) -> str:
+        """The message, with the expression and a caret under the column when both are known."""
+        lines = [self.message]
+        if self.text is not None and self.column is not None and "\n" not in self.text:
+            lines += [f"  {self.text}", "  " + " " * (self.column - 1) + "^"]
+        if self.hint:
+            lines.append(f"  hint: {self.hint}")
+        return "\n".join(lines)
+
+
+@dataclasses.dataclass(frozen=True)
+class FieldPath:
+    """One field path of the expression, for `check_fields`: `segments` are field names (str) and indexes
+    (int) with their columns; `use` is what is done with the value: "value", "len" or a reducer's name."""
+
+    segments: tuple[tuple[str | int, int | None], ...]
+    use: str
+    column: int | None
+    node: ast.AST = dataclasses.field(compare=False, repr=False)
+
+
+class Source:
+    """Maps the parsed text's UTF-8 byte offsets back to 1-based columns of the user's text."""
+
+    def __init__(self, text: str):
+        self.text = text
+        # Newlines (YAML block scalars) become spaces so that the text is one line and keeps its length;
+        # leading blanks are dropped (Python refuses them) and added back to every column.
+        flat = text.replace("\r", " ").replace("\n", " ")
+        stripped = flat.lstrip(" \t\f")
+        self.shift = len(flat) - len(stripped)
+        self.src = stripped
+        self._bytes = stripped.encode()
+        self._between: dict[tuple[int, int], int | None] = {}
+
+    def column(self, col_offset: int | None) -> int | None:
+        if col_offset is None:
+            return None
+        return self.shift + len(self._bytes[:col_offset].decode(errors="replace")) + 1
+
+    def between(self, left: ast.AST, right: ast.AST, symbol: str) -> int | None:
+        """Column of an operator `symbol` written between two operands."""
+        key = (id(left), id(right))
+        if key not in self._between:
+            self._between[key] = self._find_between(left, right, symbol)
+        return self._between[key]
+
+    def _find_between(self, left: ast.AST, right: ast.AST, symbol: str) -> int | None:
+        start = getattr(left, "end_col_offset", None)
+        end = getattr(right, "col_offset", None)
+        if start is None or end is None:
+            return self.column(getattr(left, "col_offset", None))
+        seg = self._bytes[start:end].decode(errors="replace")
+        i = seg.find(symbol.split()[0])
+        if i < 0:
+            return self.column(start)
+        return self.column(start + len(seg[:i].encode()))
+
+    def node(self, node: ast.AST) -> int | None:
+        return self.column(getattr(node, "col_offset", None))
+
+    def attr(self, node: ast.Attribute) -> int | None:
+        """Column of the attribute's name (after the dot)."""
+        return self.column(node.end_col_offset - len(node.attr.encode()) if node.end_col_offset else None)
+
+
+def is_path(node: ast.AST) -> bool:
+    return isinstance(node, ast.Name | ast.Attribute | ast.Subscript)
+
+
+def index_value(node: ast.AST) -> int | None:
+    """The integer of an index `[3]` or `[-1]`, or None when it is anything else."""
+    if isinstance(node, ast.Constant) and type(node.value) is int:
+        return node.value
+    if (
+        isinstance(node, ast.UnaryOp)
+        and isinstance(node.op, ast.USub)
+        and isinstance(node.operand, ast.Constant)
+        and type(node.operand.value) is int
+    ):
+        return -node.operand.value
+
+
+ARRAY_HINT = "reduce a sequence to one value first: ranges.min() > 0.25, not ranges > 0.25"
+
+
+def did_you_mean(name: str, names: list[str]) -> str | None:
+    if name in ("true", "false"):
+        return "booleans are written True and False"
+    close = difflib.get_close_matches(name, names, n=1)
+    return f"did you mean {close[0]!r}?" if close else None

@@ -1,0 +1,53 @@
+"""A scenario file as the commands get it: its matrix variants compiled to plans (`load_variants`), the
+warnings about it (`print_notices`) and `--strict`, which makes the scenario's own warnings errors."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import typer
+
+from runner.cli.console import err
+
+
+def load_variants(file: Path, record: str | None, variant: int | None) -> list[tuple[str, Any]]:
+    """[(label, plan)] of the scenario's matrix variants (one, unlabelled, without a matrix)."""
+    from runner.compile import load_plan
+    from runner.scenario.loader import load_file
+    from runner.scenario.matrix import variants
+
+    found = variants(load_file(file))
+    if variant is not None:
+        if not 0 <= variant < len(found):
+            raise typer.BadParameter(f"the scenario has {len(found)} variant(s): 0..{len(found) - 1}")
+        found = [found[variant]]
+    out = []
+    for label, doc in found:
+        out.append((label, load_plan(doc, record_path=record)))
+    return out
+
+
+def strict_failure(plan: Any) -> None:
+    """With --strict: the scenario's own warnings are errors (exit 1)."""
+    if plan.scenario_warnings:
+        for text in plan.scenario_warnings:
+            err.print("error: " + text, markup=False, style="red")
+        err.print(
+            f"--strict: {len(plan.scenario_warnings)} warning(s) about the scenario are errors",
+            markup=False,
+            style="red",
+        )
+        raise typer.Exit(1)
+
+
+def print_notices(notices: list[str], verbose: bool) -> None:
+    """The warnings compiling the scenario gave: each of them, or (not verbose) how many."""
+    if not notices:
+        return
+    if not verbose:
+        err.print(f"{len(notices)} warning(s): `scenario validate` lists them", markup=False)
+        return
+    err.print(f"{len(notices)} warning(s):", markup=False)
+    for text in notices:
+        err.print("warning: " + text, markup=False, style="yellow")

@@ -1,0 +1,57 @@
+"""Assertion verdicts on the terminal, as `run` and `check` print them: the table, the pass/fail summary
+line, and the trajectory plot written beside the recording when an assertion failed."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from rich.table import Table
+
+from runner.cli.console import err, out
+
+MARKS = {"pass": "[green]pass[/]", "fail": "[bold red]FAIL[/]", "undecided": "[yellow]not decided[/]"}
+
+
+def plot_failure(plan: Any, mcap: Path, results: list[Any]) -> None:
+    """A failed assertion: the robots' paths, regions and the failure point, as a PNG beside the MCAP."""
+    from runner.tools.plot import trajectory_plot
+
+    try:
+        png = trajectory_plot(plan, mcap, results, mcap.with_suffix(".trajectory.png"))
+    except Exception as e:  # a picture must never hide the verdict
+        err.print(f"warning: no trajectory plot ({type(e).__name__}: {e})", markup=False)
+        return
+    if png is not None:
+        out.print(f"trajectory plot: {png}", markup=False)
+
+
+def print_results(results: list[Any], allow_undecided: bool = False) -> None:
+    """The assertions' table and a summary line; an undecided one is named with why."""
+    table = Table(
+        "assertion",
+        "type",
+        "result",
+        "at (sim s)",
+        "value",
+        "bound",
+        title="Assertions",
+        title_justify="left",
+    )
+    for r in results:
+        table.add_row(
+            r.name, r.type, MARKS[r.status], f"{r.t:.3f}" if r.t is not None else "", r.value, r.bound
+        )
+    out.print(table)
+    failed = [r for r in results if r.status == "fail"]
+    undecided = [r for r in results if r.undecided]
+    summary = f"{len(results) - len(failed) - len(undecided)} passed, {len(failed)} failed"
+    if undecided:
+        counted = (
+            "not counted as failures: --allow-undecided" if allow_undecided else "each counts as a failure"
+        )
+        summary += f", {len(undecided)} not decided ({counted})"
+    bad = failed or (undecided and not allow_undecided)
+    out.print(summary, style="red" if bad else ("yellow" if undecided else "green"), markup=False)
+    for r in undecided:
+        out.print(f"  not decided: {r.name}: {r.message}", markup=False)

@@ -1,0 +1,69 @@
+"""The run's messages: published at sim times (`timeline:`), delivered reliably or not (`qos:`), recorded
+to MCAP (`record:`), with the Foxglove 3D view a recording carries (`foxglove:`)."""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+from pydantic import Field, NonNegativeFloat, PositiveFloat
+
+from runner.scenario.schema.base import TOPIC_RE, Strict
+
+
+class TimelineEntry(Strict):
+    """At sim time `t`, publish a message on a topic of the run."""
+
+    t: NonNegativeFloat = Field(description="Sim time in seconds.")
+    topic: str = Field(
+        pattern=TOPIC_RE.pattern,
+        description="Topic inside the run's key space, e.g. `r1/cmd_vel` (-> `<run>/r1/cmd_vel`).",
+    )
+    type: str = Field(description="ROS 2 message type, e.g. `geometry_msgs/msg/Twist`.")
+    data: dict[str, Any] = Field(
+        default_factory=dict, description="Message fields as YAML; omitted fields are zero."
+    )
+
+
+class Record(Strict):
+    enabled: bool = Field(True, description="Record the run to MCAP.")
+    path: str | None = Field(
+        None,
+        description="MCAP file to write, relative to the scenario's folder (default: `runs/<name>.mcap` "
+        "in the current folder).",
+    )
+    include: list[str] = Field(
+        default_factory=lambda: ["**"],
+        description="Zenoh key expressions relative to the run (`*/scan`, `r1/**`) of topics to record.",
+    )
+    exclude: list[str] = Field(default_factory=list, description="Key expressions of topics not to record.")
+
+
+class QosRule(Strict):
+    """How the publishers of some topics behave when a subscriber falls behind."""
+
+    topics: str = Field(
+        description="Key expression inside the run (`*/camera/**`, `r1/scan`): the topics this rule is for."
+    )
+    reliability: Literal["reliable", "best_effort"] = Field(
+        description="`reliable` (the default for every topic): a publisher waits rather than drop a message, "
+        "so nothing recorded is ever lost and a slow subscriber slows the simulation down; `best_effort`: "
+        "it drops instead (cameras for a live viewer: the simulation never waits; the recorder counts "
+        "what was lost)."
+    )
+
+
+class Foxglove(Strict):
+    """What the world publishes so that a recording (or a live run) opens in Foxglove as a 3D view with no
+    set-up: the world's and robots' geometry, every link's transform, each robot's URDF."""
+
+    scene: bool = Field(
+        True,
+        description="Publish `scene` (foxglove.SceneUpdate: boxes, cylinders, spheres, meshes of every "
+        "body), `tf_static`/`tf` (every link, from `world`: a `robot_state_publisher` `tf` plugin is added "
+        "to each robot without a `tf` plugin) and `<ns>/robot_description` (URDF, links named "
+        "`<ns>/<link>`).",
+    )
+    rate: PositiveFloat = Field(
+        1.0, description="How often (per sim second) the scene, static transforms and URDFs are sent again."
+    )
+    tf_rate: PositiveFloat = Field(30.0, description="Transforms of moving links per sim second.")

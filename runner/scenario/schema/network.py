@@ -1,0 +1,179 @@
+"""The run beyond its world: the machines it spans (`hosts:`), the processes started with it (`nodes:`),
+its Zenoh configuration (`zenoh:`), how ROS 2 sees it over rmw_zenoh (`ros2:`) and the topics it
+re-exposes under other keys (`bridges:`, like ros_gz_bridge)."""
+
+from __future__ import annotations
+
+import re
+from typing import Annotated, Any, Literal
+
+from pydantic import Field, NonNegativeInt, PositiveFloat, field_validator, model_validator
+
+from runner.scenario.schema.base import IDENT_RE, NODE_NAME_RE, Namespace, Strict
+
+_ENDPOINT_PATTERN = r"^(tcp|udp|tls|quic|ws|unixsock-stream|unixpipe|serial|vsock)/\S+$"
+
+
+class Host(Strict):
+    """A machine of the run, by the Zenoh endpoint its runner listens on."""
+
+    endpoint: str = Field(
+        description="Zenoh endpoint of this host's runner, e.g. `tcp/10.0.0.2:7447`. The first host of "
+        "`hosts:` is the main one: it records and judges; the others run `scenario run FILE --host NAME` "
+        "and join it.",
+        json_schema_extra={"pattern": _ENDPOINT_PATTERN},
+    )
+
+    @field_validator("endpoint")
+    @classmethod
+    def _an_endpoint(cls, value: str) -> str:
+        if not re.match(_ENDPOINT_PATTERN, value):
+            example = value.split("/")[-1] or "10.0.0.2:7447"
+            raise ValueError(f"not a Zenoh endpoint: write it with its protocol, e.g. tcp/{example}")
+        return value
+
+
+class Node(Strict):
+    """A process of the run: a controller, a planner, a bridge. It gets the run's Zenoh endpoint, name,
+    its namespace and the clock key in its environment (`SCENARIO_ENDPOINT`, `SCENARIO_RUN`,
+    `SCENARIO_NAMESPACE`, `SCENARIO_CLOCK`, `SCENARIO_NODE`); `runner.node.Node()` reads them."""
+
+    name: Annotated[str, Field(pattern=NODE_NAME_RE.pattern)] = Field(
+        description="Node name (letters, digits, '_', '-'): in logs, `lockstep:` and the run's report."
+    )
+    cmd: str | list[str] = Field(
+        description="The command: a string split like a shell would (`python nodes/go_to_goal.py`), or a "
+        "list. A leading `python` is this interpreter. Relative paths are relative to `cwd`."
+    )
+    args: list[str] = Field(default_factory=list, description="Extra arguments after the command.")
+    env: dict[str, str] = Field(default_factory=dict, description="Extra environment variables.")
+    cwd: str | None = Field(None, description="Working folder (default: the scenario's folder).")
+    namespace: Namespace | None = Field(
+        None, description="The robot namespace it works in (`SCENARIO_NAMESPACE`), e.g. `r1`."
+    )
+    respawn: Literal["never", "on-failure"] = Field(
+        "never", description="Start it again when it exits with an error (up to `respawn_limit` times)."
+    )
+    respawn_limit: NonNegativeInt = Field(3, description="Restarts allowed with `respawn: on-failure`.")
+    required: bool = Field(
+        False, description="The run fails (exit 1) and stops when this node exits before the run ends."
+    )
+    host: str | None = Field(None, description="With `hosts:`, the host that runs it (default: the first).")
+    world: str | None = Field(
+        None,
+        description="With `worlds:`, the world whose key space the node works in (`SCENARIO_RUN` is "
+        "`<run>/<world>`; default: the world of the robot named by its namespace, else the first).",
+    )
+
+
+class Ros2(Strict):
+    """Be seen by ROS 2 over rmw_zenoh (no ROS needed here): topics under rmw_zenoh's keys
+    (`<domain>/<name>/<type>/<hash>`), with its liveliness tokens and attachments, so `ros2 topic list`,
+    `ros2 topic echo` and rclcpp/rclpy nodes running `RMW_IMPLEMENTATION=rmw_zenoh_cpp` see the run."""
+
+    domain: Annotated[int, Field(ge=0, le=232)] = Field(0, description="ROS_DOMAIN_ID.")
+    node: Annotated[str, Field(pattern=IDENT_RE.pattern)] | None = Field(
+        None, description="The ROS 2 node name the simulation appears as (default: the run's name)."
+    )
+    router: str | None = Field(
+        None,
+        description="Zenoh endpoint of a ROS 2 Zenoh router to join (e.g. `tcp/127.0.0.1:7447`, where "
+        "`ros2 run rmw_zenoh_cpp rmw_zenohd` listens). Default: ROS 2 nodes join the run's own router "
+        "(`scenario run FILE --listen tcp/127.0.0.1:7447` puts it where rmw_zenoh looks by default).",
+    )
+    topics: Literal["all", "bridged"] = Field(
+        "all",
+        description="`all`: every topic of the simulation appears as `/<namespace>/<topic>` (and "
+        "`/clock`), in the directions the simulation uses it; `bridged`: only the `bridges:`.",
+    )
+
+
+class ZenohSettings(Strict):
+    """The run's Zenoh configuration, passed to every session of the run (router, worlds, renderers,
+    nodes, bridge, and the command-line tools that join it): TLS, access control, anything Zenoh has."""
+
+    config: str | None = Field(
+        None, description="A Zenoh configuration file (JSON5), relative to the scenario, taken first."
+    )
+    settings: dict[str, Any] = Field(
+        default_factory=dict,
+        description="Settings by their path in Zenoh's configuration, on top of the file, e.g. "
+        "`transport/link/tls/root_ca_certificate: certs/ca.pem` (file paths relative to the scenario).",
+    )
+    listen: list[str] = Field(
+        default_factory=list,
+        description="The run's router endpoints, e.g. `tls/127.0.0.1:7447` (default: a free TCP port on "
+        "127.0.0.1: loopback only unless told otherwise; `--listen` overrides).",
+    )
+
+
+BridgeDirection = Literal["SIM_TO_ZENOH", "ZENOH_TO_SIM", "BIDIRECTIONAL"]
+
+
+class Bridge(Strict):
+    """A sim topic re-exposed under another key, encoding or direction; or (`file:`) a ros_gz_bridge
+    configuration file, taken as it is."""
+
+    topic: str | None = Field(
+        None,
+        description="The sim topic, as in the timeline (`r1/scan`, `/clock`); from a `file:`, the gz "
+        "topic names resolve to the sim topic of the same name (in `robot`'s namespace, if given).",
+    )
+    file: str | None = Field(
+        None,
+        description="A ros_gz_bridge YAML file (relative to the scenario): `topic_name` / `ros_topic_name` "
+        "/ `gz_topic_name`, `ros_type_name`, `gz_type_name`, `direction` (GZ_TO_ROS, ROS_TO_GZ, "
+        "BIDIRECTIONAL), `lazy`. gz topics are our sim topics; ROS topics are Zenoh keys (or rmw_zenoh "
+        "topics with `ros2:`).",
+    )
+    robot: str | None = Field(
+        None,
+        description="With `file:`: the robot whose topics the gz names are, and whose namespace relative "
+        "ROS names go under (like ros_gz_bridge started in that namespace).",
+    )
+    key: str | None = Field(
+        None,
+        description="The Zenoh key expression on the other side (default: the topic's own name, outside "
+        "the run: `r1/scan`). With `ros2:` the key is rmw_zenoh's and this is not used.",
+    )
+    ros_topic: str | None = Field(
+        None, description="With `ros2:`, the ROS 2 topic name (default: `/<topic>`)."
+    )
+    type: str | None = Field(
+        None, description="ROS 2 type (default: the sim topic's own), e.g. `geometry_msgs/msg/Twist`."
+    )
+    direction: BridgeDirection = Field(
+        "SIM_TO_ZENOH",
+        description="`SIM_TO_ZENOH` (the sim's messages out), `ZENOH_TO_SIM` (messages from outside into "
+        "the sim, e.g. commands) or `BIDIRECTIONAL`.",
+    )
+    encoding: Literal["cdr", "json"] = Field(
+        "cdr",
+        description="On the other side: `cdr` (the same bytes as in the sim) or `json` (the message's "
+        'fields as a JSON object, e.g. `{"linear": {"x": 0.5}}`).',
+    )
+    rate: PositiveFloat | None = Field(
+        None, description="At most this many messages per sim second to the other side (a throttle)."
+    )
+    lazy: bool = Field(
+        False,
+        description="Forward only while someone subscribes on the other side (SIM_TO_ZENOH), like "
+        "ros_gz_bridge's `lazy`.",
+    )
+    ros2: Ros2 | bool | None = Field(
+        None,
+        description="Use rmw_zenoh's format for this bridge (`true`: the scenario's `ros2:` settings, or "
+        "the defaults). Default: the scenario's `ros2:`, if set.",
+    )
+
+    @model_validator(mode="after")
+    def _one_source(self) -> Bridge:
+        if (self.topic is None) == (self.file is None):
+            raise ValueError("a bridge has either `topic:` (one mapping) or `file:` (a ros_gz_bridge file)")
+        if self.file is not None:
+            extra = [f for f in ("key", "ros_topic", "type") if getattr(self, f) is not None]
+            if extra:
+                raise ValueError(f"{', '.join(extra)}: set per entry inside the file, not beside `file:`")
+        elif self.robot is not None:
+            raise ValueError("`robot:` goes with `file:`; for one topic write it in the topic (`r1/scan`)")
+        return self
