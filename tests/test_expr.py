@@ -1,4 +1,4 @@
-"""The assertion expression language (runner/checks/expr.py): evaluation on real messages, what it refuses
+"""The assertion expression language (runner/checks/expr/): evaluation on real messages, what it refuses
 (and where), field checks against message types."""
 
 from __future__ import annotations
