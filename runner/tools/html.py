@@ -207,7 +207,7 @@ def _png_uri(path_or_rgb: Path | np.ndarray) -> str:
 
 def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
     from runner.checks.judge import truth_key
-    from runner.record.recorder import read_summary
+    from runner.record import read_summary
     from runner.tools.pictures import NEUTRAL, hex_colour, run_colours
     from runner.tools.plot import trajectory_plot
     from runner.tools.report import judge_recording
