@@ -238,7 +238,7 @@ def test_a_required_node_lost_on_the_other_host_fails_the_run(
         assert node is not None, "the node did not start"
         # killed once its commands are in the recording (its whole chunks, read as they are written),
         # however long the start took on a loaded machine
-        from runner.record.recorder import read_summary
+        from runner.record import read_summary
 
         while time.monotonic() < deadline + 40:
             counts = {t["topic"]: t["count"] for t in read_summary(mcap)["topics"]} if mcap.exists() else {}

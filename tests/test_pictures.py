@@ -90,7 +90,7 @@ def _hue_mask(img: np.ndarray, rgb: tuple[float, float, float]) -> np.ndarray:
 def test_each_robot_has_one_colour_in_the_plot_the_report_and_the_render(demo: Path, tmp_path: Path) -> None:
     from PIL import Image
 
-    from runner.launch.announce import replay
+    from runner.tools import replay
     from runner.tools.html import load_plan, write_report
     from runner.tools.pictures import hex_colour, rgb255, run_colours
     from runner.tools.plot import trajectory_plot
@@ -168,7 +168,7 @@ def _model_centres(m: mujoco.MjModel, d: mujoco.MjData, robots: set[int]) -> dic
 def test_the_overview_frames_every_model_and_robot(scenario: str, demo: Path, tmp_path: Path) -> None:
     from PIL import Image
 
-    from runner.launch.announce import replay
+    from runner.tools import replay
     from runner.tools.pictures import robot_bodies
 
     mcap = demo if scenario == "two_robots.yaml" else _record(tmp_path / "run.mcap", scenario, 2)

@@ -17,7 +17,7 @@ from mcap.records import MessageIndex
 from mcap_ros2.decoder import DecoderFactory
 
 from bench import recorder as bench
-from runner.record.recorder import Recorder, read_summary
+from runner.record import Recorder, read_summary
 from runner.wire import msgs
 from runner.wire.transport import encoding_for, free_port, make_config, pack_attachment
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from runner.record.recorder import read_summary
+from runner.record import read_summary
 from tests.conftest import SCENARIOS, processes_of, read_mcap, run_cli, scenario_cmd
 
 TWO = """

@@ -28,6 +28,7 @@ import signal
 import sys
 import threading
 import time
+from collections.abc import Callable
 from typing import Any
 
 import zenoh
@@ -242,33 +243,15 @@ class Bridge:
 
     # ---------------------------------------------------------------------------------- sim -> outside
     def _outbound(self, p: BridgePlan) -> None:
-        session, type_name = self.session, p.type
+        type_name = p.type
         ros_out: _RosOut | None = None
         if p.ros2 is not None:
             ros_out = self._ros_out(p)
             pub: Any = ros_out.pub
         else:
-            assert p.key is not None
-            key = p.key
-            encoding = (
-                encoding_for(type_name)
-                if p.encoding == "cdr"
-                else zenoh.Encoding.APPLICATION_JSON.with_schema(type_name)
-            )
-            # the copy keeps the sim topic's QoS: reliable (it waits rather than lose a message, as the
-            # world's own publisher does) unless `qos:` made the topic best effort
-            pub = session.declare_publisher(
-                key,
-                encoding=encoding,
-                congestion_control=zenoh.CongestionControl.DROP
-                if p.best_effort
-                else zenoh.CongestionControl.BLOCK,
-                reliability=zenoh.Reliability.BEST_EFFORT if p.best_effort else zenoh.Reliability.RELIABLE,
-            )
-            self._keep.append(pub)
-            self.graph.publisher(key, type_name)
+            pub = self._zenoh_out(p)
         period_ns = round(1e9 / p.rate) if p.rate else 0
-        state = {"seq": 0, "last": None, "sub": None}
+        state = {"seq": 0, "last": None}
         as_json = p.encoding == "json" and p.ros2 is None
 
         def on_sample(sample: zenoh.Sample) -> None:
@@ -298,6 +281,39 @@ class Bridge:
             self.forwarded[p.where] = self.forwarded.get(p.where, 0) + 1
             self.last_forward = time.monotonic()
 
+        self._follow(p, pub, on_sample)
+
+    def _zenoh_out(self, p: BridgePlan) -> Any:
+        """The publisher of a mapping's other side on Zenoh (not ROS 2): CDR, or JSON with the type as its
+        encoding's schema."""
+        assert p.key is not None
+        key, type_name = p.key, p.type
+        encoding = (
+            encoding_for(type_name)
+            if p.encoding == "cdr"
+            else zenoh.Encoding.APPLICATION_JSON.with_schema(type_name)
+        )
+        # the copy keeps the sim topic's QoS: reliable (it waits rather than lose a message, as the
+        # world's own publisher does) unless `qos:` made the topic best effort
+        pub = self.session.declare_publisher(
+            key,
+            encoding=encoding,
+            congestion_control=zenoh.CongestionControl.DROP
+            if p.best_effort
+            else zenoh.CongestionControl.BLOCK,
+            reliability=zenoh.Reliability.BEST_EFFORT if p.best_effort else zenoh.Reliability.RELIABLE,
+        )
+        self._keep.append(pub)
+        self.graph.publisher(key, type_name)
+        return pub
+
+    def _follow(self, p: BridgePlan, pub: Any, on_sample: Callable[[zenoh.Sample], None]) -> None:
+        """Subscribe `on_sample` to the mapping's sim key: for good, or, when `lazy`, only while something
+        subscribes to `pub` (a cache that late subscribers read is kept filled: a TRANSIENT_LOCAL topic is
+        never lazy)."""
+        session, type_name = self.session, p.type
+        state: dict[str, Any] = {"sub": None}
+
         def subscribe() -> None:
             if state["sub"] is None:
                 state["sub"] = session.declare_subscriber(p.sim_key, on_sample, allowed_origin=REMOTE)
@@ -310,7 +326,6 @@ class Bridge:
                 with contextlib.suppress(Exception):
                     sub.undeclare()
 
-        # a cache that late subscribers read is kept filled: a TRANSIENT_LOCAL topic is never lazy
         if p.lazy and not isinstance(pub, zenoh.ext.AdvancedPublisher):
             lock = threading.Lock()
 

@@ -9,7 +9,7 @@ recorder having said it finished (its process is gone), the guard cuts the file 
 chunk and writes the summary and footer itself, with a `scenario` metadata record saying the runner was
 killed: the file reads with any MCAP reader, `scenario info` says how it ended. It takes milliseconds.
 
-The guard holds the recording's claim (the lock beside it, see `runner.record.recorder._claim`) until the file
+The guard holds the recording's claim (the lock beside it, see `runner.record.claim`) until the file
 is complete, so no other run takes the name meanwhile; and it shares the runner's stdout/stderr, so a
 caller that waits for those to close (`subprocess.run`, `communicate`) finds the file complete.
 

@@ -9,300 +9,44 @@
 
 Speed: the per-message path is a few dict/attribute lookups and two `bytearray` appends (~2 µs of
 Python); the encoding is parsed only on a key's first sample. Messages are packed straight into the chunk
-being built (`_McapFile`; the `mcap` package's `Writer` spends ~3 µs of Python per message); only the
-records written once per chunk or per file (chunk, indexes, summary) go through the `mcap` package's
-record classes. `bench/recorder.py` measures it: on 2 cores, ~200k messages/s (mean 662 B) sustained from
-another process with none lost, ~6 µs of CPU per message in the recording process, Zenoh's included
-(~100k and ~12 µs with `mcap.Writer` and the previous per-sample code).
+being built (`runner.record.mcap_file`; the `mcap` package's `Writer` spends ~3 µs of Python per
+message); only the records written once per chunk or per file (chunk, indexes, summary) go through the
+`mcap` package's record classes. `bench/recorder.py` measures it: on 2 cores, ~200k messages/s (mean
+662 B) sustained from another process with none lost, ~6 µs of CPU per message in the recording process,
+Zenoh's included (~100k and ~12 µs with `mcap.Writer` and the previous per-sample code).
 """
 
 from __future__ import annotations
 
 import contextlib
-import errno
 import os
-import struct
 import sys
 import threading
 import time
-import zlib
-from array import array
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
 
 import zenoh
-import zstandard
-from mcap.data_stream import RecordBuilder
-from mcap.opcode import Opcode
-from mcap.records import Channel, ChunkIndex, Header, McapRecord, Schema
 
-from runner.record.finisher import MAGIC, TRAILER, Guard, Tail
+from runner.record.claim import claim
+from runner.record.claim import recording_live as recording_live  # (runner.cli imports it from here)
+from runner.record.finisher import Guard
+from runner.record.mcap_file import CHUNK_SIZE, McapFile, RecordedChannel, TopicStats
+from runner.record.readback import read_summary as read_summary  # (runner.cli, bench/soak.py: from here)
+from runner.record.readback import recover as recover  # (runner.cli imports it from here)
 from runner.wire import msgs
 from runner.wire.transport import ATTACHMENT, type_from_encoding, unpack_attachment
 
-CHUNK_SIZE = 256 * 1024  # uncompressed bytes per chunk
-ZSTD_LEVEL = 1  # vs the default 3: 10-30% faster here, for the same ratio on sensor data (bench/recorder.py)
 # Samples queued for the drain thread, at most: bounds the memory a slow disk can take (1024 camera images
 # of 1 MB...); a larger queue records no faster (bench/recorder.py).
 FIFO_CAPACITY = 1024
 DRAIN_BATCH = 256  # samples the drain thread records per lock acquisition, at most
 
-# Message record: opcode, record length, channel id, sequence, log time, publish time (then the data).
-_MESSAGE_HEAD = struct.Struct("<BQHIQQ")
-_MESSAGE_FIXED = _MESSAGE_HEAD.size - 9  # the record's length minus the data's
-_MESSAGE_INDEX_HEAD = struct.Struct("<BQHI")
-# Chunk record up to its data: opcode, record length, start, end, uncompressed size and crc, compression
-# (a 4-byte string: "zstd"), compressed size.
-_CHUNK_HEAD = struct.Struct("<BQQQQII4sQ")
-_ZSTD = b"zstd"
-_OP_MESSAGE = int(Opcode.MESSAGE)
-_OP_MESSAGE_INDEX = int(Opcode.MESSAGE_INDEX)
 _PUT = zenoh.SampleKind.PUT
 _unpack_att = ATTACHMENT.unpack
 _ATT_SIZE = ATTACHMENT.size
-
-
-@dataclass(slots=True)
-class TopicStats:
-    key: str
-    type: str
-    count: int = 0
-    first_ns: int | None = None
-    last_ns: int | None = None
-    next_seq: int | None = None
-    lost: int = 0
-
-    def rate(self) -> float:
-        """Messages per sim second between the first and the last message."""
-        if self.count < 2 or self.first_ns is None or self.last_ns is None or self.last_ns <= self.first_ns:
-            return 0.0
-        return (self.count - 1) / ((self.last_ns - self.first_ns) / 1e9)
-
-
-class _Channel:
-    __slots__ = ("id", "index", "stats")
-
-    def __init__(self, channel_id: int, stats: TopicStats):
-        self.id = channel_id
-        self.stats = stats
-        # (log time, offset in the chunk) of each of its messages in the chunk being built, flat
-        self.index = array("Q")
-
-
-def _record_bytes(record: McapRecord) -> bytes:
-    builder = RecordBuilder()
-    record.write(builder)
-    return bytes(builder.end())
-
-
-class _McapFile:
-    """A chunked, indexed MCAP writer (the layout of `mcap.writer.Writer` with its defaults: zstd chunks,
-    message indexes, chunk indexes, statistics, repeated schemas and channels, summary offsets, summary
-    CRC), whose per-message work is two appends to the chunk and two to the channel's index.
-
-    Not thread-safe: the `Recorder` calls it under its lock.
-    """
-
-    def __init__(
-        self,
-        stream: IO[bytes],
-        *,
-        profile: str,
-        library: str,
-        chunk_size: int = CHUNK_SIZE,
-        guard: Guard | None = None,
-    ):
-        self._stream = stream
-        self.chunk_size = chunk_size
-        self.chunk = bytearray()  # the uncompressed records of the chunk being built
-        self._zstd = zstandard.ZstdCompressor(level=ZSTD_LEVEL)
-        self._tail = Tail()  # the summary's records, as chunks are written
-        self._by_id: dict[int, _Channel] = {}
-        self.flushed_at = time.monotonic()
-        self._pos = 0
-        self.guard = guard
-        self._write_trailed(bytearray(MAGIC + _record_bytes(Header(profile=profile, library=library))))
-        self._good = self._pos  # the end of the last chunk written whole
-        # each chunk written: where it starts, its last message's time, its messages per channel
-        self._written: list[tuple[int, int, dict[int, int]]] = []
-        self.note: dict[str, str] = {}  # written as a metadata record `scenario` by `finish`
-        if guard is not None:
-            guard.send(("header", self._good))
-
-    def _write(self, data: bytes | bytearray) -> None:
-        view = memoryview(data)
-        while view:
-            n = self._stream.write(view)  # an unbuffered file may take part of it (a disk filling up)
-            if n is None or n >= len(view):
-                break
-            if n == 0:
-                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-            view = view[n:]
-        self._pos += len(data)
-
-    def cut_back(self) -> None:
-        """After a failed write (a full disk): drop what was written of the chunk that failed, so the file
-        ends with whole chunks and `finish` can add its summary in the space that freed."""
-        good = self._good
-        fd = self._stream.fileno()
-        os.ftruncate(fd, good)
-        os.lseek(fd, good, os.SEEK_SET)
-        self._pos = good
-        self.chunk.clear()
-        for ch in self._by_id.values():
-            del ch.index[:]
-
-    def register_schema(self, name: str, encoding: str, data: bytes) -> int:
-        schema = Schema(id=len(self._tail.schemas) + 1, data=data, encoding=encoding, name=name)
-        record = _record_bytes(schema)
-        self._tail.schemas.append(record)
-        self.chunk += record
-        if self.guard is not None:
-            self.guard.send(("schema", record))
-        return schema.id
-
-    def register_channel(
-        self, topic: str, message_encoding: str, schema_id: int, stats: TopicStats
-    ) -> _Channel:
-        channel = Channel(
-            id=len(self._tail.channels) + 1,
-            topic=topic,
-            message_encoding=message_encoding,
-            schema_id=schema_id,
-            metadata={},
-        )
-        record = _record_bytes(channel)
-        self._tail.channels.append(record)
-        self.chunk += record
-        if self.guard is not None:
-            self.guard.send(("channel", record))
-        ch = self._by_id[channel.id] = _Channel(channel.id, stats)
-        return ch
-
-    def add_message(self, ch: _Channel, sequence: int, stamp: int, data: bytes) -> None:
-        chunk = self.chunk
-        offset = len(chunk)
-        # packed first: a stamp that does not fit (negative) raises before anything changed
-        chunk += _MESSAGE_HEAD.pack(_OP_MESSAGE, _MESSAGE_FIXED + len(data), ch.id, sequence, stamp, stamp)
-        chunk += data
-        ch.index.append(stamp)
-        ch.index.append(offset)
-        if len(chunk) >= self.chunk_size:
-            self.flush_chunk()
-
-    def flush_chunk(self) -> None:
-        """Compress the chunk being built and write it, then its message indexes."""
-        indexed = [ch for ch in self._by_id.values() if ch.index]
-        if not indexed:
-            # Schemas and channels but no message yet: they stay for the next chunk (as `mcap.Writer` does,
-            # a chunk without messages is never written; the summary repeats them anyway).
-            return
-        start = min(min(ch.index[0::2]) for ch in indexed)
-        end = max(max(ch.index[0::2]) for ch in indexed)
-        indexes = []
-        for ch in indexed:
-            entries = ch.index
-            if sys.byteorder != "little":
-                entries.byteswap()
-            indexes.append((ch.id, entries.tobytes()))
-            del entries[:]
-        self._write_chunk(self.chunk, start, end, indexes)
-        self.chunk.clear()
-
-    def _write_chunk(self, chunk: bytearray, start: int, end: int, indexes: list[tuple[int, bytes]]) -> None:
-        compressed = self._zstd.compress(chunk)
-        chunk_start = self._pos
-        out = bytearray(
-            _CHUNK_HEAD.pack(
-                int(Opcode.CHUNK),
-                _CHUNK_HEAD.size - 9 + len(compressed),
-                start,
-                end,
-                len(chunk),
-                zlib.crc32(chunk),
-                len(_ZSTD),
-                _ZSTD,
-                len(compressed),
-            )
-        )
-        out += compressed
-        chunk_length = len(out)
-        offsets: dict[int, int] = {}
-        for channel_id, data in indexes:
-            offsets[channel_id] = chunk_start + len(out)
-            out += _MESSAGE_INDEX_HEAD.pack(int(Opcode.MESSAGE_INDEX), 6 + len(data), channel_id, len(data))
-            out += data
-        counts = {cid: len(data) // 16 for cid, data in indexes}  # (stamp, offset) pairs
-        index = ChunkIndex(
-            message_start_time=start,
-            message_end_time=end,
-            chunk_start_offset=chunk_start,
-            chunk_length=chunk_length,
-            message_index_offsets=offsets,
-            message_index_length=len(out) - chunk_length,
-            compression=_ZSTD.decode(),
-            compressed_size=len(compressed),
-            uncompressed_size=len(chunk),
-        )
-        # One write, over the previous trailer: the chunk, its indexes and a new trailer. Handed to the OS
-        # with every chunk, so a runner killed outright (kill -9) leaves a file that any MCAP reader reads
-        # up to its last chunk, which the guard then completes with its summary.
-        self._write_trailed(out)
-        index_record = _record_bytes(index)
-        self._written.append((chunk_start, end, counts))
-        tail = self._tail
-        tail.chunk_indexes.append(index_record)
-        for cid, n in counts.items():
-            tail.counts[cid] = tail.counts.get(cid, 0) + n
-        tail.start_ns = start if tail.start_ns is None else min(tail.start_ns, start)
-        tail.end_ns = max(tail.end_ns, end)
-        self._good = self._pos
-        self.flushed_at = time.monotonic()
-        if self.guard is not None:
-            self.guard.send(("chunk", index_record, counts, start, end, self._good))
-
-    def _write_trailed(self, data: bytearray) -> None:
-        """Write `data` followed by `TRAILER` (an MCAP end without a summary; appended to `data` in place),
-        the file position staying at the end of `data`: until the next write the file is complete, only
-        without an index."""
-        data += TRAILER
-        self._write(data)
-        self._stream.seek(-len(TRAILER), os.SEEK_CUR)
-        self._pos -= len(TRAILER)
-
-    def finish_in_room(self) -> int:
-        """`finish`, after a failed write: where the summary does not fit in what cutting back freed (a
-        full disk, a size limit), the last chunks are given up one by one until it does. Returns how many
-        chunks were given up."""
-        given_up = 0
-        while True:
-            try:
-                self.finish()
-                return given_up
-            except OSError:
-                if not self._written:
-                    raise
-            start, _end, counts = self._written.pop()
-            tail = self._tail
-            tail.chunk_indexes.pop()
-            for cid, n in counts.items():
-                self._by_id[cid].stats.count -= n
-                tail.counts[cid] -= n
-            self._good = start
-            self.cut_back()
-            tail.end_ns = max((end for _, end, _ in self._written), default=0)
-            given_up += 1
-
-    def finish(self) -> None:
-        """Write the last chunk, the summary and the footer. Does not close the stream."""
-        self.flush_chunk()
-        for ch in self._by_id.values():  # channels registered in a chunk never written: 0 messages
-            self._tail.counts.setdefault(ch.id, 0)
-        self._write(self._tail.end(self._pos, self.note))
-        self._stream.truncate()  # (the summary always covers the trailer it replaces: only to be sure)
-        self._stream.flush()
 
 
 @dataclass
@@ -334,13 +78,14 @@ class Recorder:
 
     def __post_init__(self) -> None:
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.asked = self.path  # the path the plan gave; `path` is the one recorded to (see `_claim`)
-        self.path, self._claim_fd = _claim(self.path)
+        # the path the plan gave; `path` is the one recorded to (see `runner.record.claim`)
+        self.asked = self.path
+        self.path, self._claim_fd = claim(self.path)
         # unbuffered: whole chunks are written at once, and a failed write (a full disk) leaves no buffer
         # behind that a later flush would write past the point the file is cut back to
         self._file: IO[bytes] = open(self.path, "wb", buffering=0)  # noqa: SIM115 - closed in close()
         self._guard = Guard(self.path, self._claim_fd) if self.guarded else None
-        self._mcap = _McapFile(
+        self._mcap = McapFile(
             self._file,
             profile="ros2",
             library=self.library,
@@ -349,7 +94,7 @@ class Recorder:
         )
         self._lock = threading.Lock()
         self._schemas: dict[str, int] = {}
-        self._channels: dict[str, _Channel] = {}
+        self._channels: dict[str, RecordedChannel] = {}
         self._skipped: dict[str, bool] = {}
         self._inc = [zenoh.KeyExpr(e) for e in self.include]
         self._exc = [zenoh.KeyExpr(e) for e in self.exclude]
@@ -493,7 +238,7 @@ class Recorder:
                 ch = self._register(key, msgs.normalize_type(type_name))
         self._add(ch, seq, stamp, payload)
 
-    def _add(self, ch: _Channel, seq: int | None, stamp: int, payload: bytes) -> None:
+    def _add(self, ch: RecordedChannel, seq: int | None, stamp: int, payload: bytes) -> None:
         st = ch.stats
         self._mcap.add_message(ch, (seq if seq is not None else st.count) & 0xFFFFFFFF, stamp, payload)
         if seq is not None:
@@ -515,7 +260,7 @@ class Recorder:
                     if self.tap_errors == 1:
                         print(f"recorder: a reader of {st.key} failed: {e!r}", file=sys.stderr, flush=True)
 
-    def _register(self, key: str, type_name: str) -> _Channel:
+    def _register(self, key: str, type_name: str) -> RecordedChannel:
         foxglove = type_name.startswith("foxglove.")  # Foxglove's schemas (scene): protobuf
         schema_id = self._schemas.get(type_name)
         if schema_id is None:
@@ -615,155 +360,3 @@ def foxglove_schema(type_name: str) -> Any:
 
     cls = getattr(foxglove.messages, type_name.removeprefix("foxglove."))
     return cls.get_schema()
-
-
-def read_summary(path: Path) -> dict[str, Any]:
-    """Topics, types, counts and sim-time span of an MCAP file (for `scenario info`). A file without its
-    summary (the recording was cut: its runner was killed) is read record by record up to its last
-    complete chunk; then `cut` is True and `readable_bytes` says how far it reaches."""
-    from mcap.exceptions import McapError
-    from mcap.reader import make_reader
-
-    with open(path, "rb") as f:
-        try:
-            summary = make_reader(f).get_summary()
-        except (McapError, struct.error, ValueError, EOFError):
-            summary = None
-        if summary is None or summary.statistics is None:
-            return _scan(path)
-        stats = summary.statistics
-        topics = []
-        for cid, ch in sorted(summary.channels.items(), key=lambda kv: kv[1].topic):
-            schema = summary.schemas.get(ch.schema_id)
-            topics.append(
-                {
-                    "topic": ch.topic,
-                    "type": schema.name if schema else "",
-                    "count": stats.channel_message_counts.get(cid, 0),
-                }
-            )
-        note: dict[str, str] = {}
-        for index in summary.metadata_indexes if hasattr(summary, "metadata_indexes") else []:
-            if index.name == "scenario":
-                with contextlib.suppress(McapError, struct.error, ValueError, EOFError):
-                    meta = next((m for m in make_reader(f).iter_metadata() if m.name == "scenario"), None)
-                    note = dict(meta.metadata) if meta is not None else {}
-        stopped = note if "stopped" in note else None
-        return {
-            "start_ns": stats.message_start_time,
-            "end_ns": stats.message_end_time,
-            "messages": stats.message_count,
-            "topics": topics,
-            "cut": False,
-            "stopped": stopped,  # why the recording ended early, when it says so (a full disk)
-            "ended": note.get("ended"),  # how the run ended: completed, interrupted, terminated...
-        }
-
-
-def _records(path: Path) -> Iterable[Any]:
-    """The records of an MCAP file in order (chunks opened), up to the first incomplete one."""
-    from mcap.exceptions import McapError
-    from mcap.stream_reader import StreamReader
-
-    with open(path, "rb") as f:
-        try:
-            yield from StreamReader(f, validate_crcs=True).records
-        except (McapError, struct.error, ValueError, EOFError, zstandard.ZstdError):
-            return  # cut there
-
-
-def _scan(path: Path) -> dict[str, Any]:
-    from mcap.records import Message
-
-    schemas: dict[int, str] = {}
-    channels: dict[int, tuple[str, str]] = {}
-    counts: dict[int, int] = {}
-    start, end = None, 0
-    for record in _records(path):
-        if isinstance(record, Schema):
-            schemas[record.id] = record.name
-        elif isinstance(record, Channel):
-            channels[record.id] = (record.topic, schemas.get(record.schema_id, ""))
-        elif isinstance(record, Message):
-            counts[record.channel_id] = counts.get(record.channel_id, 0) + 1
-            start = record.log_time if start is None else min(start, record.log_time)
-            end = max(end, record.log_time)
-    topics = [
-        {"topic": topic, "type": type_name, "count": counts.get(cid, 0)}
-        for cid, (topic, type_name) in sorted(channels.items(), key=lambda kv: kv[1][0])
-    ]
-    return {
-        "start_ns": start or 0,
-        "end_ns": end,
-        "messages": sum(counts.values()),
-        "topics": topics,
-        "cut": True,
-    }
-
-
-def recover(path: Path, out: Path) -> dict[str, Any]:
-    """Write `out`: a complete MCAP (summary, indexes) with every message the cut file `path` holds."""
-    from mcap.records import Message
-    from mcap.writer import CompressionType, Writer
-
-    schema_ids: dict[int, int] = {}
-    channel_ids: dict[int, int] = {}
-    with open(out, "wb") as f:
-        writer = Writer(f, compression=CompressionType.ZSTD)
-        writer.start(profile="ros2", library="scenario-runner (recovered)")
-        for record in _records(path):
-            if isinstance(record, Schema) and record.id not in schema_ids:
-                schema_ids[record.id] = writer.register_schema(record.name, record.encoding, record.data)
-            elif isinstance(record, Channel) and record.id not in channel_ids:
-                channel_ids[record.id] = writer.register_channel(
-                    record.topic,
-                    record.message_encoding,
-                    schema_ids.get(record.schema_id, 0),
-                    dict(record.metadata),
-                )
-            elif isinstance(record, Message) and record.channel_id in channel_ids:
-                writer.add_message(
-                    channel_ids[record.channel_id],
-                    record.log_time,
-                    record.data,
-                    record.publish_time,
-                    record.sequence,
-                )
-        writer.finish()
-    return read_summary(out)
-
-
-def recording_live(path: Path) -> bool:
-    """Whether a live run (or its guard) holds the claim on the recording `path` (see `_claim`)."""
-    import fcntl
-
-    try:
-        fd = os.open(path.with_name(f".{path.name}.lock"), os.O_RDONLY)
-    except OSError:
-        return False
-    try:
-        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
-    except OSError:
-        return True
-    finally:
-        os.close(fd)
-    return False
-
-
-def _claim(path: Path) -> tuple[Path, int]:
-    """The recording path this run may write, and the descriptor that holds it: a lock on a hidden
-    `.<name>.lock` beside it (released when the process ends, however it ends). A path another live run
-    is recording to is not touched: the next free `<stem>-2.mcap`, `-3`... is taken instead."""
-    import fcntl
-
-    for n in range(1, 1000):
-        candidate = path if n == 1 else path.with_name(f"{path.stem}-{n}{path.suffix}")
-        lock = candidate.with_name(f".{candidate.name}.lock")
-        fd = os.open(lock, os.O_WRONLY | os.O_CREAT, 0o600)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            os.close(fd)
-            continue
-        return candidate, fd
-    raise OSError(f"a thousand runs are recording beside {path}")

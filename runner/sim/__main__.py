@@ -11,11 +11,13 @@ import json
 import sys
 import threading
 import time
+from typing import Any
 
 import zenoh
 
+from runner.plan import RunPlan
 from runner.sim.child import StopFlag, mujoco_warnings_to_stderr, parse, process_name
-from runner.sim.world import World
+from runner.sim.world import World, WorldStats
 from runner.wire.graph import GraphTokens
 from runner.wire.transport import ZenohBus, make_config, meta_key
 
@@ -40,15 +42,9 @@ def main(argv: list[str] | None = None) -> int:
             end_pub = session.declare_publisher(
                 meta_key(plan.name, "world", "end"), congestion_control=zenoh.CongestionControl.BLOCK
             )
-            # Start only once the runner listens, so that nothing published is missed by the recorder.
-            deadline = time.monotonic() + READY_TIMEOUT_S
-            while not end_pub.matching_status.matching:
-                if time.monotonic() > deadline:
-                    print("world: the runner is not listening; giving up", file=sys.stderr)
-                    return 1
-                if should_stop():
-                    return 130
-                time.sleep(0.005)
+            code = _wait_for_runner(end_pub, should_stop)
+            if code is not None:
+                return code
             world = World(plan, bus)
             if world.remote_renders and not world.wait_for_renderers(READY_TIMEOUT_S, should_stop):
                 if should_stop():
@@ -66,55 +62,86 @@ def main(argv: list[str] | None = None) -> int:
                 (go if sample.kind == zenoh.SampleKind.PUT else gone).set()
 
             go_sub = session.liveliness().declare_subscriber(meta_key(run, "go"), on_go, history=True)
-            deadline = time.monotonic() + START_TIMEOUT_S
-            while not go.wait(0.01):
-                if should_stop():
-                    return 130
-                if time.monotonic() > deadline:
-                    print("world: the runner did not say go; giving up", file=sys.stderr)
-                    return 1
+            code = _wait_for_go(go, should_stop)
+            if code is not None:
+                return code
             stats = world.run(should_stop=lambda: should_stop() or gone.is_set())
             go_sub.undeclare()
-            reason = "completed" if stats.sim_ns >= plan.duration_ns else "stopped"
-            if stats.error is not None:
-                reason = "failed"  # the runner reports it (the end message carries it)
-            if reason == "stopped" and gone.is_set() and not should_stop():
-                print(
-                    f"world: the runner went away at {stats.sim_ns / 1e9:.2f} s sim; stopping",
-                    file=sys.stderr,
-                )
-            # The runner acknowledges the end message, which comes after everything published before it: once
-            # acknowledged, nothing of this world is still in flight, and the session may close.
-            acked = threading.Event()
-            ack_sub = session.declare_subscriber(
-                meta_key(plan.name, "world", "end_ack"), lambda _s: acked.set()
-            )
-            end_pub.put(
-                json.dumps(
-                    {
-                        "reason": reason,
-                        "sim_ns": stats.sim_ns,
-                        "steps": stats.steps,
-                        "wall_s": stats.wall_s,
-                        "published": stats.published,
-                        "rejected": stats.rejected,
-                        "error": stats.error,
-                    }
-                ).encode()
-            )
-            deadline = time.monotonic() + END_ACK_TIMEOUT_S
-            while not acked.wait(0.02):
-                if should_stop():  # the runner is gone (or stops us): nobody will acknowledge
-                    break
-                if time.monotonic() > deadline:
-                    print("world: the runner did not acknowledge the end; closing anyway", file=sys.stderr)
-                    break
-            ack_sub.undeclare()
+            _announce_end(session, plan, end_pub, stats, _reason(plan, stats, gone, should_stop), should_stop)
             end_pub.undeclare()
             alive.undeclare()
         finally:
             bus.undeclare_all()
     return should_stop.exit_code()
+
+
+def _wait_for_runner(end_pub: Any, should_stop: StopFlag) -> int | None:
+    """Start only once the runner listens, so that nothing published is missed by the recorder: None then,
+    else the exit code (the runner never came, or we were stopped)."""
+    deadline = time.monotonic() + READY_TIMEOUT_S
+    while not end_pub.matching_status.matching:
+        if time.monotonic() > deadline:
+            print("world: the runner is not listening; giving up", file=sys.stderr)
+            return 1
+        if should_stop():
+            return 130
+        time.sleep(0.005)
+    return None
+
+
+def _wait_for_go(go: threading.Event, should_stop: StopFlag) -> int | None:
+    """Until the runner says go (None), or the exit code if it never does or we are stopped."""
+    deadline = time.monotonic() + START_TIMEOUT_S
+    while not go.wait(0.01):
+        if should_stop():
+            return 130
+        if time.monotonic() > deadline:
+            print("world: the runner did not say go; giving up", file=sys.stderr)
+            return 1
+    return None
+
+
+def _reason(plan: RunPlan, stats: WorldStats, gone: threading.Event, should_stop: StopFlag) -> str:
+    """How the run ended for this world, as its end message says it."""
+    reason = "completed" if stats.sim_ns >= plan.duration_ns else "stopped"
+    if stats.error is not None:
+        reason = "failed"  # the runner reports it (the end message carries it)
+    if reason == "stopped" and gone.is_set() and not should_stop():
+        print(
+            f"world: the runner went away at {stats.sim_ns / 1e9:.2f} s sim; stopping",
+            file=sys.stderr,
+        )
+    return reason
+
+
+def _announce_end(
+    session: zenoh.Session, plan: RunPlan, end_pub: Any, stats: WorldStats, reason: str, should_stop: StopFlag
+) -> None:
+    """Send the end message and wait for the runner's acknowledgement: it comes after everything published
+    before it, so once acknowledged nothing of this world is still in flight, and the session may close."""
+    acked = threading.Event()
+    ack_sub = session.declare_subscriber(meta_key(plan.name, "world", "end_ack"), lambda _s: acked.set())
+    end_pub.put(
+        json.dumps(
+            {
+                "reason": reason,
+                "sim_ns": stats.sim_ns,
+                "steps": stats.steps,
+                "wall_s": stats.wall_s,
+                "published": stats.published,
+                "rejected": stats.rejected,
+                "error": stats.error,
+            }
+        ).encode()
+    )
+    deadline = time.monotonic() + END_ACK_TIMEOUT_S
+    while not acked.wait(0.02):
+        if should_stop():  # the runner is gone (or stops us): nobody will acknowledge
+            break
+        if time.monotonic() > deadline:
+            print("world: the runner did not acknowledge the end; closing anyway", file=sys.stderr)
+            break
+    ack_sub.undeclare()
 
 
 if __name__ == "__main__":

@@ -22,7 +22,8 @@ from typing import Any
 import zenoh
 
 from runner.sim.child import StopFlag, mujoco_warnings_to_stderr, parse, process_name
-from runner.sim.world import _STATE_HEAD, World
+from runner.sim.links import STATE_HEAD
+from runner.sim.world import World
 from runner.wire.graph import GraphTokens
 from runner.wire.transport import ZenohBus, make_config, meta_key
 
@@ -80,8 +81,8 @@ def main(argv: list[str] | None = None) -> int:
                 if what == "stop":
                     break
                 index = int(what)
-                now_ns, _frame = _STATE_HEAD.unpack_from(payload)
-                world.render(index, now_ns, payload[_STATE_HEAD.size :])
+                now_ns, _frame = STATE_HEAD.unpack_from(payload)
+                world.render(index, now_ns, payload[STATE_HEAD.size :])
                 frames[index] += 1
                 acks[index].put(json.dumps({"n": frames[index], "published": world.published()}).encode())
         except Exception as e:  # reported on stderr, which the runner shows

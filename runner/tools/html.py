@@ -206,26 +206,95 @@ def _png_uri(path_or_rgb: Path | np.ndarray) -> str:
 
 
 def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
-    from runner.checks.judge import truth_key
-    from runner.record.recorder import read_summary
-    from runner.tools.pictures import NEUTRAL, hex_colour, run_colours
+    from runner.record import read_summary
     from runner.tools.plot import trajectory_plot
     from runner.tools.report import judge_recording
-    from runner.wire.transport import hidden_key
 
     plan = plan or load_plan(mcap)
     summary = read_summary(mcap)
     # (with several worlds, each world's plan holds its own assertions, their topics inside the world)
     keyed = [(a, part.name) for part in plan.parts() for a in part.assertions]
-    assertions = [a for a, _ in keyed]
-    results = judge_recording(plan, mcap)[0] if assertions else []
-    run = plan.name
-    # signals: each robot's speed (ground truth), each checked topic's rate per sim second
+    results = judge_recording(plan, mcap)[0] if keyed else []
+    charts = _charts(plan, mcap, keyed)
+    camera, frames = _camera_frames(mcap, summary)
+    with tempfile.TemporaryDirectory() as tmp:
+        plot = trajectory_plot(plan, mcap, results, Path(tmp) / "trajectory.png")
+        trajectory = _png_uri(plot) if plot is not None and plot.exists() else None
+    span = (summary["end_ns"] - summary["start_ns"]) / 1e9
+    h = html.escape
+    page = [
+        f'<!doctype html><html><head><meta charset="utf-8"><title>{h(plan.name)}: run report</title>',
+        f"<style>{STYLE}</style></head><body>",
+        f'<h1>{h(plan.name)}</h1><p class="sub">{h(_shown_path(plan.scenario_file))}</p>',
+        f"<p>{_verdict(results)} &nbsp; {span:.2f} s sim, {summary['messages']} messages recorded"
+        + (" (the recording was cut)" if summary.get("cut") else "")
+        + "</p>",
+    ]
+    if trajectory:
+        page.append(
+            f'<figure><img alt="trajectory plot" src="{trajectory}" style="max-width:100%">'
+            "<figcaption>Paths from above, with the assertions' regions and goals</figcaption></figure>"
+        )
+    if results:
+        page.append(
+            "<h2>Assertions</h2><table><tr><th>assertion</th><th>type</th><th>result</th>"
+            f"<th>at (sim s)</th><th>value</th><th>bound</th></tr>{''.join(_result_row(r) for r in results)}"
+            "</table>"
+        )
+    if charts:
+        page.append("<h2>Signals</h2>" + "".join(f"<figure>{c}</figure>" for c in charts))
+    if frames:
+        page.append(
+            f'<h2>Camera</h2><p class="sub">{h(camera)}</p><div class="frames">'
+            + "".join(f'<img alt="camera frame" src="{_png_uri(f)}">' for f in frames)
+            + "</div>"
+        )
+    page.append(
+        "<h2>Topics</h2><table><tr><th>topic</th><th>type</th><th>messages</th><th>sim Hz</th></tr>"
+        f"{_topic_rows(summary, span)}</table>"
+    )
+    page.append("</body></html>")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text("\n".join(page), encoding="utf-8")
+    return {
+        "assertions": len(results),
+        "passed": sum(r.passed for r in results),
+        "charts": len(charts),
+        "frames": len(frames),
+        "trajectory": trajectory is not None,
+    }
+
+
+def _charts(plan: Any, mcap: Path, keyed: list[tuple[dict[str, Any], str]]) -> list[str]:
+    """The signals: each robot's speed (ground truth), its distance travelled and tilt where an assertion
+    bounds them, and each checked topic's rate per sim second; each with the bounds its assertions set."""
+    from runner.checks.judge import truth_key
+    from runner.tools.pictures import run_colours
+
     truth = {r.name: truth_key(p.name, r.namespace) for p in plan.parts() for r in p.robots}
     rate_keys = sorted({f"{w}/{a['topic'].strip('/')}" for a, w in keyed if a.get("type") == "topic_rate"})
     series = _series(mcap, set(truth.values()), stamps_only=set(rate_keys) - set(truth.values()))
     colours = run_colours(plan)  # each robot's colour, as in the trajectory plot and `scenario render`
+    speed, travelled, tilt = _robot_signals(series, truth, colours)
+    kinds = {a.get("type") for a, _ in keyed}
     charts = []
+    if speed:
+        charts.append(
+            svg_chart("Speed of each robot (ground truth)", "m/s", speed, _bounds(keyed, "max_speed"))
+        )
+    if travelled and "distance_traveled" in kinds:
+        charts.append(svg_chart("Distance travelled", "m", travelled, _bounds(keyed, "distance_traveled")))
+    if tilt and "max_tilt" in kinds:
+        charts.append(svg_chart("Tilt from upright", "rad", tilt, _bounds(keyed, "max_tilt")))
+    return charts + _rate_charts(plan, keyed, rate_keys, series, colours)
+
+
+def _robot_signals(
+    series: dict[str, list[tuple[int, Any]]], truth: dict[str, str], colours: dict[str, Any]
+) -> tuple[list[Line], list[Line], list[Line]]:
+    """Each robot's speed, distance travelled and tilt over sim time, from its ground truth."""
+    from runner.tools.pictures import hex_colour
+
     speed: list[Line] = []
     travelled: list[Line] = []
     tilt: list[Line] = []
@@ -247,28 +316,24 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
             speed.append((name, t, v, colour))
             travelled.append((name, t, dist, colour))
             tilt.append((name, t, tilts, colour))
-    kinds = {a.get("type") for a in assertions}
+    return speed, travelled, tilt
 
-    def bounds(kind: str, key: str | None = None) -> list[Bound]:
-        """The bounds of the assertions of this kind (and topic key), to draw as dashed lines."""
-        out: list[Bound] = []
-        for a, w in keyed:
-            if a.get("type") != kind or (key is not None and f"{w}/{a['topic'].strip('/')}" != key):
-                continue
-            for side in ("min", "max"):
-                if isinstance(a.get(side), int | float):
-                    out.append((float(a[side]), f"{side} {a[side]:g} ({a.get('name', kind)})"))
-        return out
 
-    if speed:
-        charts.append(svg_chart("Speed of each robot (ground truth)", "m/s", speed, bounds("max_speed")))
-    if travelled and "distance_traveled" in kinds:
-        charts.append(svg_chart("Distance travelled", "m", travelled, bounds("distance_traveled")))
-    if tilt and "max_tilt" in kinds:
-        charts.append(svg_chart("Tilt from upright", "rad", tilt, bounds("max_tilt")))
+def _rate_charts(
+    plan: Any,
+    keyed: list[tuple[dict[str, Any], str]],
+    rate_keys: list[str],
+    series: dict[str, list[tuple[int, Any]]],
+    colours: dict[str, Any],
+) -> list[str]:
+    """A chart per topic a `topic_rate` assertion checks: messages per whole sim second, in the colour of
+    the robot the topic belongs to."""
+    from runner.tools.pictures import NEUTRAL, hex_colour
+
     owners = {f"{p.name}/{r.namespace}/": hex_colour(colours[r.name]) for p in plan.parts() for r in p.robots}
+    charts = []
     for key in rate_keys:
-        topic = key.removeprefix(f"{run}/")
+        topic = key.removeprefix(f"{plan.name}/")
         stamps = [s / 1e9 for s, _ in series.get(key, [])]
         if stamps:
             whole = max(1, int(stamps[-1]))  # whole sim seconds (a last, partial second would dip)
@@ -280,80 +345,61 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
                     f"Rate of {topic}",
                     "messages per sim second (Hz)",
                     [(topic, list(secs), list(counts.astype(float)), colour)],
-                    bounds("topic_rate", key),
+                    _bounds(keyed, "topic_rate", key),
                 )
             )
-    camera, frames = _camera_frames(mcap, summary)
-    with tempfile.TemporaryDirectory() as tmp:
-        plot = trajectory_plot(plan, mcap, results, Path(tmp) / "trajectory.png")
-        trajectory = _png_uri(plot) if plot is not None and plot.exists() else None
-    passed = sum(r.passed for r in results)
-    span = (summary["end_ns"] - summary["start_ns"]) / 1e9
+    return charts
+
+
+def _bounds(keyed: list[tuple[dict[str, Any], str]], kind: str, key: str | None = None) -> list[Bound]:
+    """The bounds of the assertions of this kind (and topic key), to draw as dashed lines."""
+    out: list[Bound] = []
+    for a, w in keyed:
+        if a.get("type") != kind or (key is not None and f"{w}/{a['topic'].strip('/')}" != key):
+            continue
+        for side in ("min", "max"):
+            if isinstance(a.get(side), int | float):
+                out.append((float(a[side]), f"{side} {a[side]:g} ({a.get('name', kind)})"))
+    return out
+
+
+_LABEL = {"pass": "pass", "fail": "FAIL", "undecided": "not decided"}
+
+
+def _result_row(r: Any) -> str:
     h = html.escape
-    rows = "".join(
+    why = f"<br><small>{h(r.message)}</small>" if r.undecided else ""  # (why it was not decided)
+    at = "" if r.t is None else f"{r.t:.2f}"
+    return (
+        f'<tr><td>{h(r.name)}</td><td>{h(r.type)}</td><td class="{r.status}">{_LABEL[r.status]}</td>'
+        f"<td>{at}</td><td>{h(str(r.value or ''))}</td><td>{h(str(r.bound or ''))}{why}</td></tr>"
+    )
+
+
+def _verdict(results: list[Any]) -> str:
+    """The badge: how many assertions pass (and how many were not decided)."""
+    if not results:
+        return '<span class="badge ok">no assertions</span>'
+    passed = sum(r.passed for r in results)
+    undecided = sum(r.undecided for r in results)
+    return (
+        f'<span class="badge {"ok" if passed == len(results) else "ko"}">'
+        f"{passed} of {len(results)} assertions pass"
+        f"{f', {undecided} not decided' if undecided else ''}</span>"
+    )
+
+
+def _topic_rows(summary: dict[str, Any], span: float) -> str:
+    """A table row per recorded topic: type, count, rate per sim second; the run's helper topics
+    (`_truth`...) left out, as `scenario info` leaves them out."""
+    from runner.wire.transport import hidden_key
+
+    h = html.escape
+    return "".join(
         f"<tr><td>{h(t['topic'])}</td><td>{h(t['type'])}</td><td>{t['count']}</td>"
         f"<td>{(t['count'] - 1) / span:.1f}</td></tr>"
         if span > 0 and t["count"] > 1
         else f"<tr><td>{h(t['topic'])}</td><td>{h(t['type'])}</td><td>{t['count']}</td><td>-</td></tr>"
         for t in summary["topics"]
-        if not hidden_key(t["topic"])  # the run's helper topics (`_truth`...): as `scenario info` hides them
+        if not hidden_key(t["topic"])
     )
-    label = {"pass": "pass", "fail": "FAIL", "undecided": "not decided"}
-
-    def result_row(r: Any) -> str:
-        why = f"<br><small>{h(r.message)}</small>" if r.undecided else ""  # (why it was not decided)
-        at = "" if r.t is None else f"{r.t:.2f}"
-        return (
-            f'<tr><td>{h(r.name)}</td><td>{h(r.type)}</td><td class="{r.status}">{label[r.status]}</td>'
-            f"<td>{at}</td><td>{h(str(r.value or ''))}</td><td>{h(str(r.bound or ''))}{why}</td></tr>"
-        )
-
-    results_rows = "".join(result_row(r) for r in results)
-    undecided = sum(r.undecided for r in results)
-    verdict = (
-        f'<span class="badge {"ok" if passed == len(results) else "ko"}">'
-        f"{passed} of {len(results)} assertions pass"
-        f"{f', {undecided} not decided' if undecided else ''}</span>"
-        if results
-        else '<span class="badge ok">no assertions</span>'
-    )
-    page = [
-        f'<!doctype html><html><head><meta charset="utf-8"><title>{h(run)}: run report</title>',
-        f"<style>{STYLE}</style></head><body>",
-        f'<h1>{h(run)}</h1><p class="sub">{h(_shown_path(plan.scenario_file))}</p>',
-        f"<p>{verdict} &nbsp; {span:.2f} s sim, {summary['messages']} messages recorded"
-        + (" (the recording was cut)" if summary.get("cut") else "")
-        + "</p>",
-    ]
-    if trajectory:
-        page.append(
-            f'<figure><img alt="trajectory plot" src="{trajectory}" style="max-width:100%">'
-            "<figcaption>Paths from above, with the assertions' regions and goals</figcaption></figure>"
-        )
-    if results:
-        page.append(
-            "<h2>Assertions</h2><table><tr><th>assertion</th><th>type</th><th>result</th>"
-            f"<th>at (sim s)</th><th>value</th><th>bound</th></tr>{results_rows}</table>"
-        )
-    if charts:
-        page.append("<h2>Signals</h2>" + "".join(f"<figure>{c}</figure>" for c in charts))
-    if frames:
-        page.append(
-            f'<h2>Camera</h2><p class="sub">{h(camera)}</p><div class="frames">'
-            + "".join(f'<img alt="camera frame" src="{_png_uri(f)}">' for f in frames)
-            + "</div>"
-        )
-    page.append(
-        "<h2>Topics</h2><table><tr><th>topic</th><th>type</th><th>messages</th><th>sim Hz</th></tr>"
-        f"{rows}</table>"
-    )
-    page.append("</body></html>")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text("\n".join(page), encoding="utf-8")
-    return {
-        "assertions": len(results),
-        "passed": passed,
-        "charts": len(charts),
-        "frames": len(frames),
-        "trajectory": trajectory is not None,
-    }

@@ -283,11 +283,30 @@ def _draw_panel(
     by_name: dict[str, Result],
     failed: set[str],
 ) -> None:
-    from PIL import Image, ImageDraw
-
     (x0, y0), (w, h) = p.origin, p.size
     frame = [x0 * SS, y0 * SS, (x0 + w) * SS, (y0 + h) * SS]
     draw.rectangle(frame, fill=FIELD)
+    _draw_axes(img, draw, p, fonts, frame)
+    _draw_world(draw, p)
+    _draw_regions(draw, p, fonts["small"], failed)
+    _draw_paths(draw, p, colours)
+    # where pose assertions failed: the robot's place at that time
+    for s in p.specs:
+        r = by_name.get(s.name)
+        if r is None or r.status != "fail" or r.t_ns is None or s.type not in POSE_KINDS:
+            continue
+        path = p.paths.get(s.robot)
+        if path is not None and len(path):
+            row = path[int(np.argmin(np.abs(path[:, 0] - r.t_ns)))]
+            _cross(draw, *p.px(float(row[1]), float(row[2])))
+    draw.rectangle(frame, outline=AXIS, width=SS)
+
+
+def _draw_axes(img: Any, draw: Any, p: _Panel, fonts: dict[str, Any], frame: list[float]) -> None:
+    """The grid and ticks on both axes, the axes' labels, the panel's title, and what was left out."""
+    from PIL import Image, ImageDraw
+
+    (x0, y0), (w, h) = p.origin, p.size
     step = _nice_step(float(max(p.hi - p.lo)))
     small = fonts["small"]
     for axis in (0, 1):
@@ -321,7 +340,10 @@ def _draw_panel(
             + (" ..." if len(p.left_out) > 4 else "")
         )
         draw.text((x0 * SS, frame[3] + 46 * SS), note, fill=AXIS, font=small, anchor="lt")
-    # the world
+
+
+def _draw_world(draw: Any, p: _Panel) -> None:
+    """The world's models: fixed ones solid, those that can move paler (where they start)."""
     for f in sorted(p.shapes, key=lambda f: f.moving):
         for poly in f.polygons:
             pts = [p.px(float(x), float(y)) for x, y in poly]
@@ -330,7 +352,11 @@ def _draw_panel(
                 draw.polygon(pts, fill=fill)
             else:
                 draw.polygon(pts, fill=fill, outline=edge, width=SS)
-    # the assertions' regions and goals
+
+
+def _draw_regions(draw: Any, p: _Panel, small: Any, failed: set[str]) -> None:
+    """The assertions' regions (circles, boxes) and goals (a point and its tolerance), dashed, named; red
+    for a failed assertion."""
     for s in p.specs:
         edge = FAILED if s.name in failed else REGION
         region = getattr(s, "region", None)
@@ -355,7 +381,10 @@ def _draw_panel(
         if corner is not None:
             anchor = "lb"
             draw.text((corner[0] + 3 * SS, corner[1] - 2 * SS), s.name, fill=edge, font=small, anchor=anchor)
-    # the paths: start (open circle), end (filled)
+
+
+def _draw_paths(draw: Any, p: _Panel, colours: dict[str, RGB]) -> None:
+    """Each robot's path in its colour: start (open circle), end (filled)."""
     for name, path in p.paths.items():
         ink = rgb255(colours[name])
         pts = [p.px(x, y) for _t, x, y in path]
@@ -366,13 +395,3 @@ def _draw_panel(
             draw.ellipse(
                 [u - r, v - r, u + r, v + r], fill=ink if filled else PAPER, outline=ink, width=2 * SS
             )
-    # where pose assertions failed: the robot's place at that time
-    for s in p.specs:
-        r = by_name.get(s.name)
-        if r is None or r.status != "fail" or r.t_ns is None or s.type not in POSE_KINDS:
-            continue
-        path = p.paths.get(s.robot)
-        if path is not None and len(path):
-            row = path[int(np.argmin(np.abs(path[:, 0] - r.t_ns)))]
-            _cross(draw, *p.px(float(row[1]), float(row[2])))
-    draw.rectangle(frame, outline=AXIS, width=SS)

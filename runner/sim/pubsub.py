@@ -1,0 +1,129 @@
+"""What the world process sends and takes in: its publishers (`Outgoing`: CDR on the bus, stamped and
+numbered, and handed at once to subscribers in the same process), the plugins' subscriptions, and the
+inbox of messages from other processes, delivered at the next boundary (`PubSub`, a part of `World`).
+"""
+
+from __future__ import annotations
+
+import queue
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+from runner.plan import RunPlan
+from runner.plugin import Publisher
+from runner.wire import msgs
+from runner.wire.transport import ATTACHMENT as _ATT
+from runner.wire.transport import Bus, topic_key
+
+if TYPE_CHECKING:
+    from runner.sim.links import Lockstep
+
+
+class Outgoing:
+    """One published key: sends CDR bytes with the (sequence, stamp) attachment and hands the message to
+    subscribers inside this process (decoded only when there is one)."""
+
+    __slots__ = ("key", "local", "send", "seq", "type")
+
+    def __init__(self, key: str, type_name: str, send: Callable[[bytes, bytes], None]):
+        self.key = key
+        self.type = type_name
+        self.send = send
+        self.seq = 0
+        self.local: list[tuple[str, Callable[[Any, int], None]]] = []
+
+    def publish(self, msg: Any, stamp_ns: int) -> None:
+        self.send(msgs.encode(msg, self.type), _ATT.pack(self.seq, stamp_ns))
+        self.seq += 1
+        for _type, cb in self.local:
+            cb(msg, stamp_ns)
+
+    def publish_cdr(self, payload: bytes, stamp_ns: int) -> None:
+        self.send(payload, _ATT.pack(self.seq, stamp_ns))
+        self.seq += 1
+        if self.local:
+            msg = msgs.decode(payload, self.type)
+            for _type, cb in self.local:
+                cb(msg, stamp_ns)
+
+
+class PubSub:
+    """The world's publishers and subscriptions, and its inbox: a part of `World` (a base class, so that
+    the loop calls these methods with no layer in between). `World.__init__` sets the attributes below
+    and calls `_init_pubsub` before anything publishes or subscribes."""
+
+    plan: RunPlan
+    bus: Bus
+    now_ns: int
+    _lockstep: Lockstep | None
+
+    def _init_pubsub(self) -> None:
+        self._out: dict[str, Outgoing] = {}
+        self._local: dict[str, list[tuple[str, Callable[[Any, int], None]]]] = {}
+        self._remote_subscribed: set[str] = set()
+        self._inbox: queue.SimpleQueue[tuple[str, bytes, bytes | None]] = queue.SimpleQueue()
+        self._received: dict[str, int] = {}  # messages from other processes, per key
+
+    def make_publisher(self, key: str, type_name: str) -> Outgoing:
+        out = self._out.get(key)
+        if out is None:
+            out = Outgoing(key, type_name, self.bus.publisher(key, type_name))
+            out.local = self._local.setdefault(key, [])
+            self._out[key] = out
+        elif out.type != type_name:
+            raise ValueError(f"{key} is published as {out.type} and as {type_name}")
+        return out
+
+    def publish(self, out: Outgoing, msg: Any, stamp_ns: int) -> None:
+        out.publish(msg, stamp_ns)
+
+    def publish_cdr(self, out: Outgoing, payload: bytes, stamp_ns: int) -> None:
+        out.publish_cdr(payload, stamp_ns)
+
+    def _publisher_factory(self, namespace: str) -> Callable[[str, str], Publisher]:
+        def make(topic: str, type_name: str) -> Publisher:
+            type_name = msgs.normalize_type(type_name)
+            out = self.make_publisher(topic_key(self.plan.name, namespace, topic), type_name)
+            return Publisher(out.key, type_name, out.publish, out.publish_cdr)
+
+        return make
+
+    def _subscriber_factory(self, namespace: str) -> Callable[[str, str, Callable[[Any, int], None]], None]:
+        def subscribe(topic: str, type_name: str, callback: Callable[[Any, int], None]) -> None:
+            key = topic_key(self.plan.name, namespace, topic)
+            # the same list as the publisher's `local`, if this process also publishes the key
+            self._local.setdefault(key, []).append((msgs.normalize_type(type_name), callback))
+            if key not in self._remote_subscribed:
+                self._remote_subscribed.add(key)
+                self.bus.subscribe(key, self._on_remote, msgs.normalize_type(type_name))
+
+        return subscribe
+
+    def _on_remote(self, key: str, payload: bytes, att: bytes | None) -> None:
+        """A message from another process (a Zenoh thread): queued for the next boundary, and counted, so
+        lockstep knows when everything a node sent has arrived."""
+        self._inbox.put((key, payload, att))
+        self._received[key] = self._received.get(key, 0) + 1
+        lockstep = self._lockstep
+        if lockstep is not None:
+            lockstep.poke()
+
+    def _drain_inbox(self) -> None:
+        while True:
+            try:
+                key, payload, _att = self._inbox.get_nowait()
+            except queue.Empty:
+                return
+            for type_name, cb in self._local.get(key, ()):
+                try:
+                    msg = msgs.decode(payload, type_name)
+                except Exception:
+                    # not a message of the subscribed type: a foreign publisher's mistake, dropped and counted
+                    reject = getattr(self.bus, "reject", None)
+                    if reject is not None:
+                        reject(key, f"{len(payload)} bytes that do not decode as {type_name}")
+                    continue
+                cb(msg, self.now_ns)
+
+    def published(self) -> dict[str, int]:
+        return {k: o.seq for k, o in self._out.items()}
