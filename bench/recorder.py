@@ -45,7 +45,7 @@ if sys.path and Path(sys.path[0]).resolve() == REPO / "bench":
 
 import zenoh  # noqa: E402
 
-from runner.record.recorder import Recorder  # noqa: E402
+from runner.record import Recorder  # noqa: E402
 from runner.wire.transport import ATTACHMENT, encoding_for, free_port, make_config  # noqa: E402
 
 HERE = Path(__file__).resolve().parent

@@ -71,7 +71,7 @@ def soak(seconds: float = 600.0, scenario: Path = TWO_ROBOTS, extra: tuple[str, 
         wall = time.monotonic() - t0
         if proc.returncode != 0:
             raise SystemExit(f"the soak run failed ({proc.returncode}):\n{err[-2000:]}")
-        from runner.record.recorder import read_summary
+        from runner.record import read_summary
 
         summary = read_summary(mcap)
         suite = json.loads(results.read_text())

@@ -236,7 +236,7 @@ def test_stop_on_first_failure_ends_the_run_early(write_scenario, tmp_path: Path
 def test_live_and_recorded_judgements_agree_on_every_example(example: str, tmp_path: Path):
     """Every example, run in-process (cameras shrunk, rates as declared): the judge fed message by message
     as the live run feeds it, and the judge reading the MCAP the real recorder wrote, decide alike."""
-    from runner.record.recorder import Recorder
+    from runner.record import Recorder
     from runner.tools.report import judge_recording
     from tests.test_seeds import _shrunk_plan
 

@@ -9,7 +9,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from runner.record.recorder import Recorder
+from runner.record import Recorder
 from runner.wire import msgs
 from runner.wire.transport import unpack_attachment
 from tests.conftest import read_mcap

@@ -126,7 +126,7 @@ def test_meshes_capsules_and_planes_become_foxglove_primitives() -> None:
     from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
     from mcap_protobuf.decoder import DecoderFactory  # noqa: F401  (protobuf available: decode below)
 
-    from runner.record.recorder import foxglove_schema
+    from runner.record import foxglove_schema
 
     schema = foxglove_schema("foxglove.SceneUpdate")
     pool = descriptor_pool.DescriptorPool()

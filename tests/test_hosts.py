@@ -169,7 +169,7 @@ def test_a_world_lost_on_the_other_host_fails_the_run(two_namespaces, write_scen
             far_world = mine[0] if mine else None
         assert far_world is not None, "the far world did not start"
         # killed once it steps (its clock in the recording's whole chunks), however long the start took
-        from runner.record.recorder import read_summary
+        from runner.record import read_summary
 
         while time.monotonic() < deadline:
             counts = {t["topic"]: t["count"] for t in read_summary(mcap)["topics"]} if mcap.exists() else {}

@@ -151,7 +151,7 @@ def test_a_required_node_that_dies_ends_the_run_within_a_second(write_scenario, 
             node = mine[0] if mine else None
         assert node is not None, "the node did not start"
         # killed once a few of its commands are recorded (whole chunks), however long the start took
-        from runner.record.recorder import read_summary
+        from runner.record import read_summary
 
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline:

@@ -200,7 +200,7 @@ _KILLED_WRITER = """
 import os, signal, sys
 from pathlib import Path
 from runner.wire import msgs
-from runner.record.recorder import Recorder
+from runner.record import Recorder
 
 path = Path(sys.argv[1])
 rec = Recorder(path, ["r/**"], chunk_size=1024, guarded=True)

@@ -22,7 +22,7 @@ def info(mcap: RecordingArg, show_all: AllOpt = False) -> None:
 
     Example: scenario info runs/two_robots.mcap
     """
-    from runner.record.recorder import read_summary, recording_live
+    from runner.record import read_summary, recording_live
     from runner.wire.transport import hidden_key
 
     if not mcap.is_file():
@@ -145,7 +145,7 @@ def render(
       scenario render runs/two_robots.mcap -o two_robots.mp4
       scenario render runs/two_robots.mcap -o r1.gif --camera chase:r1 --size 480x360
     """
-    from runner.launch.announce import replay
+    from runner.tools import replay
 
     try:
         w, h = (int(v) for v in size.lower().split("x"))
@@ -215,7 +215,7 @@ def recover(
 
     Example: scenario recover runs/two_robots.mcap
     """
-    from runner.record.recorder import recover as do_recover
+    from runner.record import recover as do_recover
 
     if not mcap.is_file():
         raise fail(RunError(f"{mcap}: file not found"))

@@ -66,7 +66,7 @@ class LiveView:
             if ch is None:
                 fox = self._fox
                 if type_name.startswith("foxglove."):
-                    from runner.record.recorder import foxglove_schema
+                    from runner.record import foxglove_schema
 
                     s = foxglove_schema(type_name)
                     schema, encoding = fox.Schema(name=s.name, encoding="protobuf", data=s.data), "protobuf"

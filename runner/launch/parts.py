@@ -18,7 +18,7 @@ import zenoh
 from runner.errors import RunError
 from runner.launch.nodes import NodeError, Nodes
 from runner.plan import NodePlan, RunPlan
-from runner.record.recorder import Recorder
+from runner.record import Recorder
 from runner.wire import msgs
 from runner.wire.graph import GraphTokens
 from runner.wire.transport import meta_key, unpack_attachment

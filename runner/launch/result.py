@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from runner.record.recorder import TopicStats
+from runner.record import TopicStats
 
 
 @dataclass

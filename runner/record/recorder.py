@@ -31,11 +31,8 @@ from typing import IO, Any
 import zenoh
 
 from runner.record.claim import claim
-from runner.record.claim import recording_live as recording_live  # (runner.cli imports it from here)
 from runner.record.finisher import Guard
 from runner.record.mcap_file import CHUNK_SIZE, McapFile, RecordedChannel, TopicStats
-from runner.record.readback import read_summary as read_summary  # (runner.cli, bench/soak.py: from here)
-from runner.record.readback import recover as recover  # (runner.cli imports it from here)
 from runner.wire import msgs
 from runner.wire.transport import ATTACHMENT, type_from_encoding, unpack_attachment
 
