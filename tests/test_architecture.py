@@ -104,3 +104,30 @@ def test_modules_and_functions_stay_readable() -> None:
 @pytest.mark.parametrize("why", list(LONG_ON_PURPOSE.values()) or ["(none)"])
 def test_every_exception_says_why(why: str) -> None:
     assert why == "(none)" or len(why) > 30
+
+
+def test_the_public_imports_stay_where_users_find_them() -> None:
+    """What node scripts, plugins and the README's examples import (docs/architecture.md, Public imports)."""
+    import runner.msgs
+    import runner.transport
+    import runner.wire.msgs
+    import runner.wire.transport
+    from runner import msgs
+    from runner.node import Node
+    from runner.plugin import (
+        BuildContext,
+        Plugin,
+        PluginParams,
+        RatedParams,
+        RobotHandle,
+        RuntimeContext,
+        Topic,
+    )
+    from runner.transport import encoding_for, free_port, make_config
+
+    assert runner.msgs is runner.wire.msgs and msgs is runner.wire.msgs  # the same module, not a copy
+    assert runner.transport is runner.wire.transport
+    assert make_config is runner.wire.transport.make_config and callable(encoding_for) and callable(free_port)
+    assert msgs.T["geometry_msgs/msg/Twist"] is not None
+    assert all(callable(c) for c in (Node, BuildContext, Plugin, PluginParams, RatedParams, RobotHandle))
+    assert RuntimeContext.__annotations__["robot"] in ("RobotHandle", RobotHandle) and Topic is not None
