@@ -215,7 +215,8 @@ class RecorderPart(Part):
         for world in run.worlds:
             if world.child is None and world.remote_host is None:
                 continue  # never started (stopped while starting)
-            if not run.wait(world.ended, 0.5) or run.hurry.is_set():
+            # its end message comes just before it exits (it has by now): interrupted, do not linger
+            if not run.wait(world.ended, 0.2 if hurried else 0.5) or run.hurry.is_set():
                 continue
             published: dict[str, int] = world.end_info.get("published", {})
             deadline = run.clock() + (DRAIN_HURRIED_S if hurried else DRAIN_TIMEOUT_S)
