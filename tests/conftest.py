@@ -6,6 +6,7 @@ import os
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 from typing import Any
 
@@ -44,6 +45,19 @@ def write_scenario(tmp_path: Path):
         return path
 
     return write
+
+
+def wait_recorded(mcap: Path, topic: str, at_least: int, deadline: float, every_s: float = 0.2) -> bool:
+    """Wait (until `deadline`, a time.monotonic() value) for a recording being written to hold `at_least`
+    messages on `topic`, read from its whole chunks: a run's progress, however long its start took."""
+    from runner.record import read_summary
+
+    while time.monotonic() < deadline:
+        counts = {t["topic"]: t["count"] for t in read_summary(mcap)["topics"]} if mcap.exists() else {}
+        if counts.get(topic, 0) >= at_least:
+            return True
+        time.sleep(every_s)
+    return False
 
 
 def processes_of(root: int, pattern: str, *, direct: bool = False) -> list[int]:

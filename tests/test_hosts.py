@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from tests.conftest import REPO, processes_of, scenario_cmd, start_cli
+from tests.conftest import REPO, processes_of, scenario_cmd, start_cli, wait_recorded
 
 SCENE = """
 name: spread
@@ -169,13 +169,7 @@ def test_a_world_lost_on_the_other_host_fails_the_run(two_namespaces, write_scen
             far_world = mine[0] if mine else None
         assert far_world is not None, "the far world did not start"
         # killed once it steps (its clock in the recording's whole chunks), however long the start took
-        from runner.record import read_summary
-
-        while time.monotonic() < deadline:
-            counts = {t["topic"]: t["count"] for t in read_summary(mcap)["topics"]} if mcap.exists() else {}
-            if counts.get("spread/yonder/clock", 0) > 0:
-                break
-            time.sleep(0.2)
+        wait_recorded(mcap, "spread/yonder/clock", 1, deadline)
         killed = time.monotonic()
         os.kill(far_world, signal.SIGKILL)
         main_out, main_err = main.communicate(timeout=30)
@@ -238,13 +232,7 @@ def test_a_required_node_lost_on_the_other_host_fails_the_run(
         assert node is not None, "the node did not start"
         # killed once its commands are in the recording (its whole chunks, read as they are written),
         # however long the start took on a loaded machine
-        from runner.record import read_summary
-
-        while time.monotonic() < deadline + 40:
-            counts = {t["topic"]: t["count"] for t in read_summary(mcap)["topics"]} if mcap.exists() else {}
-            if counts.get("spread/yonder/r2/cmd_vel", 0) >= 5:
-                break
-            time.sleep(0.3)
+        wait_recorded(mcap, "spread/yonder/r2/cmd_vel", 5, deadline + 40, every_s=0.3)
         os.kill(node, signal.SIGKILL)
         main_out, main_err = main.communicate(timeout=30)
         _far_out, far_err = far.communicate(timeout=30)

@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from tests.conftest import SCENARIOS, processes_of, read_mcap, run_cli, scenario_cmd
+from tests.conftest import SCENARIOS, processes_of, read_mcap, run_cli, scenario_cmd, wait_recorded
 
 NODE = """
 import sys
@@ -151,14 +151,7 @@ def test_a_required_node_that_dies_ends_the_run_within_a_second(write_scenario, 
             node = mine[0] if mine else None
         assert node is not None, "the node did not start"
         # killed once a few of its commands are recorded (whole chunks), however long the start took
-        from runner.record import read_summary
-
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline:
-            counts = {t["topic"]: t["count"] for t in read_summary(mcap)["topics"]} if mcap.exists() else {}
-            if counts.get("with_node/r1/cmd_vel", 0) >= 5:
-                break
-            time.sleep(0.2)
+        wait_recorded(mcap, "with_node/r1/cmd_vel", 5, time.monotonic() + 60)
         killed = time.monotonic()
         os.kill(node, signal.SIGKILL)
         proc.wait(timeout=30)
