@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sys
 import threading
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -47,8 +48,6 @@ class Run(Protocol):
     def announce(self, **changes: str) -> None: ...
 
     def wait(self, event: threading.Event, timeout_s: float) -> bool: ...
-
-    def clock(self) -> float: ...
 
     def reached(self) -> int: ...
 
@@ -130,8 +129,9 @@ class RemoteNodesPart(Part):
             run.subs.append(run.session.liveliness().declare_subscriber(alive_key, on_node))
 
     def poll(self, run: Run) -> None:
-        all_completed = all(w.end_info.get("reason") == "completed" for w in run.worlds)
-        if self.lost and run.error is None and run.reason == "completed" and not all_completed:
+        if not self.lost or run.error is not None or run.reason != "completed":
+            return
+        if not all(w.end_info.get("reason") == "completed" for w in run.worlds):
             run.end("failed", self.lost[0])
 
 
@@ -219,8 +219,8 @@ class RecorderPart(Part):
             if not run.wait(world.ended, 0.2 if hurried else 0.5) or run.hurry.is_set():
                 continue
             published: dict[str, int] = world.end_info.get("published", {})
-            deadline = run.clock() + (DRAIN_HURRIED_S if hurried else DRAIN_TIMEOUT_S)
-            while run.clock() < deadline and not run.hurry.is_set():
+            deadline = time.monotonic() + (DRAIN_HURRIED_S if hurried else DRAIN_TIMEOUT_S)
+            while time.monotonic() < deadline and not run.hurry.is_set():
                 got = recorder.counts()
                 if all(got.get(k, 0) >= n for k, n in published.items() if recorder.wanted(k)):
                     break

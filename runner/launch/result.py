@@ -6,9 +6,12 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from runner.record import TopicStats
+
+if TYPE_CHECKING:
+    from runner.launch.supervisor import Supervisor
 
 
 @dataclass
@@ -34,7 +37,7 @@ class RunResult:
         return {k: n - got[k] for k, n in self.published.items() if k in got and n > got[k]}
 
 
-def result_of(run: Any) -> RunResult:
+def result_of(run: Supervisor) -> RunResult:
     """What a finished supervisor tells: how the run ended, its times, what was published and recorded."""
     infos = [w.end_info for w in run.worlds]
     walls = [float(i["wall_s"]) for i in infos if "wall_s" in i]

@@ -163,6 +163,9 @@ class Supervisor:
     def _supervise(self) -> None:
         """STARTING and RUNNING: tick until the worlds have ended (or the run ends another way)."""
         waiting: set[str] = set()  # the other hosts this run said it waits for
+        # polled in the order the causes are told apart: the recording, the nodes, the worlds, the judge
+        before = sorted((p for p in self.parts if p.poll_order < 0), key=lambda p: p.poll_order)
+        after = sorted((p for p in self.parts if p.poll_order > 0), key=lambda p: p.poll_order)
         while any(w.running() for w in self.worlds) and not self.signalled.is_set():
             self.signalled.wait(TICK_S)
             if self.signalled.is_set():
@@ -170,14 +173,11 @@ class Supervisor:
             ready = self.ready()
             if ready and self.state is State.STARTING:
                 self._go_on()
-            # in the order the causes are told apart: the recording, the nodes, the worlds, the judge
-            for part in sorted(self.parts, key=lambda p: p.poll_order):
-                if part.poll_order < 0:
-                    part.poll(self)
+            for part in before:
+                part.poll(self)
             self._poll_worlds()
-            for part in self.parts:
-                if part.poll_order > 0:
-                    part.poll(self)
+            for part in after:
+                part.poll(self)
             if ready and self.on_progress is not None:
                 sim_ns = self.recorder.recorder.latest_ns if self.recorder else self.latest_ns
                 self.on_progress(sim_ns, time.perf_counter() - self.started_at)
@@ -315,10 +315,6 @@ class Supervisor:
         while not event.is_set() and not self.hurry.is_set() and time.monotonic() < deadline:
             event.wait(min(TICK_S, max(0.0, deadline - time.monotonic())))
         return event.is_set()
-
-    @staticmethod
-    def clock() -> float:
-        return time.monotonic()
 
     def _on_clock(self, sample: zenoh.Sample) -> None:
         att = sample.attachment
