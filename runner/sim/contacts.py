@@ -60,20 +60,29 @@ class ContactWatch:
         if d.ncon:
             # a few dozen contacts at most: plain Python over the list beats numpy's per-call overhead
             owner, watched, k = self._owner_list, self._watched_list, len(self._owner_names)
-            found = set()
-            for a, b in d.contact.geom.tolist():
+            found: dict[int, int] = {}  # pair -> its first contact
+            for c, (a, b) in enumerate(d.contact.geom.tolist()):
                 oa, ob = owner[a], owner[b]
                 if oa != ob and (watched[oa] or watched[ob]):
-                    found.add(oa * k + ob if oa < ob else ob * k + oa)
+                    found.setdefault(oa * k + ob if oa < ob else ob * k + oa, c)
             if found:
                 pairs = tuple(sorted(found))
+                # a contact: where it is (the judge says where a collision happened); rare, so the message
+                # is made anew rather than from a fixed layout
+                self._out.publish(self._message(pairs, [d.contact.pos[found[p]] for p in pairs], now), now)
+                return
         layout = self._layouts.get(pairs)
         if layout is None:
             layout = self._layouts[pairs] = self._layout(pairs)
         self._out.publish_cdr(layout.encode(now), now)
 
     def _layout(self, pairs: tuple[int, ...]) -> Layout:
+        return Layout(CONTACTS, self._message(pairs, [], 0), ["header.stamp"])
+
+    def _message(self, pairs: tuple[int, ...], where: list[np.ndarray], now: int) -> object:
+        """The ContactsState of `pairs`, each with the position of its first contact when `where` has them."""
         names, k = self._owner_names, len(self._owner_names)
+        vec = msgs.T["geometry_msgs/msg/Vector3"]
         zero = msgs.from_data("geometry_msgs/msg/Wrench", {})
         state = msgs.T["gazebo_msgs/msg/ContactState"]
         states = [
@@ -83,11 +92,12 @@ class ContactWatch:
                 collision2_name=names[code % k],
                 wrenches=[],
                 total_wrench=zero,
-                contact_positions=[],
+                contact_positions=[
+                    vec(x=float(p[0]), y=float(p[1]), z=float(p[2])) for p in where[i : i + 1]
+                ],
                 contact_normals=[],
                 depths=np.zeros(0),
             )
-            for code in pairs
+            for i, code in enumerate(pairs)
         ]
-        msg = msgs.T[CONTACTS](header=msgs.header(0, "world"), states=states)
-        return Layout(CONTACTS, msg, ["header.stamp"])
+        return msgs.T[CONTACTS](header=msgs.header(now, "world"), states=states)
