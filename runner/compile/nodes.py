@@ -6,9 +6,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from runner.errors import Problem, ScenarioError
-from runner.plan import NodePlan
+from runner.plan import NodePlan, TopicPlan
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import Scenario
+from runner.wire import msgs
+from runner.wire.transport import topic_key
 
 
 def compile_nodes(sc: Scenario, doc: Document, base: Path) -> list[NodePlan]:
@@ -69,25 +71,14 @@ def compile_nodes(sc: Scenario, doc: Document, base: Path) -> list[NodePlan]:
                 env=dict(node.env),
                 cwd=str(cwd.resolve()),
                 namespace=node.namespace,
+                topics=_node_topics(sc, doc, i, problems),
                 respawn=node.respawn,
                 respawn_limit=node.respawn_limit,
                 required=node.required,
                 host=host_of(sc, doc, node.host, ("nodes", i, "host")),
             )
         )
-    for j, name in enumerate(sc.lockstep):
-        if name not in seen:
-            where = ("lockstep", j)
-            problems.append(
-                Problem(
-                    f"no node named {name!r}",
-                    doc.locate(where),
-                    where,
-                    expected="one of: " + ", ".join(sorted(seen))
-                    if seen
-                    else "a node of this scenario (nodes:)",
-                )
-            )
+    problems += _lockstep_names(sc, doc, seen)
     if problems:
         raise ScenarioError(problems)
     return out
@@ -105,3 +96,37 @@ def host_of(sc: Scenario, doc: Document, name: str | None, where: PathKey) -> st
             )
         )
     return name
+
+
+def _node_topics(sc: Scenario, doc: Document, i: int, problems: list[Problem]) -> list[TopicPlan]:
+    """What node `i` says it publishes (`publishes:`), each type checked."""
+    node = sc.nodes[i]
+    out = []
+    for topic, type_name in node.publishes.items():
+        if not msgs.is_known(msgs.normalize_type(type_name)):
+            where: PathKey = ("nodes", i, "publishes", topic)
+            close = msgs.similar_types(type_name)
+            problems.append(
+                Problem(
+                    f"unknown message type {type_name!r}",
+                    doc.locate(where),
+                    where,
+                    expected="a ROS 2 message type such as std_msgs/msg/String",
+                    hint=f"did you mean {close[0]!r}?" if close else None,
+                )
+            )
+            continue
+        key = topic_key(sc.name, node.namespace or "", topic)
+        out.append(TopicPlan(key=key, type=msgs.normalize_type(type_name), owner=node.name))
+    return out
+
+
+def _lockstep_names(sc: Scenario, doc: Document, nodes: set[str]) -> list[Problem]:
+    """`lockstep:` names nodes of the scenario."""
+    out = []
+    for j, name in enumerate(sc.lockstep):
+        if name not in nodes:
+            where: PathKey = ("lockstep", j)
+            expected = "one of: " + ", ".join(sorted(nodes)) if nodes else "a node of this scenario (nodes:)"
+            out.append(Problem(f"no node named {name!r}", doc.locate(where), where, expected=expected))
+    return out

@@ -9,7 +9,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, NonNegativeInt, PositiveFloat, field_validator, model_validator
 
-from runner.scenario.schema.base import IDENT_RE, NODE_NAME_RE, Namespace, Strict
+from runner.scenario.schema.base import IDENT_RE, NODE_NAME_RE, TOPIC_RE, Namespace, Strict
 
 _ENDPOINT_PATTERN = r"^(tcp|udp|tls|quic|ws|unixsock-stream|unixpipe|serial|vsock)/\S+$"
 
@@ -46,6 +46,11 @@ class Node(Strict):
         "list. A leading `python` is this interpreter. Relative paths are relative to `cwd`."
     )
     args: list[str] = Field(default_factory=list, description="Extra arguments after the command.")
+    publishes: dict[Annotated[str, Field(pattern=TOPIC_RE.pattern)], str] = Field(
+        default_factory=dict,
+        description="Topics the node publishes that assertions and events read: topic (relative to its "
+        "namespace, or `/abs`) -> ROS 2 type, e.g. `{status: std_msgs/msg/String}`.",
+    )
     env: dict[str, str] = Field(default_factory=dict, description="Extra environment variables.")
     cwd: str | None = Field(None, description="Working folder (default: the scenario's folder).")
     namespace: Namespace | None = Field(
