@@ -61,6 +61,30 @@ class TimelinePlan(BaseModel):
     data: dict[str, Any]
 
 
+class ActorPlan(BaseModel):
+    """An actor (a mocap body named `name`): its path as times and points, or its hinge."""
+
+    name: str
+    start_ns: int | None  # None: started by an event
+    pos: list[float]  # where it stands before it starts (world frame)
+    quat: list[float]  # its orientation then (w, x, y, z)
+    times: list[float] = []  # seconds after it starts, one per point
+    points: list[list[float]] = []  # [x, y, z] of its origin
+    loop: bool = False
+    travel: bool = False  # its yaw follows the direction of travel (added to its pose's)
+    hinge: dict[str, Any] | None = None  # {at, axis, angle, duration} in the model's frame
+
+
+class EventPlan(BaseModel):
+    """An event with every name resolved (MuJoCo bodies, Zenoh keys, actor and plugin indices):
+    `when` and each of `do` are `{"kind": ..., fields...}` (runner.compile.events says which)."""
+
+    name: str
+    when: dict[str, Any]
+    do: list[dict[str, Any]]
+    repeat: bool = False
+
+
 class NodePlan(BaseModel):
     """A process of the run, its command resolved (`argv[0]` an executable, `cwd` absolute)."""
 
@@ -71,6 +95,7 @@ class NodePlan(BaseModel):
     env: dict[str, str] = {}
     cwd: str
     namespace: str | None = None
+    topics: list[TopicPlan] = []  # what it says it publishes (`publishes:`)
     respawn: Literal["never", "on-failure"] = "never"
     respawn_limit: int = 3
     required: bool = False
@@ -124,6 +149,9 @@ class RunPlan(BaseModel):
     robots: list[RobotPlan]
     timeline: list[TimelinePlan]
     record: RecordPlan
+    actors: list[ActorPlan] = []
+    events: list[EventPlan] = []  # in the order they are looked at in a step (one that follows another
+    # in the same step after it)
     notices: list[str] = []  # warnings from compile: tags read but not acted on, and the scenario's own
     # warnings about the scenario file itself (a window past its end, a typo'd topic): errors with --strict
     scenario_warnings: list[str] = []
@@ -193,6 +221,11 @@ class RunPlan(BaseModel):
                         known.owner = f"{known.owner}, {t.owner}"
                         if known.rate is not None and t.rate is not None:
                             known.rate += t.rate
+        for n in self.nodes:
+            for t in n.topics:
+                if (t.key, "pub") not in seen:
+                    seen[(t.key, "pub")] = t
+                    out.append(t)
         for ev in self.timeline:
             if (ev.key, "pub") not in seen:
                 seen[(ev.key, "pub")] = TopicPlan(key=ev.key, type=ev.type, direction="pub", owner="timeline")

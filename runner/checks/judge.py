@@ -14,6 +14,7 @@ gazebo_msgs/ContactsState, published by the world when a `no_collision` asks), a
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -32,6 +33,7 @@ TRUTH_TOPIC = "_truth"
 TRUTH_RATE = 50.0
 CONTACTS_TOPIC = "_contacts"
 CONTACTS_RATE = 100.0
+EVENTS_TOPIC = "_events"
 
 
 def truth_key(run: str, namespace: str) -> str:
@@ -42,12 +44,19 @@ def contacts_key(run: str) -> str:
     return f"{run}/{CONTACTS_TOPIC}"
 
 
+def events_key(run: str) -> str:
+    """Where a world says what its events did (runner.sim.events): std_msgs/String, JSON."""
+    return f"{run}/{EVENTS_TOPIC}"
+
+
 def judged_types(plan: Any) -> dict[str, str]:
-    """The ROS type of every key a judge of `plan` may read (the plan's topics and the world's contacts)."""
+    """The ROS type of every key a judge of `plan` may read (the plan's topics, the world's contacts and
+    its events)."""
     types: dict[str, str] = {}
     for part in plan.worlds or [plan]:  # several worlds: every world's keys (full keys, distinct)
         types.update({t.key: t.type for t in part.topics()})
         types[contacts_key(part.name)] = "gazebo_msgs/msg/ContactsState"
+        types[events_key(part.name)] = "std_msgs/msg/String"
     return types
 
 
@@ -282,7 +291,11 @@ class _NoCollision(_Check):
                 s.others and (a in named or b in named) and "ground" not in (a, b)
             )
             if hit:
-                self.decide(False, t_ns, f"{a} touched {b}", "no contact", f"{a} touched {b}")
+                at = ""
+                if len(st.contact_positions):
+                    p = st.contact_positions[0]
+                    at = f" at ({p.x:.2f}, {p.y:.2f}, {p.z:.2f})"
+                self.decide(False, t_ns, f"{a} touched {b}{at}", "no contact", f"{a} touched {b}{at}")
                 return
 
     def finish(self, span: Span) -> None:
@@ -456,12 +469,23 @@ _CHECKS: dict[type, type[_Check]] = {
 }
 
 
+@dataclass(frozen=True)
+class _EventSpec:
+    name: str
+    type: str = "event"
+
+
 class Judge:
     """Decides assertions from messages. `specs` are the scenario's assertion models; `keys[i]` is the
     Zenoh key the i-th one reads (from `assertion_keys`)."""
 
-    def __init__(self, specs: list[Any], keys: list[str]):
+    def __init__(self, specs: list[Any], keys: list[str], events: Sequence[str] = ()):
+        """`events`: the keys where worlds say what their events did (`events_key`): each firing is kept
+        (`fired`), and one that ends the run (`end:`) is a result of its own, passed or failed."""
         from runner.checks.expr import compile_expr
+
+        self.events_keys = set(events)
+        self.fired: list[dict[str, Any]] = []
 
         self.checks: list[_Check] = []
         for spec, key in zip(specs, keys, strict=True):
@@ -475,12 +499,42 @@ class Judge:
 
     @property
     def keys(self) -> set[str]:
-        return set(self._by_key)
+        return set(self._by_key) | self.events_keys
 
     def feed(self, key: str, t_ns: int, msg: Any) -> None:
+        if key in self.events_keys:
+            self._event(t_ns, msg)
+            return
         for c in self._by_key.get(key, ()):
             if not c.decided:  # topic_rate is decided only by finish()
                 c.feed(t_ns, msg)
+
+    def _event(self, t_ns: int, msg: Any) -> None:
+        import json
+
+        try:
+            entry = json.loads(msg.data)
+        except ValueError:
+            return  # (not one of ours: someone else published there)
+        if not isinstance(entry, dict) or "event" not in entry:
+            return
+        entry["t_ns"] = t_ns
+        self.fired.append(entry)
+        end = entry.get("end")
+        if isinstance(end, dict):
+            passed = end.get("result") == "pass"
+            said = end.get("message") or ("the run ends here" if passed else "the run fails here")
+            check = _Check(_EventSpec(f"event {entry['event']}"), key="")
+            check.result = Result(
+                check.spec.name,
+                "event",
+                PASS if passed else FAIL,
+                t_ns,
+                str(entry.get("why", "")),
+                "end",
+                said,
+            )
+            self.checks.append(check)
 
     def failed(self) -> bool:
         return any(c.result is not None and not c.result.passed for c in self.checks)

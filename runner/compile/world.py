@@ -10,6 +10,8 @@ from typing import Any
 import mujoco
 
 from runner.checks import assertion_keys, check_names
+from runner.compile.actors import add_actors
+from runner.compile.events import compile_events
 from runner.compile.nodes import compile_nodes, host_of
 from runner.compile.packages import PackageMap
 from runner.compile.record import record_plan
@@ -24,6 +26,7 @@ from runner.plan import NodePlan, RecordPlan, RobotPlan, RunPlan
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import NoCollision, Scenario, WorldModel
 from runner.wire import msgs
+from runner.wire.transport import topic_key
 
 _GEOM = {
     "box": mujoco.mjtGeom.mjGEOM_BOX,
@@ -57,11 +60,13 @@ def compile_world(
     checks do not report their topics as missing, and there is no model): the caller raises `problems`
     before anything uses it."""
     packages = _packages(sc, doc, problems)
-    world, sdf_rate = mujoco.MjSpec(), None
+    world, sdf_rate, actors = mujoco.MjSpec(), None, []
     with problems.each():
         world, sdf_rate = world_spec(sc, doc, packages, notices)
+        actors = add_actors(world, sc.world.actors, doc, problems)
     with problems.each():
-        check_names(sc, doc, {m.name for m in sc.world.models}, bool(sc.world.sdf))
+        models = {m.name for m in sc.world.models} | {a.name for a in sc.world.actors}
+        check_names(sc, doc, models, bool(sc.world.sdf))
     robots = add_robots(world, sc, doc, packages, notices, problems, unloaded)
     mjcf, step = "", sc.world.physics.timestep
     if not problems:  # a world with a robot missing, or one that failed, would only add noise
@@ -69,6 +74,7 @@ def compile_world(
             mjcf = compile_model(world, robots, sc, doc, notices)
             step = world.option.timestep
     timeline = compile_timeline(sc, doc, robots, problems)
+    events = compile_events(sc, doc, mjcf, robots, actors, problems)
     record = RecordPlan(enabled=False, path="", include=[], exclude=[])
     with problems.each():
         record = record_plan(sc, doc, record_path)
@@ -94,6 +100,8 @@ def compile_world(
         robots=robots,
         timeline=timeline,
         record=record,
+        actors=actors,
+        events=events,
         notices=[n.render() for n in notices],
         assertions=[a.model_dump(mode="json") for a in sc.assertions],
         assertion_keys=keys,
@@ -130,8 +138,13 @@ def _assertion_keys(
     sc: Scenario, doc: Document, robots: list[RobotPlan], problems: Problems, unloaded: list[str]
 ) -> list[str]:
     """The keys the assertions read, checked against what the world's plugins and timeline publish."""
-    published = {t.key: t.type for r in robots for p in r.plugins for t in p.topics if t.direction == "pub"}
+    # what the world publishes, and what someone else does: the topics its plugins take in (a node's
+    # cmd_vel) and those nodes say they publish
+    published = {t.key: t.type for r in robots for p in r.plugins for t in p.topics}
     published.update({f"{sc.name}/{ev.topic.strip('/')}": msgs.normalize_type(ev.type) for ev in sc.timeline})
+    for node in sc.nodes:
+        for topic, type_name in node.publishes.items():
+            published[topic_key(sc.name, node.namespace or "", topic)] = msgs.normalize_type(type_name)
     keys: list[str] = []
     with problems.each():
         keys = assertion_keys(sc, doc, published, unchecked=unloaded)

@@ -129,6 +129,7 @@ def _compile_one(
             ],
             "assertions": [_strip_world(sc.assertions[i]) for i in a_idx],
             "nodes": [],
+            "events": [],  # (one world's: refused with several, runner.scenario.validate)
             "lockstep": [],
             "matrix": {},
             "bridges": [],  # run-wide: compiled once, against every world's topics

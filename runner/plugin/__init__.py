@@ -169,6 +169,9 @@ class Plugin:
     # velocities, contacts and position/velocity sensors of the current instant, and acceleration-stage
     # sensor values (accelerometer) of the step that led to it, at no extra cost.
     needs_forward: ClassVar[bool] = False
+    # Parameters an event may change while the plugin runs (`set:`): ones its hooks read from `self.params`
+    # every time (the world swaps in a new, validated `params`). `rate` is the world's to change, always.
+    live: ClassVar[frozenset[str]] = frozenset()
 
     def __init__(self, params: PluginParams, ctx: RuntimeContext, name: str):
         self.params = params

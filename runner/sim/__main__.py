@@ -103,7 +103,8 @@ def _wait_for_go(go: threading.Event, should_stop: StopFlag) -> int | None:
 
 def _reason(plan: RunPlan, stats: WorldStats, gone: threading.Event, should_stop: StopFlag) -> str:
     """How the run ended for this world, as its end message says it."""
-    reason = "completed" if stats.sim_ns >= plan.duration_ns else "stopped"
+    # (an event's `end:` completes the run where it fires)
+    reason = "completed" if stats.sim_ns >= plan.duration_ns or stats.ended else "stopped"
     if stats.error is not None:
         reason = "failed"  # the runner reports it (the end message carries it)
     if reason == "stopped" and gone.is_set() and not should_stop():
@@ -131,6 +132,7 @@ def _announce_end(
                 "published": stats.published,
                 "rejected": stats.rejected,
                 "error": stats.error,
+                "ended": stats.ended,
             }
         ).encode()
     )

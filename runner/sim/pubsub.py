@@ -21,9 +21,10 @@ if TYPE_CHECKING:
 
 class Outgoing:
     """One published key: sends CDR bytes with the (sequence, stamp) attachment and hands the message to
-    subscribers inside this process (decoded only when there is one)."""
+    subscribers inside this process (decoded only when there is one). While an event's fault is on the key
+    (`fault`, runner.sim.faults), every message goes through it instead: dropped, held, replaced."""
 
-    __slots__ = ("key", "local", "send", "seq", "type")
+    __slots__ = ("fault", "key", "last", "local", "send", "seq", "type")
 
     def __init__(self, key: str, type_name: str, send: Callable[[bytes, bytes], None]):
         self.key = key
@@ -31,18 +32,39 @@ class Outgoing:
         self.send = send
         self.seq = 0
         self.local: list[tuple[str, Callable[[Any, int], None]]] = []
+        self.fault: Any = None
+        self.last: bytes | None = None  # the last message sent (what a `freeze` fault repeats)
 
     def publish(self, msg: Any, stamp_ns: int) -> None:
-        self.send(msgs.encode(msg, self.type), _ATT.pack(self.seq, stamp_ns))
+        payload = msgs.encode(msg, self.type)
+        if self.fault is not None:
+            self.fault.take(self, payload, msg, stamp_ns)
+            return
+        self.send(payload, _ATT.pack(self.seq, stamp_ns))
         self.seq += 1
+        self.last = payload
         for _type, cb in self.local:
             cb(msg, stamp_ns)
 
     def publish_cdr(self, payload: bytes, stamp_ns: int) -> None:
+        if self.fault is not None:
+            self.fault.take(self, payload, None, stamp_ns)
+            return
         self.send(payload, _ATT.pack(self.seq, stamp_ns))
         self.seq += 1
+        self.last = payload
         if self.local:
             msg = msgs.decode(payload, self.type)
+            for _type, cb in self.local:
+                cb(msg, stamp_ns)
+
+    def deliver(self, payload: bytes, msg: Any, stamp_ns: int) -> None:
+        """Send, past any fault (what a fault lets through, or releases late)."""
+        self.send(payload, _ATT.pack(self.seq, stamp_ns))
+        self.seq += 1
+        self.last = payload
+        if self.local:
+            msg = msg if msg is not None else msgs.decode(payload, self.type)
             for _type, cb in self.local:
                 cb(msg, stamp_ns)
 

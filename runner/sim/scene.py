@@ -210,7 +210,7 @@ class SceneFeed:
         for b in range(1, m.nbody):
             if b in robot_bodies or int(m.body_parentid[b]) != 0:
                 continue
-            if int(m.body_jntnum[b]) > 0:
+            if int(m.body_jntnum[b]) > 0 or int(m.body_mocapid[b]) >= 0:  # free, or an actor
                 self.moving.append(b)
                 self._frames.append(_frame(m, b))
             else:

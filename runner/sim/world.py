@@ -28,7 +28,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import mujoco
 import numpy as np
@@ -40,6 +40,9 @@ from runner.sim.contacts import ContactWatch
 from runner.sim.links import Lockstep, RemoteRender
 from runner.sim.pubsub import PubSub
 from runner.sim.schedule import Hook, next_due, sleep_until
+
+if TYPE_CHECKING:
+    from runner.sim.events import Events
 from runner.wire import msgs
 from runner.wire.cdr import Layout
 from runner.wire.transport import Bus
@@ -55,6 +58,7 @@ class WorldStats:
     wall_s: float = 0.0
     published: dict[str, int] = field(default_factory=dict)
     error: str | None = None  # why the world stopped early on its own (physics went unstable)
+    ended: str | None = None  # an event ended the run (`end:`), and how
     rejected: dict[str, dict[str, int]] = field(default_factory=dict)  # inbound samples dropped: key, why
 
 
@@ -88,6 +92,9 @@ class World(PubSub):
         self._lockstep: Lockstep | None = None
         self.robots = [RobotHandle(self.model, r) for r in plan.robots]
         self.plugins: list[Plugin] = []
+        self._plugin_index: dict[int, Plugin] = {}  # by place in the plan (events change their parameters)
+        self._hooks_of: dict[int, list[Hook]] = {}
+        self._ended: str | None = None
         self._before: list[Hook] = []
         self._after: list[Hook] = []
         session = getattr(bus, "session", None)
@@ -119,6 +126,11 @@ class World(PubSub):
         if plan.contact_watch:
             for fn, period in ContactWatch(self, plan.contact_watch).hooks():
                 self._after.append(Hook(fn, period))
+        self._events: Events | None = None
+        if plan.actors or plan.events:
+            from runner.sim.events import Events
+
+            self._events = Events(self)
         for plugin in self.plugins:
             plugin.setup()
 
@@ -139,19 +151,24 @@ class World(PubSub):
                     link = RemoteRender(session, self.plan.name, index)
                     self.remote_renders[index] = link
                     self._after.append(Hook(self._render_hook(link), period))
+                    self._hooks_of[index] = [self._after[-1]]
                     continue
                 params = cls.Params.model_validate(pp.params)
                 # random numbers by the plugin's place in the plan, so a renderer process draws the same
                 plugin = cls(params, self._context(handle, index), pp.name)
                 self.plugins.append(plugin)
+                self._plugin_index[index] = plugin
                 if role == "renderer":
                     self.render_plugins[index] = plugin
                     continue
+                hooks = self._hooks_of.setdefault(index, [])
                 if overrides(plugin, "before_step"):
                     control = period if pp.control_rate is None else round(1e9 / pp.control_rate)
-                    self._before.append(Hook(plugin.before_step, control))
+                    hooks.append(Hook(plugin.before_step, control))
+                    self._before.append(hooks[-1])
                 if overrides(plugin, "after_step"):
-                    self._after.append(Hook(plugin.after_step, period, forward=plugin.needs_forward))
+                    hooks.append(Hook(plugin.after_step, period, forward=plugin.needs_forward))
+                    self._after.append(hooks[-1])
 
     def _context(self, handle: RobotHandle, stream: int) -> RuntimeContext:
         """What a plugin of this robot works with; its random numbers are the plan seed's stream `stream`."""
@@ -183,6 +200,9 @@ class World(PubSub):
             # the nodes' answers to the clocks published so far come before their next wait message
             self._lockstep.wait(self._clock_sent, self._should_stop)
         self._drain_inbox()
+        events = self._events
+        if events is not None and now >= events.next_ns:
+            events.boundary(now)
         for h in self._before:
             if now >= h.next_ns:
                 h.fn(now)
@@ -227,6 +247,31 @@ class World(PubSub):
         self.now_ns = now_ns
         self.render_plugins[index].after_step(now_ns)
 
+    # ----------------------------------------------------------------------- what events act on
+    def listen(self, key: str, type_name: str, callback: Callable[[Any, int], None]) -> None:
+        """`callback(msg, stamp_ns)` for each message on a full key: handed over at once when this world
+        publishes it, else at the next boundary from other processes."""
+        own = {t.key for t in self.plan.topics() if t.direction == "pub"} | set(self._out)
+        own |= {a["key"] for e in self.plan.events for a in e.do if a["kind"] == "publish"}
+        own.add(f"{self.plan.name}/_contacts")
+        if key in own:
+            self._local.setdefault(key, []).append((type_name, callback))
+        else:
+            self._subscriber_factory("")("/" + key.split("/", 1)[1], type_name, callback)
+
+    def plugin_at(self, index: int) -> Plugin | None:
+        return self._plugin_index.get(index)
+
+    def set_rate(self, index: int, rate: float, now_ns: int) -> None:
+        """A plugin's rate changed by an event: its hooks run at the new period from the next multiple."""
+        period = round(1e9 / rate)
+        for h in self._hooks_of.get(index, ()):
+            h.period_ns = period
+            h.next_ns = (now_ns // period + 1) * period
+
+    def end_here(self, why: str) -> None:
+        self._ended = why
+
     def _publish_clock(self, now: int) -> None:
         self.publish_cdr(self._clock, self._clock_layout.encode(now), now)
         self._clock_sent = now
@@ -239,6 +284,8 @@ class World(PubSub):
             nxt = min(nxt, h.next_ns)
         if self._timeline_i < len(self._timeline):
             nxt = min(nxt, self._timeline[self._timeline_i][0])
+        if self._events is not None:
+            nxt = min(nxt, self._events.next_ns)
         return nxt
 
     def run(
@@ -263,7 +310,7 @@ class World(PubSub):
         error = None
         while True:
             self._boundary()
-            if self.now_ns >= end_ns:
+            if self.now_ns >= end_ns or self._ended is not None:
                 break
             target = self._next_boundary(end_ns)
             n = max(1, math.ceil((target - self.now_ns) / self.step_ns))
@@ -313,6 +360,7 @@ class World(PubSub):
             published=published,
             error=error,
             rejected=rejected,
+            ended=self._ended,
         )
 
     def _instability(self, t0_ns: int, t1_ns: int) -> str:

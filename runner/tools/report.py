@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from runner.checks.judge import FAIL, PASS, UNDECIDED, Judge, Result, ended_early, judged_types
+from runner.checks.judge import FAIL, PASS, UNDECIDED, Judge, Result, ended_early, events_key, judged_types
 
 
 def judge_for(plan: Any) -> Judge | None:
@@ -15,9 +15,10 @@ def judge_for(plan: Any) -> Judge | None:
 
     parts = plan.worlds or [plan]  # several worlds: one judge over all (their keys are distinct)
     assertions = [a for part in parts for a in part.assertions]
-    if not assertions:
+    events = [events_key(part.name) for part in parts if part.events]
+    if not assertions and not events:
         return None
-    return Judge(specs_from_plan(assertions), [k for part in parts for k in part.assertion_keys])
+    return Judge(specs_from_plan(assertions), [k for part in parts for k in part.assertion_keys], events)
 
 
 def judge_recording(plan: Any, mcap: Path) -> tuple[list[Result], int, str | None]:

@@ -37,6 +37,17 @@ from runner.scenario.schema.base import (
     Strict,
     Vec3,
 )
+from runner.scenario.schema.events import (
+    ACTIONS,
+    TRIGGERS,
+    Action,
+    Actor,
+    Event,
+    Fault,
+    Hinge,
+    Waypoint,
+    When,
+)
 from runner.scenario.schema.messages import Foxglove, QosRule, Record, TimelineEntry
 from runner.scenario.schema.network import Bridge, BridgeDirection, Host, Node, Ros2, ZenohSettings
 from runner.scenario.schema.robots import Description, PluginEntry, Robot, XacroArg
@@ -44,6 +55,7 @@ from runner.scenario.schema.scenario import MAX_DURATION, SCHEMA_VERSION, Scenar
 from runner.scenario.schema.world import Ground, NamedWorld, Physics, World, WorldModel
 
 __all__ = [
+    "ACTIONS",
     "IDENT_RE",
     "MAX_DURATION",
     "NAMESPACE_RE",
@@ -52,13 +64,19 @@ __all__ = [
     "RUN_NAME_RE",
     "SCHEMA_VERSION",
     "TOPIC_RE",
+    "TRIGGERS",
+    "Action",
+    "Actor",
     "Assertion",
     "Bridge",
     "BridgeDirection",
     "Description",
     "DistanceTraveled",
+    "Event",
+    "Fault",
     "Foxglove",
     "Ground",
+    "Hinge",
     "Host",
     "MaxSpeed",
     "MaxTilt",
@@ -86,6 +104,8 @@ __all__ = [
     "TopicRate",
     "Vec2",
     "Vec3",
+    "Waypoint",
+    "When",
     "World",
     "WorldModel",
     "XacroArg",

@@ -8,8 +8,9 @@ from typing import Annotated, Any, Literal
 
 from pydantic import ConfigDict, Field, PositiveFloat, field_validator
 
-from runner.scenario.schema.assertions import Assertion
-from runner.scenario.schema.base import NODE_NAME_RE, Rate, RunName, Strict
+from runner.scenario.schema.assertions import Assertion, Region
+from runner.scenario.schema.base import IDENT_RE, NODE_NAME_RE, Rate, RunName, Strict
+from runner.scenario.schema.events import Event
 from runner.scenario.schema.messages import Foxglove, QosRule, Record, TimelineEntry
 from runner.scenario.schema.network import Bridge, Host, Node, Ros2, ZenohSettings
 from runner.scenario.schema.robots import Robot
@@ -62,6 +63,15 @@ class Scenario(Strict):
     robots: list[Robot] = Field(default_factory=list, description="Robots and their plugins.")
     timeline: list[TimelineEntry] = Field(
         default_factory=list, description="Messages to publish at sim times."
+    )
+    regions: dict[Annotated[str, Field(pattern=IDENT_RE.pattern)], Region] = Field(
+        default_factory=dict, description="Named regions of the ground plane, for events (`enter`, `leave`)."
+    )
+    events: list[Event] = Field(
+        default_factory=list,
+        description="What happens when: a trigger (`when`: a time, a body entering a region or coming "
+        "near, a message, another event, an assertion decided) and actions (`do`: publish, start an "
+        "actor, teleport, push, change a parameter, inject a fault, block a wheel, end the run).",
     )
     record: Record = Field(default_factory=Record, description="What to record, and where.")
     assertions: list[Assertion] = Field(

@@ -8,6 +8,7 @@ from typing import Annotated, Any, Literal
 from pydantic import Field, PositiveFloat, field_validator
 
 from runner.scenario.schema.base import IDENT_RE, Namespace, Pose, Rgba, Strict, Vec3
+from runner.scenario.schema.events import Actor
 
 
 class Physics(Strict):
@@ -63,6 +64,11 @@ class World(Strict):
     physics: Physics = Field(default_factory=Physics, description="Physics settings.")
     ground: Ground = Field(default_factory=Ground, description="The ground plane.")
     models: list[WorldModel] = Field(default_factory=list, description="Primitive models in the world.")
+    actors: list[Actor] = Field(
+        default_factory=list,
+        description="Models that move on their own (people walking a path, a door that opens), "
+        "kinematically: they push robots and are seen by their sensors.",
+    )
     clock_rate: PositiveFloat = Field(
         100.0, description="How often sim time is published on `<run>/clock`, in sim Hz."
     )

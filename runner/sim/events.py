@@ -1,0 +1,262 @@
+"""Events played in the world (`events:`, compiled by runner.compile.events): at each step boundary where
+something may fire, the events are looked at in their plan order, and each whose trigger holds fires: its
+actions run at once, in order, and the firing is published on `<run>/_events`.
+
+When triggers are looked at: a time (`at`) and a delayed `after` at the exact step of their time; `near`,
+`enter` and `leave` every `TICK_NS` (10 ms of sim time; bodies are where the physics has them at that
+step); `message` at the first boundary after a message for which its expression holds (published by a
+sensor at that boundary, by an earlier event of the step, or received from a node); `assertion` when the
+world's own copy of the judge decides it; `after` (no delay) in the same step, after the event it follows.
+
+The step's order (runner.sim.world): sensors publish, the timeline, messages from other processes, then
+events (actors move after them, on ticks), then controllers act on the commands, then the clock."""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable
+from typing import Any, Protocol
+
+import mujoco
+import numpy as np
+
+from runner.checks.judge import events_key
+from runner.plan import EventPlan, RunPlan
+from runner.sim.actors import TICK_NS, Actors
+from runner.sim.faults import Fault
+from runner.wire import msgs
+
+_EVENTS_STREAM = 1_000_003  # random streams of events' faults: (seed, this + event index)
+
+
+class EventWorld(Protocol):
+    """What events act on: the world (runner.sim.world.World)."""
+
+    plan: RunPlan
+    model: mujoco.MjModel
+    data: mujoco.MjData
+
+    def make_publisher(self, key: str, type_name: str) -> Any: ...
+    def publish(self, out: Any, msg: Any, stamp_ns: int) -> None: ...
+    def listen(self, key: str, type_name: str, callback: Callable[[Any, int], None]) -> None: ...
+    def plugin_at(self, index: int) -> Any: ...
+    def set_rate(self, index: int, rate: float, now_ns: int) -> None: ...
+    def end_here(self, why: str) -> None: ...
+
+
+class _Event:
+    def __init__(self, plan: EventPlan, index: int):
+        self.plan = plan
+        self.name = plan.name
+        self.kind = plan.when["kind"]
+        self.index = index
+        self.done = False  # fired, and fires once
+        self.pending: str | None = None  # fire at the next look, saying why
+        self.due: list[int] = []  # times to fire (`at`, delayed `after`)
+        self.inside: bool | None = None  # the last look's answer (near, enter, leave)
+        self.fired = 0
+
+
+class Events:
+    """The events and actors of one world. `boundary(now)` when `now >= next_ns`."""
+
+    def __init__(self, world: EventWorld):
+        plan = world.plan
+        self.world = world
+        self.m, self.d = world.model, world.data
+        self.actors = Actors(self.m, self.d, plan.actors) if plan.actors else None
+        self.events = [_Event(p, i) for i, p in enumerate(plan.events)]
+        self.by_name = {e.name: e for e in self.events}
+        self.followers: dict[str, list[_Event]] = {}
+        self.seed = plan.seed
+        self.next_tick = 0
+        self.next_ns = 0
+        self.faults: dict[str, tuple[Fault, Any]] = {}  # key -> (fault, its Outgoing)
+        self.pushes: list[tuple[int, int]] = []  # (until_ns, body)
+        self.spatial = [e for e in self.events if e.kind in ("near", "enter", "leave")]
+        self.out = world.make_publisher(events_key(plan.name), "std_msgs/msg/String") if self.events else None
+        self.log: list[dict[str, Any]] = []
+        for e in self.events:
+            when = e.plan.when
+            if e.kind == "at":
+                e.due.append(when["t_ns"])
+            elif e.kind == "after":
+                self.followers.setdefault(when["event"], []).append(e)
+            elif e.kind == "message":
+                self._listen_message(e)
+            elif e.kind == "assertion":
+                self._listen_assertion(e, plan)
+            elif e.kind in ("near", "enter", "leave"):
+                e.body_at = self._locator(when["body"])  # type: ignore[attr-defined]
+                if e.kind == "near" and isinstance(when["to"], dict):
+                    e.to_at = self._locator(when["to"])  # type: ignore[attr-defined]
+
+    # -------------------------------------------------------------------------------- triggers
+    def _locator(self, ref: dict[str, Any]) -> Callable[[], tuple[float, float]]:
+        d = self.d
+        if "geom" in ref:
+            gid = mujoco.mj_name2id(self.m, mujoco.mjtObj.mjOBJ_GEOM, ref["geom"])
+            return lambda: (float(d.geom_xpos[gid, 0]), float(d.geom_xpos[gid, 1]))
+        bid = mujoco.mj_name2id(self.m, mujoco.mjtObj.mjOBJ_BODY, ref["body"])
+        return lambda: (float(d.xpos[bid, 0]), float(d.xpos[bid, 1]))
+
+    def _listen_message(self, e: _Event) -> None:
+        from runner.checks.expr import compile_expr
+
+        when = e.plan.when
+        expr = compile_expr(when["expr"])
+
+        def on_message(msg: Any, stamp_ns: int) -> None:
+            if e.done or e.pending is not None:
+                return
+            try:
+                ok = expr.test(msg)
+            except Exception:  # a reducer over nothing, a missing field: not true
+                return
+            if ok:
+                e.pending = f"`{when['expr']}` on {when['topic']}"
+                self.next_ns = 0
+
+        self.world.listen(when["key"], when["type"], on_message)
+
+    def _listen_assertion(self, e: _Event, plan: RunPlan) -> None:
+        from runner.checks import specs_from_plan
+        from runner.checks.judge import Judge
+
+        when = e.plan.when
+        spec = specs_from_plan([plan.assertions[when["index"]]])[0]
+        key = plan.assertion_keys[when["index"]]
+        judge = Judge([spec], [key])
+        want = "pass" if when["becomes"] == "pass" else "fail"
+        types = {t.key: t.type for t in plan.topics()}
+        types.setdefault(f"{plan.name}/_contacts", "gazebo_msgs/msg/ContactsState")
+
+        def on_message(msg: Any, stamp_ns: int) -> None:
+            if e.done or e.pending is not None:
+                return
+            judge.feed(key, stamp_ns, msg)
+            result = judge.checks[0].result
+            if result is not None and result.status == want:
+                e.pending = (
+                    f"assertion {when['name']!r} {'passed' if want == 'pass' else 'failed'}: {result.message}"
+                )
+                self.next_ns = 0
+
+        self.world.listen(key, types[key], on_message)
+
+    def _holds(self, e: _Event, now: int) -> str | None:
+        """Why `e` fires now, or None."""
+        if e.pending is not None:
+            why, e.pending = e.pending, None
+            return why
+        if e.due and e.due[0] <= now:
+            e.due.pop(0)
+            return (
+                "at t"
+                if e.kind == "at"
+                else f"{e.plan.when['delay_ns'] / 1e9:g} s after {e.plan.when['event']}"
+            )
+        if e.kind not in ("near", "enter", "leave") or now % TICK_NS:
+            return None
+        return self._spatial(e)
+
+    def _spatial(self, e: _Event) -> str | None:
+        when = e.plan.when
+        x, y = e.body_at()  # type: ignore[attr-defined]
+        who = when["body"]["name"]
+        if e.kind == "near":
+            tx, ty = e.to_at() if hasattr(e, "to_at") else when["to"]  # type: ignore[attr-defined]
+            dist = math.hypot(x - tx, y - ty)
+            now_in = dist <= when["within"]
+            was, e.inside = e.inside, now_in
+            if now_in and not was:
+                to = when["to"]["name"] if isinstance(when["to"], dict) else f"[{tx:g}, {ty:g}]"
+                return f"{who} within {when['within']:g} m of {to} ({dist:.2f} m)"
+            return None
+        r = when["region"]
+        if "center" in r:
+            now_in = (x - r["center"][0]) ** 2 + (y - r["center"][1]) ** 2 <= r["radius"] ** 2
+        else:
+            now_in = r["min"][0] <= x <= r["max"][0] and r["min"][1] <= y <= r["max"][1]
+        was, e.inside = e.inside, now_in
+        if was is None:
+            return None  # the first look sets where it is: entering or leaving is a change
+        if e.kind == "enter" and now_in and not was:
+            return f"{who} entered {when['label']} at ({x:.2f}, {y:.2f})"
+        if e.kind == "leave" and was and not now_in:
+            return f"{who} left {when['label']} at ({x:.2f}, {y:.2f})"
+        return None
+
+    # -------------------------------------------------------------------------------- the step
+    def boundary(self, now: int) -> None:
+        for key, (fault, out) in list(self.faults.items()):
+            fault.release(out, now)
+            if fault.until_ns is not None and now >= fault.until_ns:
+                for payload_due in list(fault.held):  # what it still holds goes out at its time
+                    out.deliver(payload_due[1], payload_due[2], now)
+                out.fault = None
+                del self.faults[key]
+        if self.pushes:
+            for _until, body in [p for p in self.pushes if p[0] <= now]:
+                self.d.xfrc_applied[body] = 0.0
+            self.pushes = [p for p in self.pushes if p[0] > now]
+        tick = now >= self.next_tick
+        for e in self.events:
+            if e.done:
+                continue
+            why = self._holds(e, now)
+            if why is not None:
+                self._fire(e, now, why)
+        if tick:
+            if self.actors is not None:
+                self.actors.tick(now)
+            self.next_tick = (now // TICK_NS + 1) * TICK_NS
+        self.next_ns = self._next(now)
+
+    def _next(self, now: int) -> int:
+        nxt = self.next_tick if (self.actors is not None or self.spatial) else 2**62
+        for e in self.events:
+            if e.due and not e.done:
+                nxt = min(nxt, e.due[0])
+        for fault, _out in self.faults.values():
+            t = fault.next_ns()
+            if t is not None:
+                nxt = min(nxt, t)
+        for until, _b in self.pushes:
+            nxt = min(nxt, until)
+        return max(nxt, now + 1)
+
+    def _fire(self, e: _Event, now: int, why: str) -> None:
+        e.fired += 1
+        if not e.plan.repeat:
+            e.done = True
+        did = [self._do(e, a, now) for a in e.plan.do]
+        end = next((a for a in e.plan.do if a["kind"] == "end"), None)
+        entry = {"event": e.name, "t": now / 1e9, "why": why, "did": did, "n": e.fired}
+        if end is not None:
+            entry["end"] = {"result": end["result"], "message": end["message"]}
+        self.log.append(entry)
+        if self.out is not None:
+            self.world.publish(self.out, msgs.T["std_msgs/msg/String"](data=json.dumps(entry)), now)
+        for f in self.followers.get(e.name, ()):
+            if f.done:
+                continue
+            delay = f.plan.when["delay_ns"]
+            if delay == 0:
+                f.pending = f"after {e.name}"
+            else:
+                f.due.append(now + delay)
+                f.due.sort()
+        if end is not None:
+            self.world.end_here(
+                f"event {e.name}: {end['result']}" + (f" ({end['message']})" if end["message"] else "")
+            )
+
+    def _do(self, e: _Event, a: dict[str, Any], now: int) -> str:
+        from runner.sim.event_actions import act
+
+        return act(self, e, a, now)
+
+    def fault_rng(self, e: _Event, k: int) -> np.random.Generator:
+        return np.random.default_rng([self.seed, _EVENTS_STREAM + e.index, k])
