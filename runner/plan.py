@@ -173,6 +173,8 @@ class RunPlan(BaseModel):
     worlds: list[RunPlan] = []
     hosts: dict[str, str] = {}  # host name -> Zenoh endpoint; the first is the main host
     host: str | None = None  # with hosts: the host that simulates this world (None: the first)
+    variant: str = ""  # the matrix variant's label ("" without a matrix): its values, sample, drawn values
+    drawn: dict[str, Any] = {}  # values drawn at random (runner.scenario.draws): {path: value}
 
     def parts(self) -> list[RunPlan]:
         """The world plans of the run: `worlds`, or this plan itself."""

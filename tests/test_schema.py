@@ -254,7 +254,14 @@ def test_every_installed_plugin_has_its_params_rule_and_its_defaults_pass() -> N
     assert lidar["properties"]["samples"]["type"] == "integer"
     assert lidar["properties"]["samples"]["exclusiveMinimum"] == 0
     assert lidar["properties"]["points_format"]["enum"] == ["xyz", "velodyne"]
-    assert lidar["properties"]["min_angle"]["minimum"] == -7.0
+    assert _plain(lidar["properties"]["min_angle"])["minimum"] == -7.0
+
+
+def _plain(prop: dict[str, Any]) -> dict[str, Any]:
+    """A number's (or number vector's) own schema: every one of them also takes a draw (`{uniform: ...}`)."""
+    own, draw = prop["anyOf"]
+    assert draw == {"$ref": "#/$defs/Draw"}, prop
+    return own  # type: ignore[no-any-return]
 
 
 def test_params_rules_refuse_nothing_the_model_takes(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -381,8 +388,8 @@ def test_a_third_party_plugin_gets_its_params_rule(tmp_path: Path) -> None:
     beacon = _then(schema, "beacon")
     assert beacon["additionalProperties"] is False
     assert set(beacon["properties"]) == {"rate", "point", "link", "topic"}
-    assert beacon["properties"]["rate"]["exclusiveMinimum"] == 0
-    assert beacon["properties"]["point"]["maxItems"] == 3
+    assert _plain(beacon["properties"]["rate"])["exclusiveMinimum"] == 0
+    assert _plain(beacon["properties"]["point"])["maxItems"] == 3
     # the rest is the committed schema (built with the built-ins only), the beacon's rule and model added
     committed = json.loads((REPO / "schemas" / "scenario.schema.json").read_text())
     rules = schema["$defs"]["PluginEntry"].pop("allOf")

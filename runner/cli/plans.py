@@ -12,8 +12,9 @@ from runner.cli.console import err
 
 
 def load_variants(file: Path, record: str | None, variant: int | None) -> list[tuple[str, Any]]:
-    """[(label, plan)] of the scenario's matrix variants (one, unlabelled, without a matrix)."""
-    from runner.compile import load_plan
+    """[(label, plan)] of the scenario's matrix variants (one, unlabelled, without a matrix). Values drawn at
+    random are in the plans (`plan.drawn`), their poses placed free of collisions, and in the labels."""
+    from runner.compile.placement import load_drawn_plan
     from runner.scenario.loader import load_file
     from runner.scenario.matrix import variants
 
@@ -24,8 +25,19 @@ def load_variants(file: Path, record: str | None, variant: int | None) -> list[t
         found = [found[variant]]
     out = []
     for label, doc in found:
-        out.append((label, load_plan(doc, record_path=record)))
+        plan = load_drawn_plan(doc, record_path=record)
+        out.append((plan.variant or label, plan))
     return out
+
+
+def drawn_line(plan: Any) -> str:
+    """`drawn: path=value,...` for a run that drew values without a matrix ("" otherwise: a variant's label
+    shows them)."""
+    if not plan.drawn or plan.variant:
+        return ""
+    from runner.scenario.draws import shown
+
+    return "drawn: " + shown(plan.drawn)
 
 
 def strict_failure(plan: Any) -> None:

@@ -3,7 +3,9 @@ collected as tests, one item per assertion, so `pytest scenarios/` works in an e
 
 Each scenario runs once (`scenario run --no-record`, judged live); its assertions report their verdicts,
 with the time, value and bound of a failure. An assertion the run could not decide (its window lies past
-the run's end...) fails, saying why; `--scenario-allow-undecided` makes it a skip instead.
+the run's end...) fails, saying why; `--scenario-allow-undecided` makes it a skip instead. With a
+`matrix:`, every variant runs, and an assertion passes when it passes in each one (a failure names the
+variant, its drawn values included).
 """
 
 from __future__ import annotations
@@ -77,25 +79,33 @@ class ScenarioFile(pytest.File):
 
 class ScenarioItem(pytest.Item):
     def runtest(self) -> None:
+        """The assertion's verdict in the run (in each variant of a matrix: it must pass in every one)."""
         parent = self.parent
         assert isinstance(parent, ScenarioFile)
         data = parent.results()
-        if data.get("error"):
-            raise ScenarioFailure(data["error"])
-        result = next((r for r in data["results"] if r["name"] == self.name), None)
-        if result is None:
-            raise ScenarioFailure(f"assertion {self.name!r} was not judged")
-        if result.get("status") == "undecided":
-            why = f"{self.name} ({result['type']}) not decided: {result['message']}"
-            if self.config.getoption("--scenario-allow-undecided", False):
-                pytest.skip(why)
-            raise ScenarioFailure(why)
-        if not result["passed"]:
-            at = f" at t={result['t']:.3f} s" if result["t"] is not None else ""
-            raise ScenarioFailure(
-                f"{self.name} ({result['type']}) failed{at}: {result['message']}; value {result['value']}; "
-                f"bound {result['bound']}"
-            )
+        runs = data.get("variants") or [data]
+        failures: list[str] = []
+        undecided: list[str] = []
+        for run in runs:
+            named = f"{run['name']}: " if len(runs) > 1 else ""
+            if run.get("error"):
+                failures.append(named + run["error"])
+                continue
+            result = next((r for r in run["results"] if r["name"] == self.name), None)
+            if result is None:
+                failures.append(f"{named}assertion {self.name!r} was not judged")
+            elif result.get("status") == "undecided":
+                undecided.append(f"{named}{self.name} ({result['type']}) not decided: {result['message']}")
+            elif not result["passed"]:
+                at = f" at t={result['t']:.3f} s" if result["t"] is not None else ""
+                failures.append(
+                    f"{named}{self.name} ({result['type']}) failed{at}: {result['message']}; value "
+                    f"{result['value']}; bound {result['bound']}"
+                )
+        if undecided and not failures and self.config.getoption("--scenario-allow-undecided", False):
+            pytest.skip("\n".join(undecided))
+        if failures or undecided:
+            raise ScenarioFailure("\n".join(failures + undecided))
 
     def repr_failure(self, excinfo: Any, style: Any = None) -> str:
         if isinstance(excinfo.value, ScenarioFailure):

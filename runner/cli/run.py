@@ -19,7 +19,7 @@ from rich.table import Table
 from runner import interrupts
 from runner.cli.console import err, fail, out
 from runner.cli.options import AllOpt, AllowUndecided
-from runner.cli.plans import load_variants, print_notices, strict_failure
+from runner.cli.plans import drawn_line, load_variants, print_notices, strict_failure
 from runner.cli.results import plot_failure, print_results
 from runner.errors import RunError, ScenarioError
 
@@ -162,6 +162,8 @@ def run(
             plan.record.path = str(path.with_name(f"{path.stem}-{i}{path.suffix}"))
         if label and not quiet:
             err.print(f"variant {i}: {label}", markup=False)
+        elif drawn_line(plan) and not quiet:
+            err.print(drawn_line(plan), markup=False)
         suite, rc = _run_one(plan, label, options)
         suites.append(suite)
         code = max(code, rc)
@@ -292,6 +294,7 @@ def _run_one(plan: Any, label: str, options: RunOptions) -> tuple[Any, int]:
         allow_undecided=options.allow_undecided,
         timestamp=started,
         interrupted=ended,
+        label=label,
     )
     if results and not suite.passed and result.mcap is not None:
         plot_failure(plan, result.mcap, results)

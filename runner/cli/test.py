@@ -154,7 +154,8 @@ def _run_in_process(task: Task, out_dir: Path, no_record: bool, allow_undecided:
         proc = subprocess.run(cmd, capture_output=True, text=True)
         if res.is_file():
             suite = Suite.from_json(json.loads(res.read_text()))
-            suite.name = name
+            # the run's own label: a pose drawn in collision was drawn again there
+            suite.name = f"{f.stem}[{suite.label}]" if suite.label else name
             return suite
         why = (proc.stderr.strip() or proc.stdout.strip() or f"exit {proc.returncode}").splitlines()
         return Suite(name, error="\n".join(why[-12:]))

@@ -11,7 +11,7 @@ import typer
 from rich.table import Table
 
 from runner.cli.console import err, fail, out
-from runner.cli.plans import load_variants, print_notices, strict_failure
+from runner.cli.plans import drawn_line, load_variants, print_notices, strict_failure
 from runner.errors import ScenarioError
 from runner.plan import RobotPlan
 
@@ -46,6 +46,8 @@ def validate(
         return
     parts = plan.worlds or [plan]
     _print_headline(plan, parts)
+    if drawn_line(plan):
+        out.print(drawn_line(plan), markup=False)
     out.print(_robots_table(plan, parts))
     for part in parts:
         for r in part.robots:

@@ -40,8 +40,89 @@ def build() -> dict[str, Any]:
     bridges.pop("type", None)
     bridges["anyOf"] = [{"type": "array", "items": one}, one]
     props["seed"]["minimum"] = 0  # (Scenario._seed)
+    props["matrix"]["properties"] = {"samples": SAMPLES}
+    props["matrix"]["additionalProperties"] = {"type": "array"}
     _check_plugin_params(schema)
+    schema = _with_draws(schema)
+    schema["$defs"].update(DRAW_DEFS)
+    schema["$defs"] = dict(sorted(schema["$defs"].items()))
     return {"$schema": DRAFT, **schema}
+
+
+# ------------------------------------------------------------------------------------------------- draws
+# Values drawn at random (runner.scenario.draws) are resolved before the models see the file: in the JSON
+# Schema, every number (and vector of numbers) also takes a draw, and every pose the `within` form.
+SAMPLES = {
+    "type": "integer",
+    "minimum": 1,
+    "description": "How many seeded draws of the scenario's random values to run (each combination of the "
+    "other keys N times, sample i drawing from [seed, i]).",
+}
+_TWO = {
+    "type": "array",
+    "prefixItems": [{"type": "number"}, {"type": "number"}],
+    "minItems": 2,
+    "maxItems": 2,
+}
+
+
+def _one_key(key: str, value: dict[str, Any], description: str) -> dict[str, Any]:
+    return {
+        "type": "object",
+        "properties": {key: value},
+        "required": [key],
+        "additionalProperties": False,
+        "description": description,
+    }
+
+
+DRAW_DEFS: dict[str, Any] = {
+    "Draw": {
+        "title": "Draw",
+        "description": "A value drawn at random from the scenario's seed (and the sample's index).",
+        "oneOf": [
+            _one_key("uniform", _TWO, "`[lo, hi]`: a float in [lo, hi)."),
+            _one_key("normal", _TWO, "`[mean, stddev]`: a float from a normal distribution."),
+            _one_key("choice", {"type": "array", "minItems": 1}, "One of the items."),
+        ],
+    },
+    "DrawnPose": {
+        "title": "DrawnPose",
+        "description": "A pose drawn uniformly within a region of the ground, free of collisions at the "
+        "start: `{xyz: [x, y, z], rpy: [0, 0, yaw]}`.",
+        "type": "object",
+        "properties": {
+            "within": {"$ref": "#/$defs/Region"},
+            "z": {"type": "number", "description": "Height in metres (default 0)."},
+            "yaw": {
+                "anyOf": [{"type": "number"}, _TWO],
+                "description": "Yaw in radians: a number, or [lo, hi] drawn uniformly (default 0).",
+            },
+        },
+        "required": ["within"],
+        "additionalProperties": False,
+    },
+}
+_VALUES = ("default", "examples", "const", "enum")  # keywords whose value is data, not a schema
+
+
+def _with_draws(node: Any) -> Any:
+    """`node` with every number and number vector also taking a `Draw`, every `Pose` a `DrawnPose`."""
+    if isinstance(node, list):
+        return [_with_draws(v) for v in node]
+    if not isinstance(node, dict):
+        return node
+    out = {k: (v if k in _VALUES else _with_draws(v)) for k, v in node.items()}
+    if node.get("$ref") == "#/$defs/Pose":
+        rest = {k: v for k, v in out.items() if k != "$ref"}
+        return {"anyOf": [{"$ref": "#/$defs/Pose"}, {"$ref": "#/$defs/DrawnPose"}], **rest}
+    items = node.get("prefixItems")
+    vector = node.get("type") == "array" and isinstance(items, list) and items
+    if node.get("type") == "number" or (vector and all(i.get("type") == "number" for i in items)):
+        kept = {k: v for k, v in out.items() if k in ("title", "description", "default")}
+        inner = {k: v for k, v in out.items() if k not in kept}
+        return {"anyOf": [inner, {"$ref": "#/$defs/Draw"}], **kept}
+    return out
 
 
 def _drop(node: Any, keyword: str) -> None:

@@ -9,6 +9,10 @@ matrix:
 expands into the cartesian product (here 8 variants); each key is a path into the scenario, each value
 replaces what is there (missing mappings on the way are created). Every variant is validated, run and judged
 on its own, and reported as `<name>[seed=1,robots[0].pose.xyz=[0, 0, 0.06],...]`.
+
+`samples: N` (a key of its own, not a path) runs each combination N times, sample i drawing the file's random
+values (`runner.scenario.draws`) from `[seed, i]`: `<name>[sample=2,robots[0].pose=[1.23, -0.5, 0.06, yaw
+1.2]]`. A file with draws and no matrix is one run, drawn as sample 0.
 """
 
 from __future__ import annotations
@@ -20,12 +24,14 @@ import re
 from typing import Any
 
 from runner.errors import Problem, ScenarioError
+from runner.scenario.draws import DrawnDocument, draw, has_draws
 from runner.scenario.loader import Document
 
 _PART = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(-?\d+)\]")
 
 
 MAX_VARIANTS = 1000  # each one is a run: beyond this, a matrix is a mistake, not a test plan
+SAMPLES = "samples"  # the matrix key that is not a path: how many seeded draws of each combination
 
 
 def parse_path(text: str) -> tuple[str | int, ...] | None:
@@ -68,54 +74,16 @@ def _label(value: Any) -> str:
 
 
 def variants(doc: Document) -> list[tuple[str, Document]]:
-    """[(label, document)] for every combination; [("", doc)] without a matrix."""
+    """[(label, document)] for every combination (and sample); [("", doc)] without a matrix. A variant whose
+    file draws values is a `DrawnDocument` holding them."""
     data = doc.data
     if not isinstance(data, dict) or not data.get("matrix"):
+        if isinstance(data, dict) and has_draws(data):
+            drawn = copy.deepcopy(data)
+            return [("", DrawnDocument(drawn, doc.file, doc.positions, draw(doc, drawn)))]
         return [("", doc)]
+    paths, samples = _matrix(doc)
     matrix = data["matrix"]
-    problems: list[Problem] = []
-    if not isinstance(matrix, dict):
-        raise ScenarioError(
-            Problem(
-                "`matrix` must map paths to lists of values",
-                doc.locate(("matrix",)),
-                ("matrix",),
-                hint="e.g. `matrix: {seed: [1, 2]}`",
-            )
-        )
-    paths: list[tuple[str, tuple[str | int, ...]]] = []
-    for key, values in matrix.items():
-        where = ("matrix", key)
-        path = parse_path(str(key))
-        if path is None or path[0] in ("matrix", "name"):
-            problems.append(
-                Problem(
-                    f"{key!r} is not a path into the scenario",
-                    doc.locate(where),
-                    where,
-                    hint="paths look like `seed`, `robots[0].pose.xyz`, `timeline[1].data.linear.x`",
-                )
-            )
-        elif not isinstance(values, list) or not values:
-            problems.append(
-                Problem("expected a non-empty list of values", doc.locate(where), where, found=repr(values))
-            )
-        else:
-            paths.append((str(key), path))
-    if problems:
-        raise ScenarioError(problems)
-    total = math.prod(len(matrix[k]) for k, _ in paths)
-    if total > MAX_VARIANTS:
-        raise ScenarioError(
-            Problem(
-                f"the matrix makes {total} variants, more than {MAX_VARIANTS}",
-                doc.locate(("matrix",)),
-                ("matrix",),
-                expected=f"at most {MAX_VARIANTS} combinations",
-                found=" x ".join(str(len(matrix[k])) for k, _ in paths),
-                hint="split it into several scenario files, or run chosen variants with --variant",
-            )
-        )
     out: list[tuple[str, Document]] = []
     for combo in itertools.product(*[matrix[k] for k, _ in paths]):
         variant = copy.deepcopy(data)
@@ -131,6 +99,78 @@ def variants(doc: Document) -> list[tuple[str, Document]]:
                         hint="list indices must exist (robots[0] needs a first robot)",
                     )
                 )
-        label = ",".join(f"{key}={_label(v)}" for (key, _), v in zip(paths, combo, strict=True))
-        out.append((label, Document(variant, doc.file, doc.positions)))
+        prefix = [f"{key}={_label(v)}" for (key, _), v in zip(paths, combo, strict=True)]
+        if samples is None and not has_draws(variant):
+            out.append((",".join(prefix), Document(variant, doc.file, doc.positions)))
+            continue
+        for i in range(samples or 1):
+            one = copy.deepcopy(variant) if samples else variant
+            draws = draw(doc, one, i, [*prefix, *([f"sample={i}"] if samples else [])])
+            out.append((draws.label(), DrawnDocument(one, doc.file, doc.positions, draws)))
     return out
+
+
+def _matrix(doc: Document) -> tuple[list[tuple[str, tuple[str | int, ...]]], int | None]:
+    """The matrix's paths (key, parsed) and `samples` (None without), every mistake in it at once."""
+    matrix = doc.data["matrix"]
+    problems: list[Problem] = []
+    if not isinstance(matrix, dict):
+        raise ScenarioError(
+            Problem(
+                "`matrix` must map paths to lists of values",
+                doc.locate(("matrix",)),
+                ("matrix",),
+                hint="e.g. `matrix: {seed: [1, 2]}`",
+            )
+        )
+    paths: list[tuple[str, tuple[str | int, ...]]] = []
+    samples: int | None = None
+    for key, values in matrix.items():
+        where = ("matrix", key)
+        path = parse_path(str(key))
+        if key == SAMPLES:
+            if isinstance(values, int) and not isinstance(values, bool) and values >= 1:
+                samples = values
+            else:
+                problems.append(
+                    Problem(
+                        "`samples` is how many seeded draws of the scenario to run",
+                        doc.locate(where),
+                        where,
+                        expected="a whole number, 1 or more",
+                        found=repr(values),
+                        hint="e.g. `matrix: {samples: 10}`",
+                    )
+                )
+        elif path is None or path[0] in ("matrix", "name"):
+            problems.append(
+                Problem(
+                    f"{key!r} is not a path into the scenario",
+                    doc.locate(where),
+                    where,
+                    hint="paths look like `seed`, `robots[0].pose.xyz`, `timeline[1].data.linear.x`; "
+                    "`samples: N` runs N seeded draws",
+                )
+            )
+        elif not isinstance(values, list) or not values:
+            problems.append(
+                Problem("expected a non-empty list of values", doc.locate(where), where, found=repr(values))
+            )
+        else:
+            paths.append((str(key), path))
+    if problems:
+        raise ScenarioError(problems)
+    total = math.prod(len(matrix[k]) for k, _ in paths) * (samples or 1)
+    if total > MAX_VARIANTS:
+        counts = [str(len(matrix[k])) for k, _ in paths] + ([f"{samples} samples"] if samples else [])
+        raise ScenarioError(
+            Problem(
+                f"the matrix makes {total} variants, more than {MAX_VARIANTS}",
+                doc.locate(("matrix",)),
+                ("matrix",),
+                expected=f"at most {MAX_VARIANTS} combinations",
+                found=" x ".join(counts),
+                hint="split it into several scenario files, or run chosen variants with --variant",
+            )
+        )
+    return paths, samples

@@ -226,6 +226,7 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
         f'<!doctype html><html><head><meta charset="utf-8"><title>{h(plan.name)}: run report</title>',
         f"<style>{STYLE}</style></head><body>",
         f'<h1>{h(plan.name)}</h1><p class="sub">{h(_shown_path(plan.scenario_file))}</p>',
+        *_variant_lines(plan),
         f"<p>{_verdict(results)} &nbsp; {span:.2f} s sim, {summary['messages']} messages recorded"
         + (" (the recording was cut)" if summary.get("cut") else "")
         + "</p>",
@@ -263,6 +264,16 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
         "frames": len(frames),
         "trajectory": trajectory is not None,
     }
+
+
+def _variant_lines(plan: Any) -> list[str]:
+    """The matrix variant the run was (its label) and the values it drew at random, if any."""
+    from runner.scenario.draws import shown
+
+    lines = [f'<p class="sub">variant: {html.escape(plan.variant)}</p>'] if plan.variant else []
+    if plan.drawn:
+        lines.append(f'<p class="sub">drawn: {html.escape(shown(plan.drawn))}</p>')
+    return lines
 
 
 def _charts(plan: Any, mcap: Path, keyed: list[tuple[dict[str, Any], str]]) -> list[str]:

@@ -80,6 +80,7 @@ class Suite:
     allow_undecided: bool = False  # an undecided assertion does not fail the suite (--allow-undecided)
     timestamp: str = field(default_factory=_now)  # when it started
     interrupted: str | None = None  # "interrupted at t=...": why the run ended before its planned end
+    label: str = ""  # the matrix variant's label (its values and drawn values), "" without a matrix
 
     @property
     def passed(self) -> bool:
@@ -102,6 +103,7 @@ class Suite:
             "interrupted": self.interrupted,
             "allow_undecided": self.allow_undecided,
             "mcap": self.mcap,
+            "label": self.label,
             "counts": {
                 status: sum(1 for r in self.results if r.status == status)
                 for status in (PASS, FAIL, UNDECIDED)
@@ -133,6 +135,7 @@ class Suite:
             allow_undecided=data.get("allow_undecided", False),
             timestamp=data.get("timestamp") or _now(),
             interrupted=data.get("interrupted"),
+            label=data.get("label", ""),
         )
 
 

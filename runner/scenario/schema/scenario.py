@@ -77,10 +77,13 @@ class Scenario(Strict):
     assertions: list[Assertion] = Field(
         default_factory=list, description="Checks judged live during the run and from the recording."
     )
-    matrix: dict[str, list[Any]] = Field(
+    matrix: dict[str, list[Any] | int] = Field(
         default_factory=dict,
         description="Parameter variants: paths into this scenario (`seed`, `robots[0].pose.xyz`, "
-        "`timeline[0].data.linear.x`) mapped to lists of values; each combination is run and judged apart.",
+        "`timeline[0].data.linear.x`) mapped to lists of values; each combination is run and judged apart. "
+        "`samples: N` runs each combination N times, drawing the file's random values "
+        "(`{uniform: [lo, hi]}`, `{normal: [mean, stddev]}`, `{choice: [...]}`, `pose: {within: REGION}`) "
+        "from [seed, sample].",
     )
     stop_on: Literal["never", "first_failure", "all_decided"] = Field(
         "never", description="End the run early when an assertion fails, or when every one is decided."
@@ -135,6 +138,14 @@ class Scenario(Strict):
         if isinstance(v, bool) or not isinstance(v, int | float) or v <= 0:
             raise ValueError("rate must be 'realtime', 'max' or a positive real-time factor (e.g. 2.0)")
         return float(v)
+
+    @field_validator("matrix")
+    @classmethod
+    def _matrix(cls, v: dict[str, list[Any] | int]) -> dict[str, list[Any] | int]:
+        for key, values in v.items():
+            if isinstance(values, int) and (key != "samples" or values < 1):
+                raise ValueError(f"matrix.{key}: only `samples` takes a number (1 or more); paths take lists")
+        return v
 
     @field_validator("seed")
     @classmethod
