@@ -258,5 +258,9 @@ class Events:
 
         return act(self, e, a, now)
 
+    def wake(self, t_ns: int) -> None:
+        """Be looked at again at `t_ns` at the latest (a fault holds a message due then)."""
+        self.next_ns = min(self.next_ns, t_ns)
+
     def fault_rng(self, e: _Event, k: int) -> np.random.Generator:
         return np.random.default_rng([self.seed, _EVENTS_STREAM + e.index, k])
