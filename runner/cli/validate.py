@@ -57,6 +57,8 @@ def validate(
         out.print(_nodes_table(plan))
     if plan.bridges:
         out.print(_bridges_table(plan))
+    if any(part.actors or part.events for part in parts):
+        out.print(_happenings_table(parts))
     if plan.timeline:
         out.print(
             f"timeline: {len(plan.timeline)} message(s) from t={plan.timeline[0].t_ns / 1e9:g} s "
@@ -145,6 +147,54 @@ def _bridges_table(plan: Any) -> Table:
         options += ["lazy"] if b.lazy else []
         bridges.add_row(b.sim_key, arrows[b.direction], other, b.type, ", ".join(options))
     return bridges
+
+
+def _happenings_table(parts: list[Any]) -> Table:
+    """The actors (how they move, when they start) and the events (when, what they do), in step order."""
+    table = Table("", "name", "when", "what", title="Actors and events", title_justify="left")
+    for part in parts:
+        for a in part.actors:
+            start = "on an event" if a.start_ns is None else f"at {a.start_ns / 1e9:g} s"
+            if a.hinge is not None:
+                what = f"turns {a.hinge['angle']:g} rad about a hinge in {a.hinge['duration']:g} s"
+            elif len(a.points) > 1:
+                what = f"walks {len(a.points)} points in {a.times[-1]:.1f} s" + (
+                    ", looping" if a.loop else ""
+                )
+            else:
+                what = "stands"
+            table.add_row("actor", a.name, start, what)
+        for e in part.events:
+            table.add_row("event", e.name + (" (repeats)" if e.repeat else ""), _when(e.when), _did(e.do))
+    return table
+
+
+def _when(w: dict[str, Any]) -> str:
+    kind = w["kind"]
+    if kind == "at":
+        return f"at {w['t_ns'] / 1e9:g} s"
+    if kind in ("enter", "leave"):
+        return f"{w['body']['name']} {'enters' if kind == 'enter' else 'leaves'} {w['label']}"
+    if kind == "near":
+        to = w["to"]["name"] if isinstance(w["to"], dict) else str(w["to"])
+        return f"{w['body']['name']} within {w['within']:g} m of {to}"
+    if kind == "message":
+        return f"{w['topic']}: {w['expr']}"
+    if kind == "after":
+        return f"{w['delay_ns'] / 1e9:g} s after {w['event']}" if w["delay_ns"] else f"after {w['event']}"
+    return f"assertion {w['name']} {'passes' if w['becomes'] == 'pass' else 'fails'}"
+
+
+def _did(actions: list[dict[str, Any]]) -> str:
+    words = []
+    for a in actions:
+        target = a.get("name") or a.get("topic") or a.get("label") or (a.get("target") or {}).get("name")
+        if a["kind"] == "publish":
+            target = a["key"].split("/", 1)[1]
+        if a["kind"] == "end":
+            target = a["result"]
+        words.append(f"{a['kind']} {target}" if target else a["kind"])
+    return "; ".join(words)
 
 
 def _shown_path(file: str) -> str:
