@@ -43,6 +43,13 @@ def test_a_blind_driver_runs_into_the_person_and_the_report_says_when_and_where(
     x = float(hit["message"].split(" at (")[1].split(",")[0])
     assert 6.0 < x < 6.8, hit
     assert got["r1_stops_for_the_person"]["status"] == "fail"  # it never stopped
+    # the failed run's picture shows the person's path (dashed grey) across the robot's
+    from PIL import Image
+
+    from runner.tools.plot import ACTOR_INK
+
+    img = Image.open(tmp_path / "c.trajectory.png").convert("RGB")
+    assert list(img.getdata()).count(ACTOR_INK) > 100
     # the person started when r1 came within 3 m of the doorway: recorded on crossing/_events
     fired = [json.loads(d) for topic, _t, d in _events(tmp_path / "c.mcap")]
     assert [f["event"] for f in fired] == ["person_crosses"] and fired[0]["did"] == ["start walker"]

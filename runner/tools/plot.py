@@ -39,6 +39,9 @@ REGION = (84, 88, 100)
 FAILED = (207, 34, 46)
 
 
+ACTOR_INK = (150, 150, 150)  # actors' paths: grey, dashed (robots have the colours)
+
+
 def _fonts() -> dict[str, Any]:
     from PIL import ImageFont
 
@@ -52,6 +55,7 @@ class _Panel:
     paths: dict[str, np.ndarray]  # robot -> rows of (t ns, x, y)
     specs: list[Any]
     left_out: list[str] = field(default_factory=list)
+    actors: dict[str, np.ndarray] = field(default_factory=dict)  # actor -> rows of (t ns, x, y)
     lo: np.ndarray = field(default_factory=lambda: np.zeros(2))
     hi: np.ndarray = field(default_factory=lambda: np.ones(2))
     scale: float = 1.0  # pixels (final) per metre
@@ -98,6 +102,8 @@ def _bounds(panel: _Panel) -> None:
             kept.append(f)
     panel.shapes = kept
     pts = [subject, *(f.points() for f in kept)]
+    # actors' paths where they come near the robots' (a crowd far away does not shrink the picture)
+    pts += [a[np.linalg.norm(a[:, 1:3] - centre, axis=1) <= radius, 1:3] for a in panel.actors.values()]
     for s in panel.specs:
         pts += _region_points(s)
     allpts = np.vstack(pts)
@@ -163,9 +169,18 @@ def _panels(plan: Any, mcap: Path) -> tuple[list[_Panel], dict[str, RGB]]:
 
     parts = plan.parts()
     keys = {truth_key(part.name, r.namespace): r.name for part in parts for r in part.robots}
+    # actors: where the world's transforms put them (world -> actor, at the scene's tf rate)
+    actor_tf = {f"{part.name}/tf": {a.name for a in part.actors} for part in parts if part.actors}
     rows: dict[str, list[tuple[int, float, float]]] = {}
+    walked: dict[str, list[tuple[int, float, float]]] = {}
     with open(mcap, "rb") as f:
-        for _s, channel, message in make_reader(f).iter_messages(topics=list(keys)):
+        for _s, channel, message in make_reader(f).iter_messages(topics=[*keys, *actor_tf]):
+            if channel.topic in actor_tf:
+                for tr in msgs.decode(message.data, "tf2_msgs/msg/TFMessage").transforms:
+                    if tr.child_frame_id in actor_tf[channel.topic]:
+                        at = tr.transform.translation
+                        walked.setdefault(tr.child_frame_id, []).append((message.log_time, at.x, at.y))
+                continue
             m = msgs.decode(message.data, "nav_msgs/msg/Odometry")
             p = m.pose.pose.position
             rows.setdefault(keys[channel.topic], []).append((message.log_time, float(p.x), float(p.y)))
@@ -178,7 +193,8 @@ def _panels(plan: Any, mcap: Path) -> tuple[list[_Panel], dict[str, RGB]]:
         try:
             model = mujoco.MjModel.from_xml_string(part.mjcf)
             models[part.name] = model
-            shapes = footprints(model, skip_roots=[b for _n, b in robot_bodies(model, names)])
+            moving = [b for b in range(model.nbody) if int(model.body_mocapid[b]) >= 0]  # actors: their paths
+            shapes = footprints(model, skip_roots=[*(b for _n, b in robot_bodies(model, names)), *moving])
         except Exception:  # a model that no longer compiles (its meshes moved): paths only
             shapes = []
         specs = [
@@ -189,7 +205,8 @@ def _panels(plan: Any, mcap: Path) -> tuple[list[_Panel], dict[str, RGB]]:
         paths = {n: np.array(rows[n], dtype=float) for n in names if n in rows}
         if paths:
             title = part.name if plan.worlds else f"{plan.name}: paths from above"
-            panels.append(_Panel(title, shapes, paths, specs))
+            actors = {a.name: np.array(walked[a.name], dtype=float) for a in part.actors if a.name in walked}
+            panels.append(_Panel(title, shapes, paths, specs, actors=actors))
     return panels, run_colours(plan, models)
 
 
@@ -216,6 +233,8 @@ def trajectory_plot(plan: Any, mcap: Path, results: list[Result], out: Path) -> 
         legend.append(("world model", "solid"))
     if any(f.moving for p in panels for f in p.shapes):
         legend.append(("movable model, at start", "loose"))
+    if any(p.actors for p in panels):
+        legend.append(("actor's path", "actor"))
     if any(_region_points(s) for p in panels for s in p.specs):
         legend.append(("assertion region, goal", "region"))
     if failed:
@@ -237,8 +256,22 @@ def trajectory_plot(plan: Any, mcap: Path, results: list[Result], out: Path) -> 
     draw = ImageDraw.Draw(img)
     for p in panels:
         _draw_panel(img, draw, p, fonts, colours, by_name, failed)
-    # the legend, right of the plots
-    lx, ly = (x - GAP + LEGEND_PAD) * SS, (TOP + 4) * SS
+    _draw_legend(draw, legend, colours, fonts, ((x - GAP + LEGEND_PAD) * SS, (TOP + 4) * SS))
+    img = img.reduce(SS)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    img.save(out, optimize=True)
+    return out
+
+
+def _draw_legend(
+    draw: Any,
+    legend: list[tuple[str, str]],
+    colours: dict[str, RGB],
+    fonts: dict[str, Any],
+    at: tuple[float, float],
+) -> None:
+    """The legend, right of the plots, from its top-left corner `at` (drawing pixels)."""
+    lx, ly = at
     for text, kind in legend:
         cy = ly + 8 * SS
         sw = (lx, cy, lx + 28 * SS, cy)
@@ -258,6 +291,8 @@ def trajectory_plot(plan: Any, mcap: Path, results: list[Result], out: Path) -> 
                 outline=SOLID_EDGE,
                 width=SS,
             )
+        elif kind == "actor":
+            _dashed(draw, [(lx + 2 * SS, cy), (lx + 26 * SS, cy)], ACTOR_INK, 2 * SS)
         elif kind in ("region", "failed"):
             edge = REGION if kind == "region" else FAILED
             corners = [(lx + 2 * SS, cy - 6 * SS), (lx + 26 * SS, cy - 6 * SS), (lx + 26 * SS, cy + 6 * SS)]
@@ -268,10 +303,6 @@ def trajectory_plot(plan: Any, mcap: Path, results: list[Result], out: Path) -> 
             _cross(draw, lx + 14 * SS, cy)
         draw.text((lx + 38 * SS, cy), text, fill=ink, font=fonts["label"], anchor="lm")
         ly += 24 * SS
-    img = img.reduce(SS)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    img.save(out, optimize=True)
-    return out
 
 
 def _draw_panel(
@@ -384,7 +415,15 @@ def _draw_regions(draw: Any, p: _Panel, small: Any, failed: set[str]) -> None:
 
 
 def _draw_paths(draw: Any, p: _Panel, colours: dict[str, RGB]) -> None:
-    """Each robot's path in its colour: start (open circle), end (filled)."""
+    """Each actor's path, dashed grey, and each robot's path in its colour: start (open circle), end
+    (filled)."""
+    for path in p.actors.values():
+        pts = [p.px(x, y) for _t, x, y in path]
+        if len(pts) > 1:
+            _dashed(draw, pts, ACTOR_INK, 2 * SS)
+        u, v = pts[-1]
+        r = 4 * SS
+        draw.ellipse([u - r, v - r, u + r, v + r], fill=ACTOR_INK)
     for name, path in p.paths.items():
         ink = rgb255(colours[name])
         pts = [p.px(x, y) for _t, x, y in path]
