@@ -9,6 +9,7 @@ import json
 import os
 import re
 import subprocess
+import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any
@@ -218,3 +219,15 @@ def test_an_event_that_fires_again_and_again_is_folded_in_the_table() -> None:
     many = [{"event": f"e{i}", "t": float(i), "why": "at t", "did": []} for i in range(30)]
     rows, left = event_rows(many)
     assert len(rows) == 20 and left == 10
+
+
+def test_pytest_reports_an_event_that_failed_the_run(tmp_path: Path) -> None:
+    """The pytest plugin: an event with `end:` is an item of its own, failed with its message."""
+    folder = tmp_path / "scenarios"
+    folder.mkdir()
+    (folder / "ev.yaml").write_text(SCENARIO)
+    cmd = ["-m", "pytest", "-q", "-p", "no:cacheprovider", "-rf", str(folder / "ev.yaml")]
+    proc = subprocess.run([sys.executable, *cmd], capture_output=True, text=True, timeout=110, cwd=REPO)
+    assert proc.returncode == 1, proc.stdout + proc.stderr
+    assert "2 failed, 1 passed" in proc.stdout, proc.stdout
+    assert "event give_up (event) failed at t=2.500 s: time is up" in proc.stdout, proc.stdout
