@@ -1,5 +1,6 @@
 """pytest plugin (entry point `pytest11`): scenario files with `assertions:` under a `scenarios/` folder are
-collected as tests, one item per assertion, so `pytest scenarios/` works in an existing suite.
+collected as tests, one item per assertion, so `pytest scenarios/` works in an existing suite. An event that
+can end the run (`end:`) is an item too, `event NAME`: it fails if it fired and ended the run as a failure.
 
 Each scenario runs once (`scenario run --no-record`, judged live); its assertions report their verdicts,
 with the time, value and bound of a failure. An assertion the run could not decide (its window lies past
@@ -35,7 +36,7 @@ def pytest_collect_file(parent: pytest.Collector, file_path: Path) -> pytest.Col
         text = file_path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError):
         return None
-    if "\nassertions:" not in "\n" + text:
+    if "\nassertions:" not in "\n" + text and "\nevents:" not in "\n" + text:
         return None
     return ScenarioFile.from_parent(parent, path=file_path)
 
@@ -52,6 +53,9 @@ class ScenarioFile(pytest.File):
 
         doc = load_file(self.path)
         names = [a.get("name", f"assertion_{i}") for i, a in enumerate(doc.data.get("assertions") or [])]
+        for e in doc.data.get("events") or []:  # (named as the judge names an ending's result)
+            if isinstance(e, dict) and any(isinstance(a, dict) and "end" in a for a in e.get("do") or []):
+                names.append(f"event {e.get('name')}")
         for name in names:
             yield ScenarioItem.from_parent(self, name=str(name))
 
@@ -92,6 +96,8 @@ class ScenarioItem(pytest.Item):
                 failures.append(named + run["error"])
                 continue
             result = next((r for r in run["results"] if r["name"] == self.name), None)
+            if result is None and self.name.startswith("event "):
+                continue  # the event never fired: it did not end the run
             if result is None:
                 failures.append(f"{named}assertion {self.name!r} was not judged")
             elif result.get("status") == "undecided":

@@ -84,7 +84,8 @@ def report(
     ] = None,
 ) -> None:
     """One self-contained HTML page about a run: verdict, trajectory plot, assertions and the signals they
-    check, camera frames, topics. The scenario is read from the recording itself.
+    check, a timeline of its events and failures, camera frames, topics. The scenario is read from the
+    recording itself.
 
     Example: scenario report runs/two_robots.mcap -o two_robots.html
     """
@@ -103,7 +104,8 @@ def report(
         raise fail(e) from None
     out.print(
         f"{target}: {written['passed']}/{written['assertions']} assertions pass, "
-        f"{written['charts']} signal plot(s), {written['frames']} camera frame(s)",
+        f"{written['charts']} signal plot(s), {written['frames']} camera frame(s)"
+        + (f", {written['events']} event firing(s)" if written["events"] else ""),
         markup=False,
     )
 

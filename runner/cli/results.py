@@ -9,6 +9,7 @@ from typing import Any
 from rich.table import Table
 
 from runner.cli.console import err, out
+from runner.tools.report import event_rows
 
 MARKS = {"pass": "[green]pass[/]", "fail": "[bold red]FAIL[/]", "undecided": "[yellow]not decided[/]"}
 
@@ -55,3 +56,20 @@ def print_results(results: list[Any], allow_undecided: bool = False) -> None:
     out.print(summary, style="red" if bad else ("yellow" if undecided else "green"), markup=False)
     for r in undecided:
         out.print(f"  not decided: {r.name}: {r.message}", markup=False)
+    for r in failed:
+        if r.type == "event":  # an `end:` that failed the run: its own message says why
+            out.print(f"  {r.name} failed the run at t={r.t:.3f} s: {r.message}", markup=False)
+
+
+def print_events(events: list[dict[str, Any]]) -> None:
+    """What the run's events did, when and why (`firings`); nothing for a run without events."""
+    if not events:
+        return
+    table = Table("t (sim s)", "event", "why", "what it did", title="Events", title_justify="left")
+    rows, left = event_rows(events)
+    for row in rows:
+        table.add_row(*row)
+    if left:
+        table.caption = f"and {left} more firing(s): every one is on the run's `_events` topic"
+        table.caption_justify = "left"
+    out.print(table)

@@ -1,6 +1,6 @@
 """`scenario run`: validate, compile and run a scenario (each variant of its matrix, or this host's part of
-it), with a progress line on a terminal, the table of what was recorded, the assertions' verdicts, and the
-results as JUnit XML or JSON."""
+it), with a progress line on a terminal, the table of what was recorded, what the events did, the
+assertions' verdicts, and the results as JUnit XML or JSON."""
 
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ from runner import interrupts
 from runner.cli.console import err, fail, out
 from runner.cli.options import AllOpt, AllowUndecided
 from runner.cli.plans import drawn_line, load_variants, print_notices, strict_failure
-from runner.cli.results import plot_failure, print_results
+from runner.cli.results import plot_failure, print_events, print_results
 from runner.errors import RunError, ScenarioError
 
 # A Zenoh endpoint: protocol/address[#config]
@@ -243,7 +243,7 @@ def _run_one(plan: Any, label: str, options: RunOptions) -> tuple[Any, int]:
     """Run one plan (a variant, or this host's part), print and judge it: its suite and exit code."""
     from runner.checks.judge import ended_early
     from runner.launch.run import run_plan
-    from runner.tools.report import Suite, _now, judge_for
+    from runner.tools.report import Suite, _now, firings, judge_for
     from runner.wire.transport import use_run_settings
 
     started = _now()
@@ -277,8 +277,10 @@ def _run_one(plan: Any, label: str, options: RunOptions) -> tuple[Any, int]:
     results = (
         judge.finish(result.sim_ns, complete=ended is None, why=ended or "") if judge is not None else []
     )
+    events = firings(judge.fired) if judge is not None else []
     if not options.quiet:
         _print_summary(result, options.show_all)
+        print_events(events)
     if results:
         print_results(results, options.allow_undecided)
     error = _run_error(result, options.strict)
@@ -295,6 +297,7 @@ def _run_one(plan: Any, label: str, options: RunOptions) -> tuple[Any, int]:
         timestamp=started,
         interrupted=ended,
         label=label,
+        events=events,
     )
     if results and not suite.passed and result.mcap is not None:
         plot_failure(plan, result.mcap, results)

@@ -16,7 +16,7 @@ from rich.table import Table
 from runner.cli.console import err, fail, out
 from runner.cli.options import AllowUndecided, RecordingArg
 from runner.cli.plans import load_variants
-from runner.cli.results import plot_failure, print_results
+from runner.cli.results import plot_failure, print_events, print_results
 from runner.errors import RunError, ScenarioError
 
 
@@ -33,11 +33,12 @@ def check(
     ] = None,
     allow_undecided: AllowUndecided = False,
 ) -> None:
-    """Judge a recording with a scenario's assertions (the same judge as the live run).
+    """Judge a recording with a scenario's assertions (the same judge as the live run), and say what its
+    events did.
 
     Example: scenario check runs/two_robots.mcap --scenario scenarios/two_robots.yaml
     """
-    from runner.tools.report import Suite, judge_recording, write_junit
+    from runner.tools.report import Suite, rejudge, write_junit
 
     try:
         plans = load_variants(scenario, None, variant)
@@ -46,24 +47,28 @@ def check(
     if len(plans) > 1:
         raise fail(RunError(f"{scenario} has {len(plans)} variants: say which one with --variant"))
     plan = plans[0][1]
-    if not any(part.assertions for part in plan.worlds or [plan]):
-        raise fail(RunError(f"{scenario} has no assertions to judge"))
+    if not any(part.assertions or part.events for part in plan.worlds or [plan]):
+        raise fail(RunError(f"{scenario} has no assertions to judge and no events"))
     if not mcap.is_file():
         raise fail(RunError(f"{mcap}: file not found"))
     try:
-        results, end, ended = judge_recording(plan, mcap)
+        judged = rejudge(plan, mcap)
     except Exception as e:
         raise fail(RunError(f"{mcap}: cannot judge it: {type(e).__name__}: {e}")) from None
-    print_results(results, allow_undecided)
+    results = judged.results
+    print_events(judged.events)
+    if results:
+        print_results(results, allow_undecided)
     suite = Suite(
         plan.name,
         results,
         mcap=str(mcap),
-        sim_s=end / 1e9,
+        sim_s=judged.end_ns / 1e9,
         allow_undecided=allow_undecided,
-        interrupted=ended,
+        interrupted=judged.why,
+        events=judged.events,
     )
-    if not suite.passed:
+    if results and not suite.passed:
         plot_failure(plan, mcap, results)
     if junit is not None:
         write_junit(junit, [suite])
@@ -178,14 +183,17 @@ def _write_reports(suites: list[Any]) -> dict[str, str]:
 
 
 def _suites_table(suites: list[Any], reports: dict[str, str]) -> Table:
-    """One row per scenario run: assertions passed, failed (not decided), verdict, time, report link."""
+    """One row per scenario run: assertions passed, failed (not decided), events fired (when some run had
+    events), verdict, time, report link."""
     any_undecided = any(s.undecided for s in suites)
+    any_events = any(s.events for s in suites)
     table = Table(
         "scenario",
         "assertions",
         "passed",
         "failed",
         *(["not decided"] if any_undecided else []),
+        *(["events fired"] if any_events else []),
         "result",
         "time (s)",
         *(["report"] if reports else []),
@@ -206,6 +214,7 @@ def _suites_table(suites: list[Any], reports: dict[str, str]) -> Table:
             str(len(s.results) - failed - s.undecided),
             str(failed),
             *([str(s.undecided)] if any_undecided else []),
+            *([str(len(s.events))] if any_events else []),
             verdict,
             f"{s.time_s:.1f}",
             *(link or ([""] if reports else [])),

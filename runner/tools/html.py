@@ -2,7 +2,8 @@
 
 What it shows: the scenario (name, description, duration), the run's topics with their counts and rates,
 the assertions judged again from the recording (the same judge as the live run) with a plot of each
-robot's speed and each checked topic's rate over sim time, the trajectory plot, and a few camera frames.
+robot's speed and each checked topic's rate over sim time, the trajectory plot, a few camera frames, and a
+timeline of what the run's events did and when its assertions failed (runner.tools.timeline).
 Pictures are inline (PNG as data URIs, plots as SVG), so the file can be mailed or attached to CI as is.
 The scenario comes from the recording itself (`<run>/_plan`, written at the start of every run).
 """
@@ -130,9 +131,16 @@ Line = tuple[str, list[float], list[float], str]  # label, sim times (s), values
 Bound = tuple[float, str]  # a horizontal line: value, label
 
 
-def svg_chart(title: str, unit: str, lines: list[Line], bounds: list[Bound] | None = None) -> str:
+def svg_chart(
+    title: str,
+    unit: str,
+    lines: list[Line],
+    bounds: list[Bound] | None = None,
+    marks: list[tuple[float, str]] | None = None,
+) -> str:
     """A small line chart: (label, sim times s, values, colour) per line; the assertions' bounds as dashed
-    horizontal lines, each labelled."""
+    horizontal lines, each labelled; `marks` (sim time, what: the events' firings) as dotted vertical
+    lines, named in their tooltips."""
     w, h, pad, left = 640, 220, 36, 48
     bounds = [(v, label) for v, label in bounds or [] if v is not None and math.isfinite(v)]
     xs = [x for _l, t, _v, _c in lines for x in t] or [0.0, 1.0]
@@ -158,6 +166,13 @@ def svg_chart(title: str, unit: str, lines: list[Line], bounds: list[Bound] | No
     parts.append(f'<text x="{left}" y="{h - pad + 14}" font-size="10">{x0:.3g} s</text>')
     parts.append(f'<text x="{w - pad}" y="{h - pad + 14}" font-size="10" text-anchor="end">{x1:.3g} s</text>')
     parts.append(f'<text x="{left}" y="{h - 6}" font-size="10">{html.escape(unit)}</text>')
+    for t, what in marks or []:
+        if x0 <= t <= x1:
+            a, b = px(t, y0), px(t, y1)
+            parts.append(
+                f'<polyline class="event-mark" points="{a} {b}" stroke="#2f6fdf" stroke-width="1" '
+                f'stroke-dasharray="2,3" fill="none"><title>{html.escape(what)}</title></polyline>'
+            )
     top = max((v for v, _ in bounds), default=None)
     for value, label in bounds:
         a, b = px(x0, value), px(x1, value)
@@ -208,14 +223,15 @@ def _png_uri(path_or_rgb: Path | np.ndarray) -> str:
 def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
     from runner.record import read_summary
     from runner.tools.plot import trajectory_plot
-    from runner.tools.report import judge_recording
+    from runner.tools.report import firing_line, rejudge
 
     plan = plan or load_plan(mcap)
     summary = read_summary(mcap)
     # (with several worlds, each world's plan holds its own assertions, their topics inside the world)
     keyed = [(a, part.name) for part in plan.parts() for a in part.assertions]
-    results = judge_recording(plan, mcap)[0] if keyed else []
-    charts = _charts(plan, mcap, keyed)
+    judged = rejudge(plan, mcap) if keyed or any(part.events for part in plan.parts()) else None
+    results, events = (judged.results, judged.events) if judged else ([], [])
+    charts = _charts(plan, mcap, keyed, [(f["t"], firing_line(f)) for f in events])
     camera, frames = _camera_frames(mcap, summary)
     with tempfile.TemporaryDirectory() as tmp:
         plot = trajectory_plot(plan, mcap, results, Path(tmp) / "trajectory.png")
@@ -242,6 +258,7 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
             f"<th>at (sim s)</th><th>value</th><th>bound</th></tr>{''.join(_result_row(r) for r in results)}"
             "</table>"
         )
+    page += _timeline(events, results, span)
     if charts:
         page.append("<h2>Signals</h2>" + "".join(f"<figure>{c}</figure>" for c in charts))
     if frames:
@@ -263,7 +280,22 @@ def write_report(mcap: Path, out: Path, plan: Any = None) -> dict[str, Any]:
         "charts": len(charts),
         "frames": len(frames),
         "trajectory": trajectory is not None,
+        "events": len(events),
     }
+
+
+def _timeline(events: list[dict[str, Any]], results: list[Any], span: float) -> list[str]:
+    """What the events did and when the assertions failed, over sim time, then the events' table; nothing
+    for a run without events or failures."""
+    from runner.tools.timeline import events_table, timeline_svg
+
+    if not events and all(r.passed for r in results):
+        return []
+    return [
+        "<h2>Timeline</h2>",
+        f"<figure>{timeline_svg(events, results, span)}</figure>",
+        *(["<h3>Events</h3>", events_table(events)] if events else []),
+    ]
 
 
 def _variant_lines(plan: Any) -> list[str]:
@@ -276,9 +308,12 @@ def _variant_lines(plan: Any) -> list[str]:
     return lines
 
 
-def _charts(plan: Any, mcap: Path, keyed: list[tuple[dict[str, Any], str]]) -> list[str]:
+def _charts(
+    plan: Any, mcap: Path, keyed: list[tuple[dict[str, Any], str]], marks: list[tuple[float, str]]
+) -> list[str]:
     """The signals: each robot's speed (ground truth), its distance travelled and tilt where an assertion
-    bounds them, and each checked topic's rate per sim second; each with the bounds its assertions set."""
+    bounds them, and each checked topic's rate per sim second; each with the bounds its assertions set,
+    and the events' firings marked (`marks`)."""
     from runner.checks.judge import truth_key
     from runner.tools.pictures import run_colours
 
@@ -291,12 +326,14 @@ def _charts(plan: Any, mcap: Path, keyed: list[tuple[dict[str, Any], str]]) -> l
     charts = []
     if speed:
         charts.append(
-            svg_chart("Speed of each robot (ground truth)", "m/s", speed, _bounds(keyed, "max_speed"))
+            svg_chart("Speed of each robot (ground truth)", "m/s", speed, _bounds(keyed, "max_speed"), marks)
         )
     if travelled and "distance_traveled" in kinds:
-        charts.append(svg_chart("Distance travelled", "m", travelled, _bounds(keyed, "distance_traveled")))
+        charts.append(
+            svg_chart("Distance travelled", "m", travelled, _bounds(keyed, "distance_traveled"), marks)
+        )
     if tilt and "max_tilt" in kinds:
-        charts.append(svg_chart("Tilt from upright", "rad", tilt, _bounds(keyed, "max_tilt")))
+        charts.append(svg_chart("Tilt from upright", "rad", tilt, _bounds(keyed, "max_tilt"), marks))
     return charts + _rate_charts(plan, keyed, rate_keys, series, colours)
 
 
@@ -379,7 +416,8 @@ _LABEL = {"pass": "pass", "fail": "FAIL", "undecided": "not decided"}
 
 def _result_row(r: Any) -> str:
     h = html.escape
-    why = f"<br><small>{h(r.message)}</small>" if r.undecided else ""  # (why it was not decided)
+    # why it was not decided, or what failed (when the value does not say it already: a collision's does)
+    why = f"<br><small>{h(r.message)}</small>" if not r.passed and r.message != r.value else ""
     at = "" if r.t is None else f"{r.t:.2f}"
     return (
         f'<tr><td>{h(r.name)}</td><td>{h(r.type)}</td><td class="{r.status}">{_LABEL[r.status]}</td>'

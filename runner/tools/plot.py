@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -37,6 +38,8 @@ SOLID_EDGE = (118, 120, 128)
 LOOSE = (212, 214, 220)  # models that can move, where they start
 REGION = (84, 88, 100)
 FAILED = (207, 34, 46)
+# where a no_collision failure says the bodies touched (runner.checks.judge: "r1 touched walker at (x, y, z)")
+_TOUCHED = re.compile(r" at \((-?[0-9.]+), (-?[0-9.]+), -?[0-9.]+\)$")
 
 
 ACTOR_INK = (150, 150, 150)  # actors' paths: grey, dashed (robots have the colours)
@@ -321,10 +324,15 @@ def _draw_panel(
     _draw_world(draw, p)
     _draw_regions(draw, p, fonts["small"], failed)
     _draw_paths(draw, p, colours)
-    # where pose assertions failed: the robot's place at that time
+    # where pose assertions failed: the robot's place at that time; a collision: where the bodies touched
     for s in p.specs:
         r = by_name.get(s.name)
-        if r is None or r.status != "fail" or r.t_ns is None or s.type not in POSE_KINDS:
+        if r is None or r.status != "fail" or r.t_ns is None:
+            continue
+        touched = _TOUCHED.search(r.value) if s.type == "no_collision" else None
+        if touched is not None:
+            _cross(draw, *p.px(float(touched[1]), float(touched[2])))
+        if s.type not in POSE_KINDS:
             continue
         path = p.paths.get(s.robot)
         if path is not None and len(path):

@@ -21,18 +21,60 @@ def judge_for(plan: Any) -> Judge | None:
     return Judge(specs_from_plan(assertions), [k for part in parts for k in part.assertion_keys], events)
 
 
+def firings(fired: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """What a judge saw the events do (`Judge.fired`), as the reports show and write it: per firing its
+    event, sim time (s), why it fired, what its actions did, its count (`n`) and its `end:` if it had one."""
+    out = []
+    for f in fired:
+        entry = {
+            "event": str(f.get("event", "")),
+            "t": f["t_ns"] / 1e9 if "t_ns" in f else float(f.get("t", 0.0)),
+            "why": str(f.get("why", "")),
+            "did": [str(d) for d in f.get("did") or []],
+            "n": int(f.get("n", 1)),
+        }
+        if isinstance(f.get("end"), dict):
+            entry["end"] = f["end"]
+        out.append(entry)
+    return out
+
+
+def firing_line(f: dict[str, Any]) -> str:
+    """One firing on one line: `t=6.880 s person_crosses: r1 within 3 m of [6.5, 1.5] (3.00 m) -> start
+    walker`."""
+    did = f" -> {'; '.join(f['did'])}" if f.get("did") else ""
+    return f"t={f['t']:.3f} s {f['event']}: {f['why']}{did}"
+
+
+@dataclass
+class Judged:
+    """A recording judged again: the results, its last sim time, why it ended before its planned end
+    (None: it did not), and what its events did (`firings`)."""
+
+    results: list[Result]
+    end_ns: int
+    why: str | None
+    events: list[dict[str, Any]]
+
+
 def judge_recording(plan: Any, mcap: Path) -> tuple[list[Result], int, str | None]:
-    """Re-judge a recording with the scenario's assertions (the same Judge the live run used). Returns the
-    results, the recording's last sim time, and why the run ended before its planned end (None: it did
-    not). How it ended is read from the recording's `scenario` metadata (written by the run); a recording
-    without it (cut, or older) counts as complete only if it reaches the planned duration."""
+    """`rejudge` without the events: the results, the last sim time and why the run ended early."""
+    judged = rejudge(plan, mcap)
+    return judged.results, judged.end_ns, judged.why
+
+
+def rejudge(plan: Any, mcap: Path) -> Judged:
+    """Re-judge a recording with the scenario's assertions (the same Judge the live run used), reading its
+    events' firings too. How it ended is read from the recording's `scenario` metadata (written by the
+    run); a recording without it (cut, or older) counts as complete only if it reaches the planned
+    duration."""
     from mcap.reader import make_reader
 
     from runner.wire import msgs
 
     judge = judge_for(plan)
     if judge is None:
-        return [], 0, None
+        return Judged([], 0, None, [])
     types = judged_types(plan)
     end_ns = 0
     meta: dict[str, str] = {}
@@ -57,7 +99,8 @@ def judge_recording(plan: Any, mcap: Path) -> tuple[list[Result], int, str | Non
         why = None
     else:
         why = f"the recording ends{at}, before the run's planned end ({plan.duration_ns / 1e9:g} s)"
-    return judge.finish(end_ns, complete=why is None, why=why or ""), end_ns, why
+    results = judge.finish(end_ns, complete=why is None, why=why or "")
+    return Judged(results, end_ns, why, firings(judge.fired))
 
 
 def _now() -> str:
@@ -81,6 +124,7 @@ class Suite:
     timestamp: str = field(default_factory=_now)  # when it started
     interrupted: str | None = None  # "interrupted at t=...": why the run ended before its planned end
     label: str = ""  # the matrix variant's label (its values and drawn values), "" without a matrix
+    events: list[dict[str, Any]] = field(default_factory=list)  # the events' firings (`firings`)
 
     @property
     def passed(self) -> bool:
@@ -109,6 +153,7 @@ class Suite:
                 for status in (PASS, FAIL, UNDECIDED)
             },
             "results": [r.to_json() for r in self.results],
+            "events": self.events,
         }
 
     @classmethod
@@ -136,11 +181,14 @@ class Suite:
             timestamp=data.get("timestamp") or _now(),
             interrupted=data.get("interrupted"),
             label=data.get("label", ""),
+            events=list(data.get("events") or []),
         )
 
 
 def failure_text(r: Result) -> str:
     at = f" at t={r.t:.3f} s" if r.t is not None else ""
+    if r.type == "event":  # an `end:` that failed the run: its message, and why the event fired
+        return f"{r.name} failed the run{at}: {r.message} (fired: {r.value})"
     if r.undecided:
         return f"{r.name} ({r.type}) not decided{at}: {r.message}; value {r.value}; bound {r.bound}"
     return f"{r.name} ({r.type}) failed{at}: {r.message}; value {r.value}; bound {r.bound}"
@@ -152,7 +200,9 @@ def write_junit(path: Path, suites: list[Suite]) -> None:
 
     A testcase's `time` is the sim time at which its verdict was reached (the run's end for one held
     to the end). An undecided assertion is a `<failure type="undecided">` whose message says why, or,
-    with --allow-undecided, `<skipped>` with that message."""
+    with --allow-undecided, `<skipped>` with that message. A suite whose events fired has them as
+    `<properties>` (`event.NAME`: the sim time it first fired) and in its `<system-out>`, one line each
+    (`firing_line`); an `end:` event is a testcase of its own (its Result)."""
     import socket
 
     root = ET.Element("testsuites", name="scenario")
@@ -174,6 +224,7 @@ def write_junit(path: Path, suites: list[Suite]) -> None:
             hostname=socket.gethostname() or "localhost",
         )
         wall += s.time_s
+        _event_properties(suite, s.events)  # (first: Ant's schema orders properties, testcases, output)
         if s.error:
             case = ET.SubElement(suite, "testcase", classname=s.name, name="run", time=f"{s.sim_s:.3f}")
             ET.SubElement(
@@ -198,9 +249,62 @@ def write_junit(path: Path, suites: list[Suite]) -> None:
                 ).text = text
             else:
                 ET.SubElement(case, "failure", message=text, type=r.type).text = text
+        if s.events:
+            ET.SubElement(suite, "system-out").text = _event_lines(s.events)
     root.set("tests", str(total))
     root.set("failures", str(failures))
     root.set("errors", str(errors))
     root.set("time", f"{wall:.3f}")
     path.parent.mkdir(parents=True, exist_ok=True)
     ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
+
+
+JUNIT_EVENT_LINES = 1000  # firings written to a suite's <system-out>, at most (a repeating event...)
+
+
+def _event_properties(suite: ET.Element, events: list[dict[str, Any]]) -> None:
+    """`event.NAME` = the sim time it first fired (and `event.NAME.fired` = how often, when more than
+    once), for CI readers that show a suite's properties."""
+    if not events:
+        return
+    props = ET.SubElement(suite, "properties")
+    seen: dict[str, list[float]] = {}
+    for f in events:
+        seen.setdefault(f["event"], []).append(f["t"])
+    for name, times in seen.items():
+        ET.SubElement(props, "property", name=f"event.{name}", value=f"{times[0]:.3f}")
+        if len(times) > 1:
+            ET.SubElement(props, "property", name=f"event.{name}.fired", value=str(len(times)))
+
+
+def _event_lines(events: list[dict[str, Any]]) -> str:
+    lines = [firing_line(f) for f in events[:JUNIT_EVENT_LINES]]
+    if len(events) > JUNIT_EVENT_LINES:
+        lines.append(f"... and {len(events) - JUNIT_EVENT_LINES} more firing(s)")
+    return "\n".join(lines) + "\n"
+
+
+EVENT_ROWS = 20  # rows of the Events table, at most
+EVENT_REPEATS = 3  # firings of one event shown before the rest are folded into one row
+
+
+def event_rows(events: list[dict[str, Any]]) -> tuple[list[tuple[str, str, str, str]], int]:
+    """The Events table's rows (t, event, why, what it did) in firing order, and how many firings they
+    leave out. An event that fires again and again shows its first firings, then one row for the rest
+    (`4.000..9.000`, `and 12 more firings`), so one that repeats cannot crowd out the others."""
+    by_name: dict[str, list[dict[str, Any]]] = {}
+    for f in events:
+        by_name.setdefault(f["event"], []).append(f)
+    rows: list[tuple[tuple[str, str, str, str], int]] = []  # (row, how many firings it stands for)
+    seen: dict[str, int] = {}
+    for f in events:
+        mine = by_name[f["event"]]
+        i = seen[f["event"]] = seen.get(f["event"], -1) + 1
+        if i < EVENT_REPEATS or len(mine) == EVENT_REPEATS + 1:
+            rows.append(((f"{f['t']:.3f}", f["event"], f["why"], "; ".join(f["did"])), 1))
+        elif i == EVENT_REPEATS:
+            rest = mine[EVENT_REPEATS:]
+            span = f"{rest[0]['t']:.3f}..{rest[-1]['t']:.3f}"
+            rows.append(((span, f["event"], f"and {len(rest)} more firings", "; ".join(f["did"])), len(rest)))
+    kept = rows[:EVENT_ROWS]
+    return [r for r, _n in kept], len(events) - sum(n for _r, n in kept)
