@@ -48,8 +48,8 @@ assertions:
   - {{name: no_collision_with_the_walker, type: no_collision, between: [r1, walker]}}
 """
 
-GO = "t=1.000 s go: at t -> published on r1/cmd_vel; start walker"
-GIVE_UP = "t=2.500 s give_up: at t -> end: fail (time is up)"
+GO = "t=1.000 s go: at 1 s -> published on r1/cmd_vel; start walker"
+GIVE_UP = "t=2.500 s give_up: at 2.5 s -> end: fail (time is up)"
 
 
 @pytest.fixture(scope="module")
@@ -77,8 +77,8 @@ def test_the_end_of_run_table_lists_every_firing(ran: dict[str, Any]) -> None:
     out = proc.stdout
     # after the recorded topics, before the assertions
     assert out.index("Recorded") < out.index("Events") < out.index("Assertions")
-    assert _row("1.000", "go", "at t", "published on r1/cmd_vel; start walker").search(out), out
-    assert _row("2.500", "give_up", "at t", "end: fail (time is up)").search(out), out
+    assert _row("1.000", "go", "at 1 s", "published on r1/cmd_vel; start walker").search(out), out
+    assert _row("2.500", "give_up", "at 2.5 s", "end: fail (time is up)").search(out), out
     assert "event give_up failed the run at t=2.500 s: time is up" in out
     data = json.loads(ran["json"].read_text())
     assert [(f["event"], f["t"], f["did"]) for f in data["events"]] == [
@@ -116,7 +116,7 @@ def test_junit_carries_the_firings_and_the_ending_event(ran: dict[str, Any], tmp
     assert ending is not None and ending.get("time") == "2.500"
     failure = ending.find("failure")
     assert failure is not None and failure.get("type") == "event"
-    assert failure.get("message") == "event give_up failed the run at t=2.500 s: time is up (fired: at t)"
+    assert failure.get("message") == "event give_up failed the run at t=2.500 s: time is up (fired: at 2.5 s)"
     # `scenario test` reads a run's suite back from its JSON: the same JUnit comes out of it
     again = tmp_path / "again.xml"
     write_junit(again, [Suite.from_json(json.loads(ran["json"].read_text()))])
@@ -143,7 +143,7 @@ def test_check_on_the_recording_gives_the_same_results_and_firings(
     bare.write_text(SCENARIO.split("assertions:")[0])
     proc = run_cli("check", str(ran["mcap"]), "--scenario", str(bare))
     assert proc.returncode == 1, proc.stdout + proc.stderr
-    assert _row("1.000", "go", "at t").search(proc.stdout) and "event give_up" in proc.stdout
+    assert _row("1.000", "go", "at 1 s").search(proc.stdout) and "event give_up" in proc.stdout
     assert "0 passed, 1 failed" in proc.stdout
 
 
@@ -163,7 +163,7 @@ def test_the_report_draws_the_firings_and_the_failures_on_a_timeline(ran: dict[s
     assert hit is not None and 1.0 < float(hit[1]) < 2.5, timeline
     assert 'class="run-end"' in timeline and "<title>no_collision_with_the_walker</title>" in timeline
     # the events' table, the firings marked on the speed plot, the ending's message in the assertions
-    assert "<td>go</td><td>at t</td><td>published on r1/cmd_vel; start walker</td>" in text
+    assert "<td>go</td><td>at 1 s</td><td>published on r1/cmd_vel; start walker</td>" in text
     speed = next(s for s in re.findall(r"<svg.*?</svg>", text) if "Speed of each robot" in s)
     assert speed.count('class="event-mark"') == 2
     assert "<small>time is up</small>" in text

@@ -153,7 +153,7 @@ class Events:
         if e.due and e.due[0] <= now:
             e.due.pop(0)
             return (
-                "at t"
+                f"at {now / 1e9:g} s"
                 if e.kind == "at"
                 else f"{e.plan.when['delay_ns'] / 1e9:g} s after {e.plan.when['event']}"
             )
