@@ -145,8 +145,8 @@ class Events:
 
         self.world.listen(key, types[key], on_message)
 
-    def _holds(self, e: _Event, now: int) -> str | None:
-        """Why `e` fires now, or None."""
+    def _holds(self, e: _Event, now: int, tick: bool) -> str | None:
+        """Why `e` fires now, or None (`tick`: the first step of a 10 ms tick, where places are looked at)."""
         if e.pending is not None:
             why, e.pending = e.pending, None
             return why
@@ -157,7 +157,7 @@ class Events:
                 if e.kind == "at"
                 else f"{e.plan.when['delay_ns'] / 1e9:g} s after {e.plan.when['event']}"
             )
-        if e.kind not in ("near", "enter", "leave") or now % TICK_NS:
+        if e.kind not in ("near", "enter", "leave") or not tick:
             return None
         return self._spatial(e)
 
@@ -205,7 +205,7 @@ class Events:
         for e in self.events:
             if e.done:
                 continue
-            why = self._holds(e, now)
+            why = self._holds(e, now, tick)
             if why is not None:
                 self._fire(e, now, why)
         if tick:
