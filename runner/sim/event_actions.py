@@ -32,8 +32,9 @@ def act(ev: Any, e: Any, a: dict[str, Any], now: int) -> str:
         return f"teleported {a['target']['name']} to [{', '.join(f'{x:g}' for x in a['pos'])}]"
     if kind == "push":
         body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, a["target"]["body"])
-        d.xfrc_applied[body] = [*a["force"], *a["torque"]]
-        ev.pushes.append((now + a["duration_ns"], body))
+        wrench = np.array([*a["force"], *a["torque"]], dtype=float)
+        d.xfrc_applied[body] += wrench  # on top of any other push on it: each ends on its own
+        ev.pushes.append((now + a["duration_ns"], body, wrench))
         return f"pushed {a['target']['name']} for {a['duration_ns'] / 1e9:g} s"
     if kind == "impulse":
         body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, a["target"]["body"])

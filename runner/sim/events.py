@@ -73,7 +73,7 @@ class Events:
         self.next_tick = 0
         self.next_ns = 0
         self.faults: dict[str, tuple[Fault, Any]] = {}  # key -> (fault, its Outgoing)
-        self.pushes: list[tuple[int, int]] = []  # (until_ns, body)
+        self.pushes: list[tuple[int, int, np.ndarray]] = []  # (until_ns, body, force and torque on it)
         self.spatial = [e for e in self.events if e.kind in ("near", "enter", "leave")]
         self.out = world.make_publisher(events_key(plan.name), "std_msgs/msg/String") if self.events else None
         self.log: list[dict[str, Any]] = []
@@ -198,8 +198,8 @@ class Events:
                 out.fault = None
                 del self.faults[key]
         if self.pushes:
-            for _until, body in [p for p in self.pushes if p[0] <= now]:
-                self.d.xfrc_applied[body] = 0.0
+            for _until, body, wrench in [p for p in self.pushes if p[0] <= now]:
+                self.d.xfrc_applied[body] -= wrench
             self.pushes = [p for p in self.pushes if p[0] > now]
         tick = now >= self.next_tick
         for e in self.events:
@@ -223,7 +223,7 @@ class Events:
             t = fault.next_ns()
             if t is not None:
                 nxt = min(nxt, t)
-        for until, _b in self.pushes:
+        for until, _b, _w in self.pushes:
             nxt = min(nxt, until)
         return max(nxt, now + 1)
 
