@@ -83,7 +83,7 @@ def _fault(ev: Any, e: Any, a: dict[str, Any], now: int) -> str:
     if old is not None:  # a new fault replaces the one on: what it holds goes out now
         for _due, payload, msg in old[0].held:
             out.deliver(payload, msg, now)
-    fault = Fault(a, ev.fault_rng(e, e.fired), out, now)
+    fault = Fault(a, ev.fault_rng(e, e.fired), out, now, ev.wake)
     out.fault = fault
     ev.faults[a["key"]] = (fault, out)
     what = (

@@ -193,9 +193,9 @@ class Events:
         for key, (fault, out) in list(self.faults.items()):
             fault.release(out, now)
             if fault.until_ns is not None and now >= fault.until_ns:
-                for payload_due in list(fault.held):  # what it still holds goes out at its time
-                    out.deliver(payload_due[1], payload_due[2], now)
-                out.fault = None
+                out.fault = None  # over: new messages go straight out...
+                fault.until_ns = None
+            if out.fault is not fault and not fault.held:  # ... and what it holds, each at its time
                 del self.faults[key]
         if self.pushes:
             for _until, body, wrench in [p for p in self.pushes if p[0] <= now]:
@@ -257,6 +257,10 @@ class Events:
         from runner.sim.event_actions import act
 
         return act(self, e, a, now)
+
+    def wake(self, t_ns: int) -> None:
+        """Be looked at again by sim time `t_ns` (a fault holds a message due then)."""
+        self.next_ns = min(self.next_ns, t_ns)
 
     def fault_rng(self, e: _Event, k: int) -> np.random.Generator:
         return np.random.default_rng([self.seed, _EVENTS_STREAM + e.index, k])

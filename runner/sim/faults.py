@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections import deque
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -17,8 +18,17 @@ from runner.wire import msgs
 
 
 class Fault:
-    def __init__(self, spec: dict[str, Any], rng: np.random.Generator, out: Any, now_ns: int):
+    def __init__(
+        self,
+        spec: dict[str, Any],
+        rng: np.random.Generator,
+        out: Any,
+        now_ns: int,
+        wake: Callable[[int], None] = lambda _t: None,
+    ):
+        """`wake(t)`: the world must stop at sim time t (a held message is due then)."""
         self.spec = spec
+        self.wake = wake
         self.rng = rng
         self.drop = spec.get("drop")
         self.delay_ns = int(spec.get("delay_ns") or 0)
@@ -38,6 +48,7 @@ class Fault:
             out.deliver(payload, msg, stamp_ns)
         elif self.delay_ns:
             self.held.append((stamp_ns + self.delay_ns, bytes(payload), msg))
+            self.wake(stamp_ns + self.delay_ns)
         elif self.freeze:
             if self.frozen is not None:  # (nothing sent before it: nothing to repeat)
                 out.deliver(self.frozen, None, stamp_ns)
