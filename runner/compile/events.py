@@ -158,14 +158,30 @@ def compile_events(
             )
         plan: EventPlan | None = None
         with problems.each():
-            plan = EventPlan(
-                name=ev.name, when=_when(w, ev, here, names), do=_actions(w, ev, here), repeat=ev.repeat
-            )
+            plan = _event(w, ev, here, names)
         out.append(plan)
     if problems:
         return []
     ready = [p for p in out if p is not None]
     return _ordered(ready, sc, doc)
+
+
+def _event(w: _World, ev: Event, here: PathKey, names: list[str]) -> EventPlan:
+    """One event resolved; a mistake in its trigger and ones in its actions are reported together."""
+    found: list[Problem] = []
+    when: dict[str, Any] = {}
+    do: list[dict[str, Any]] = []
+    try:
+        when = _when(w, ev, here, names)
+    except ScenarioError as e:
+        found += e.problems
+    try:
+        do = _actions(w, ev, here)
+    except ScenarioError as e:
+        found += e.problems
+    if found:
+        raise ScenarioError(found)
+    return EventPlan(name=ev.name, when=when, do=do, repeat=ev.repeat)
 
 
 def _when(w: _World, ev: Event, here: PathKey, names: list[str]) -> dict[str, Any]:
