@@ -16,6 +16,10 @@ there is no return; `xyz` does by default) or only the returns (`velodyne` does 
 all beams (`range_max` when none), with its own error (`range_offset`, a drifting bias `range_drift`, white
 noise `range_noise_stddev`, see plugins/_drift.py) added to returns short of `range_max`, clamped to
 `[range_min, range_max]`.
+
+`noise_stddev`, `resolution` and `blind_sectors` may change while it runs (an event's `set:`): a sector
+blinded by an event (mud on the window, a failed emitter) returns +inf on every beam whose azimuth lies in
+it, in the scan, the cloud (NaN) and the Range alike.
 """
 
 from __future__ import annotations
@@ -51,6 +55,11 @@ class LidarParams(RatedParams):
     range_max: PositiveFloat = Field(12.0, description="Farthest valid return, metres.")
     resolution: float = Field(0.0, ge=0, description="Range quantization step, metres (0: none).")
     noise_stddev: float = Field(0.0, ge=0, description="Gaussian noise on each range, metres.")
+    blind_sectors: list[tuple[float, float]] = Field(
+        default_factory=list,
+        description="Azimuth sectors [from, to] (radians, the beams' own angles, from <= to) where every "
+        "beam returns nothing (+inf): a blinded part of the scanner.",
+    )
     vertical_samples: PositiveInt = Field(
         1, description="Beams per column; more than 1 makes a 3D lidar that also publishes a PointCloud2."
     )
@@ -91,6 +100,11 @@ class LidarParams(RatedParams):
             raise ValueError(f"max_angle ({self.max_angle}) is below min_angle ({self.min_angle})")
         if self.range_max <= self.range_min:
             raise ValueError(f"range_max ({self.range_max}) must exceed range_min ({self.range_min})")
+        for a, b in self.blind_sectors:
+            if b < a:
+                raise ValueError(
+                    f"a blind sector goes from the smaller angle to the larger, found [{a}, {b}]"
+                )
         if self.vertical_max_angle < self.vertical_min_angle:
             raise ValueError("vertical_max_angle is below vertical_min_angle")
         if not self.publish_scan and not self.points and not self.range_topic:
@@ -113,6 +127,7 @@ class LidarParams(RatedParams):
 class Lidar(Plugin):
     Params = LidarParams
     params: LidarParams
+    live = frozenset({"noise_stddev", "resolution", "blind_sectors"})
 
     @classmethod
     def build(cls, params: LidarParams, ctx: BuildContext, name: str) -> list[Topic]:
@@ -171,6 +186,8 @@ class Lidar(Plugin):
         visible[self.own] = False
         self.may_recast = bool((skip & visible).any())
         self.vec = np.zeros((n * nv, 3))
+        self._blind_of: list[tuple[float, float]] | None = None  # the sectors `self.blind` was made for
+        self.blind = np.zeros(n * nv, dtype=bool)
         if p.publish_scan:
             self._setup_scan()
         if p.range_topic:
@@ -317,6 +334,8 @@ class Lidar(Plugin):
             every /= p.resolution
             np.round(every, out=every)
             every *= p.resolution
+        if p.blind_sectors:
+            every[self._blind_mask(p.blind_sectors)] = np.inf
         n = p.samples
         if p.points:
             self._publish_points(every, now_ns)
@@ -329,6 +348,17 @@ class Lidar(Plugin):
         out[out > p.range_max] = np.inf  # REP 117: beyond range +inf, too close -inf
         out[out < p.range_min] = -np.inf
         self.pub.publish_cdr(self.layout.encode(now_ns), now_ns)
+
+    def _blind_mask(self, sectors: list[tuple[float, float]]) -> np.ndarray:
+        """The beams (every row) whose azimuth lies in a blind sector; made again only when the sectors
+        change (an event swaps in new parameters)."""
+        if sectors is not self._blind_of:
+            az = np.zeros(len(self.angles), dtype=bool)
+            for a, b in sectors:
+                az |= (self.angles >= a) & (self.angles <= b)
+            self.blind = np.tile(az, len(self.elevations))
+            self._blind_of = sectors
+        return self.blind
 
     def _publish_points(self, ranges: np.ndarray, now_ns: int) -> None:
         """The PointCloud2 in the sensor frame (`points_format`, `organize_cloud`: see the module doc)."""

@@ -22,6 +22,7 @@ from runner.plugin.registry import load
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import Action, Event, Scenario
 from runner.wire import msgs
+from runner.wire.transport import topic_key
 
 
 def _choices(names: list[str] | set[str], what: str) -> str:
@@ -40,6 +41,7 @@ class _World:
     actors: list[ActorPlan]
     published: dict[str, str]  # key -> type of what the world publishes (plugins, timeline, events)
     taken: dict[str, str]  # key -> type of what the world's plugins subscribe (from nodes...)
+    heard: dict[str, str]  # key -> type of what nodes say they publish (`publishes:`): message triggers
     assertions: list[str] = field(default_factory=list)
 
     def key(self, topic: str) -> str:
@@ -99,18 +101,24 @@ class _World:
     def topic_type(self, topic: str, where: PathKey, *, published: bool) -> tuple[str, str]:
         """(key, type) of a topic the world publishes (or, unless `published`, also takes in)."""
         key = self.key(topic)
-        known = dict(self.published) if published else {**self.taken, **self.published}
+        known = dict(self.published) if published else {**self.heard, **self.taken, **self.published}
         if key in known:
             return key, known[key]
-        what = "the world publishes" if published else "the world publishes or takes in"
+        what = "the world publishes" if published else "the world or a node publishes, or the world takes in"
         names = sorted(k.split("/", 1)[1] for k in known)
+        hint = (
+            "faults and message triggers work on the topics of the world's plugins (sensors, odometry), "
+            "its timeline and events, and those its plugins take in (cmd_vel); message triggers also on "
+            "those a node declares (`publishes:`)"
+        )
+        if published and key in self.heard:
+            hint = "a node publishes it: the world can put a fault only on what it publishes itself"
         raise self.problem(
             f"no topic {topic!r} that {what}",
             where,
             expected=", ".join(names[:12]) + (" ..." if len(names) > 12 else ""),
             found=topic,
-            hint="faults and message triggers work on the topics of the world's plugins (sensors, "
-            "odometry), its timeline and events, and those its plugins take in (cmd_vel)",
+            hint=hint,
         )
 
 
@@ -133,7 +141,13 @@ def compile_events(
             if act.publish is not None:
                 published[f"{sc.name}/{act.publish.topic.strip('/')}"] = msgs.normalize_type(act.publish.type)
     taken = {t.key: t.type for r in robots for p in r.plugins for t in p.topics if t.direction == "sub"}
-    w = _World(sc, doc, model, robots, actors, published, taken, [a.name for a in sc.assertions])
+    heard = {
+        topic_key(sc.name, n.namespace or "", topic): msgs.normalize_type(type_name)
+        for n in sc.nodes
+        for topic, type_name in n.publishes.items()
+        if msgs.is_known(msgs.normalize_type(type_name))
+    }
+    w = _World(sc, doc, model, robots, actors, published, taken, heard, [a.name for a in sc.assertions])
     names = [e.name for e in sc.events]
     out: list[EventPlan | None] = []
     for i, ev in enumerate(sc.events):
@@ -144,14 +158,30 @@ def compile_events(
             )
         plan: EventPlan | None = None
         with problems.each():
-            plan = EventPlan(
-                name=ev.name, when=_when(w, ev, here, names), do=_actions(w, ev, here), repeat=ev.repeat
-            )
+            plan = _event(w, ev, here, names)
         out.append(plan)
     if problems:
         return []
     ready = [p for p in out if p is not None]
     return _ordered(ready, sc, doc)
+
+
+def _event(w: _World, ev: Event, here: PathKey, names: list[str]) -> EventPlan:
+    """One event resolved; a mistake in its trigger and ones in its actions are reported together."""
+    found: list[Problem] = []
+    when: dict[str, Any] = {}
+    do: list[dict[str, Any]] = []
+    try:
+        when = _when(w, ev, here, names)
+    except ScenarioError as e:
+        found += e.problems
+    try:
+        do = _actions(w, ev, here)
+    except ScenarioError as e:
+        found += e.problems
+    if found:
+        raise ScenarioError(found)
+    return EventPlan(name=ev.name, when=when, do=do, repeat=ev.repeat)
 
 
 def _when(w: _World, ev: Event, here: PathKey, names: list[str]) -> dict[str, Any]:

@@ -154,6 +154,11 @@ def consistency_problems(sc: Scenario, doc: Document) -> list[Problem]:
                     )
                 )
             model_names.setdefault(m.name, i)
+    return problems + _timeline_problems(sc, doc) + _event_problems(sc, doc)
+
+
+def _timeline_problems(sc: Scenario, doc: Document) -> list[Problem]:
+    problems = []
     for i, ev in enumerate(sc.timeline):
         if ev.t > sc.duration:
             problems.append(
@@ -167,6 +172,23 @@ def consistency_problems(sc: Scenario, doc: Document) -> list[Problem]:
                 )
             )
     return problems
+
+
+def _event_problems(sc: Scenario, doc: Document) -> list[Problem]:
+    """Events act in one world (its bodies, its topics, its step): with several worlds, none."""
+    if not (sc.worlds and sc.events):
+        return []
+    where: PathKey = ("events",)
+    return [
+        Problem(
+            f"events run in a single world: with `worlds:` ({len(sc.worlds)} of them) there is no one "
+            "world for them to act in",
+            doc.locate(where),
+            where,
+            hint="drop `worlds:` (one `world:`), or leave the events out: each world runs on its own "
+            "process and step, and an event cannot yet say which world it belongs to",
+        )
+    ]
 
 
 @dataclasses.dataclass

@@ -32,8 +32,9 @@ def act(ev: Any, e: Any, a: dict[str, Any], now: int) -> str:
         return f"teleported {a['target']['name']} to [{', '.join(f'{x:g}' for x in a['pos'])}]"
     if kind == "push":
         body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, a["target"]["body"])
-        d.xfrc_applied[body] = [*a["force"], *a["torque"]]
-        ev.pushes.append((now + a["duration_ns"], body))
+        wrench = np.array([*a["force"], *a["torque"]], dtype=float)
+        d.xfrc_applied[body] += wrench  # on top of any other push on it: each ends on its own
+        ev.pushes.append((now + a["duration_ns"], body, wrench))
         return f"pushed {a['target']['name']} for {a['duration_ns'] / 1e9:g} s"
     if kind == "impulse":
         body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, a["target"]["body"])
@@ -99,12 +100,16 @@ def _fault(ev: Any, e: Any, a: dict[str, Any], now: int) -> str:
 
 
 def _joint(m: mujoco.MjModel, a: dict[str, Any]) -> str:
+    """`cut`: the joint's motors give no torque (it turns freely). `block`: it is jammed: its motors are cut
+    too (a wheel's velocity servo, torque-limited though it is, turns a joint through any friction that
+    MuJoCo's soft friction constraint gives), and a dry friction no motor of a mobile robot overcomes
+    holds it."""
     jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, a["joint"])
-    if a["kind"] == "block":
-        m.dof_frictionloss[int(m.jnt_dofadr[jid])] = BLOCK_FRICTION
-        return f"blocked {a['label']}"
     for u in range(m.nu):
         if int(m.actuator_trntype[u]) == 0 and int(m.actuator_trnid[u, 0]) == jid:
             m.actuator_forcelimited[u] = 1
             m.actuator_forcerange[u] = [0.0, 0.0]
+    if a["kind"] == "block":
+        m.dof_frictionloss[int(m.jnt_dofadr[jid])] = BLOCK_FRICTION
+        return f"blocked {a['label']}"
     return f"cut the motor of {a['label']}"

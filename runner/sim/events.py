@@ -73,7 +73,7 @@ class Events:
         self.next_tick = 0
         self.next_ns = 0
         self.faults: dict[str, tuple[Fault, Any]] = {}  # key -> (fault, its Outgoing)
-        self.pushes: list[tuple[int, int]] = []  # (until_ns, body)
+        self.pushes: list[tuple[int, int, np.ndarray]] = []  # (until_ns, body, force and torque on it)
         self.spatial = [e for e in self.events if e.kind in ("near", "enter", "leave")]
         self.out = world.make_publisher(events_key(plan.name), "std_msgs/msg/String") if self.events else None
         self.log: list[dict[str, Any]] = []
@@ -145,8 +145,8 @@ class Events:
 
         self.world.listen(key, types[key], on_message)
 
-    def _holds(self, e: _Event, now: int) -> str | None:
-        """Why `e` fires now, or None."""
+    def _holds(self, e: _Event, now: int, tick: bool) -> str | None:
+        """Why `e` fires now, or None (`tick`: the first step of a 10 ms tick, where places are looked at)."""
         if e.pending is not None:
             why, e.pending = e.pending, None
             return why
@@ -157,7 +157,7 @@ class Events:
                 if e.kind == "at"
                 else f"{e.plan.when['delay_ns'] / 1e9:g} s after {e.plan.when['event']}"
             )
-        if e.kind not in ("near", "enter", "leave") or now % TICK_NS:
+        if e.kind not in ("near", "enter", "leave") or not tick:
             return None
         return self._spatial(e)
 
@@ -193,19 +193,19 @@ class Events:
         for key, (fault, out) in list(self.faults.items()):
             fault.release(out, now)
             if fault.until_ns is not None and now >= fault.until_ns:
-                for payload_due in list(fault.held):  # what it still holds goes out at its time
-                    out.deliver(payload_due[1], payload_due[2], now)
-                out.fault = None
+                out.fault = None  # over: new messages go straight out...
+                fault.until_ns = None
+            if out.fault is not fault and not fault.held:  # ... and what it holds, each at its time
                 del self.faults[key]
         if self.pushes:
-            for _until, body in [p for p in self.pushes if p[0] <= now]:
-                self.d.xfrc_applied[body] = 0.0
+            for _until, body, wrench in [p for p in self.pushes if p[0] <= now]:
+                self.d.xfrc_applied[body] -= wrench
             self.pushes = [p for p in self.pushes if p[0] > now]
         tick = now >= self.next_tick
         for e in self.events:
             if e.done:
                 continue
-            why = self._holds(e, now)
+            why = self._holds(e, now, tick)
             if why is not None:
                 self._fire(e, now, why)
         if tick:
@@ -223,7 +223,7 @@ class Events:
             t = fault.next_ns()
             if t is not None:
                 nxt = min(nxt, t)
-        for until, _b in self.pushes:
+        for until, _b, _w in self.pushes:
             nxt = min(nxt, until)
         return max(nxt, now + 1)
 

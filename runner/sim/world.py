@@ -250,10 +250,12 @@ class World(PubSub):
     # ----------------------------------------------------------------------- what events act on
     def listen(self, key: str, type_name: str, callback: Callable[[Any, int], None]) -> None:
         """`callback(msg, stamp_ns)` for each message on a full key: handed over at once when this world
-        publishes it, else at the next boundary from other processes."""
-        own = {t.key for t in self.plan.topics() if t.direction == "pub"} | set(self._out)
-        own |= {a["key"] for e in self.plan.events for a in e.do if a["kind"] == "publish"}
-        own.add(f"{self.plan.name}/_contacts")
+        publishes it, else at the next boundary from other processes (a node's topic, `publishes:`)."""
+        plan = self.plan
+        own = {t.key for r in plan.robots for p in r.plugins for t in p.topics if t.direction == "pub"}
+        own |= set(self._out) | {ev.key for ev in plan.timeline}
+        own |= {a["key"] for e in plan.events for a in e.do if a["kind"] == "publish"}
+        own.add(f"{plan.name}/_contacts")  # (not a node's topic, though a node declares it: `publishes:`)
         if key in own:
             self._local.setdefault(key, []).append((type_name, callback))
         else:
