@@ -19,6 +19,9 @@ Sections (in order):
 - soak: the demo for 10 sim minutes at `rate: max`, recorded with --strict: resident memory of the runner
   and of the world from warm-up to the end (bench/soak.py), messages lost.
 - plugins: per-plugin cost per call, camera frames/s, lidar rays/s (bench/plugins.py).
+- actors: the demo world with 20 actors walking looping paths and 10 events (every trigger kind that keeps
+  being looked at, actions that keep firing), against the same world without them, alternating, best of
+  N (bench/actors.py). Target: at most 15 % more wall time per sim second.
 - meshes: static non-convex collision meshes split into convex pieces (bench/meshes.py): a 50k-triangle
   one-mesh building the first time and from the cache (targets: < 10 s, < 0.2 s), and the worst case.
 
@@ -74,6 +77,7 @@ SECTIONS = (
     "soak",
     "plugins",
     "meshes",
+    "actors",
 )
 
 
@@ -593,6 +597,12 @@ def meshes(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     return doc, text
 
 
+def actors(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
+    from bench import actors as ba
+
+    return ba.run(args.quick, args.repeat)
+
+
 RUNNERS = {
     "two_robots": two_robots,
     "scaling": scaling,
@@ -604,6 +614,7 @@ RUNNERS = {
     "soak": soak,
     "plugins": plugins,
     "meshes": meshes,
+    "actors": actors,
 }
 
 

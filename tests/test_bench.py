@@ -22,7 +22,7 @@ def test_bench_suite_runs_and_writes_results(tmp_path: Path) -> None:
             "bench",
             "--quick",
             "--only",
-            "messages,two_robots",
+            "messages,two_robots,actors",
             "--results",
             str(tmp_path),
         ],
@@ -45,6 +45,13 @@ def test_bench_suite_runs_and_writes_results(tmp_path: Path) -> None:
     assert {"sensor_msgs/msg/Imu", "sensor_msgs/msg/LaserScan", "nav_msgs/msg/Odometry"} <= types
     # a fixed layout is cheaper than building the bytes with rosbags
     assert all(row["fixed_layout_us"] < row["rosbags_encode_us"] for row in messages["rows"])
+    # the actors row ran the three worlds, and the events in it fired (the scan trigger, 10 a second)
+    actors = json.loads((tmp_path / "actors.json").read_text())
+    assert (actors["actors"], actors["events"]) == (20, 10)
+    assert set(actors["steps_per_s"]) == {"without", "standing", "with"}
+    assert all(v > 0 for v in actors["steps_per_s"].values())
+    assert actors["firings"] >= 10 * actors["sim_seconds"]
+    assert "+ them walking and 10 events" in proc.stdout
 
 
 @pytest.mark.timeout(60)

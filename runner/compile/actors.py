@@ -62,12 +62,12 @@ def _add(spec: mujoco.MjSpec, a: Actor, doc: Document, here: PathKey) -> ActorPl
     else:
         assert a.size is not None
         size = list(a.size)
-        kw["size"] = {
-            "box": [s / 2 for s in size],
-            "cylinder": [size[0], size[1] / 2, 0],
-            "capsule": [size[0], size[1] / 2, 0],
-            "sphere": [size[0], 0, 0],
-        }[a.shape]
+        if a.shape == "box":
+            kw["size"] = [s / 2 for s in size]
+        elif a.shape == "sphere":  # (one number: the others' sizes cannot be worked out from it)
+            kw["size"] = [size[0], 0, 0]
+        else:  # cylinder, capsule
+            kw["size"] = [size[0], size[1] / 2, 0]
     body.add_geom(**kw)
     return plan
 

@@ -9,6 +9,7 @@ sees it there (the contacts push robots out of its way)."""
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -109,33 +110,56 @@ class Actors:
             self.last[i] = len(p) - 1
             if plans[i].loop and len(p) > 1:
                 self.lap[i] = len(p) - 1  # sample `lap` is sample 0 again
-        self.rows = np.arange(n)
+        # one table of poses (position, orientation) for all: row i * k + sample of actor i
+        self.pose = np.concatenate([self.pos, self.quat], axis=2).reshape(n * k, 7)
+        self.base = np.arange(n, dtype=np.int64) * k
         self.ticks = np.zeros(n, dtype=np.int64)  # ticks each actor has moved
         self.moving = np.zeros(n, dtype=bool)
         self.pending = sorted(
             ((a.start_ns, i) for i, a in enumerate(plans) if a.start_ns is not None), reverse=True
         )
+        self._moved: tuple[np.ndarray | None, Any, Any] | None = None  # what `tick` writes (see _which)
 
     def start(self, i: int) -> None:
         self.moving[i] = True
+        self._moved = None
 
     def stop(self, i: int) -> None:
         self.moving[i] = False
+        self._moved = None
 
     def place(self, i: int, pos: list[float], quat: list[float]) -> None:
         """Teleported: it stops, and stands there until started again (then it goes on along its path)."""
-        self.moving[i] = False
+        self.stop(i)
         self.data.mocap_pos[self.mocap[i]] = pos
         self.data.mocap_quat[self.mocap[i]] = quat
+
+    def _which(self) -> tuple[np.ndarray | None, Any, Any]:
+        """The actors that move (None: all of them) and where their poses go in the mocap arrays: a slice
+        when their mocap bodies are consecutive (every actor of the world, usually), else their indices.
+        Worked out again only when an actor starts or stops, not every tick."""
+        rows = np.flatnonzero(self.moving)
+        ids = self.mocap[rows]
+        where: Any = ids
+        if len(ids) and np.array_equal(ids, np.arange(ids[0], ids[0] + len(ids))):
+            where = slice(int(ids[0]), int(ids[0]) + len(ids))
+        self._moved = (None if len(rows) == len(self.moving) else rows, where, rows)
+        return self._moved
 
     def tick(self, now_ns: int) -> None:
         while self.pending and self.pending[-1][0] <= now_ns:
             self.moving[self.pending.pop()[1]] = True
-        moving = self.moving
-        if not moving.any():
+            self._moved = None
+        select, where, rows = self._moved or self._which()
+        if not len(rows):
             return
-        idx = np.minimum(self.ticks % self.lap, self.last)
-        rows = self.rows[moving]
-        self.data.mocap_pos[self.mocap[rows]] = self.pos[rows, idx[rows]]
-        self.data.mocap_quat[self.mocap[rows]] = self.quat[rows, idx[rows]]
-        self.ticks += moving
+        idx = self.ticks % self.lap
+        np.minimum(idx, self.last, out=idx)
+        idx += self.base
+        pose = self.pose[idx if select is None else idx[select]]
+        self.data.mocap_pos[where] = pose[:, :3]
+        self.data.mocap_quat[where] = pose[:, 3:]
+        if select is None:
+            self.ticks += 1
+        else:
+            self.ticks[select] += 1

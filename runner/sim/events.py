@@ -55,6 +55,9 @@ class _Event:
         self.pending: str | None = None  # fire at the next look, saying why
         self.due: list[int] = []  # times to fire (`at`, delayed `after`)
         self.inside: bool | None = None  # the last look's answer (near, enter, leave)
+        self.spatial = self.kind in ("near", "enter", "leave")
+        self.at = 0  # (spatial) where its body's (x, y) is in what `Events._where` gathers
+        self.to_at = 0  # (near another body) where that body's is
         self.fired = 0
 
 
@@ -77,6 +80,8 @@ class Events:
         self.spatial = [e for e in self.events if e.kind in ("near", "enter", "leave")]
         self.out = world.make_publisher(events_key(plan.name), "std_msgs/msg/String") if self.events else None
         self.log: list[dict[str, Any]] = []
+        self._bodies_at: list[int] = []  # what spatial triggers look at (see `_locator`)
+        self._geoms_at: list[int] = []
         for e in self.events:
             when = e.plan.when
             if e.kind == "at":
@@ -88,18 +93,29 @@ class Events:
             elif e.kind == "assertion":
                 self._listen_assertion(e, plan)
             elif e.kind in ("near", "enter", "leave"):
-                e.body_at = self._locator(when["body"])  # type: ignore[attr-defined]
+                e.at = self._locator(when["body"])
                 if e.kind == "near" and isinstance(when["to"], dict):
-                    e.to_at = self._locator(when["to"])  # type: ignore[attr-defined]
+                    e.to_at = self._locator(when["to"])
+        self._bodies = np.asarray(self._bodies_at, dtype=np.int64)
+        self._geoms = np.asarray(self._geoms_at, dtype=np.int64)
 
     # -------------------------------------------------------------------------------- triggers
-    def _locator(self, ref: dict[str, Any]) -> Callable[[], tuple[float, float]]:
-        d = self.d
+    def _locator(self, ref: dict[str, Any]) -> int:
+        """Where the body's (or geom's) ground position will be in what `_where` gathers."""
         if "geom" in ref:
-            gid = mujoco.mj_name2id(self.m, mujoco.mjtObj.mjOBJ_GEOM, ref["geom"])
-            return lambda: (float(d.geom_xpos[gid, 0]), float(d.geom_xpos[gid, 1]))
-        bid = mujoco.mj_name2id(self.m, mujoco.mjtObj.mjOBJ_BODY, ref["body"])
-        return lambda: (float(d.xpos[bid, 0]), float(d.xpos[bid, 1]))
+            self._geoms_at.append(mujoco.mj_name2id(self.m, mujoco.mjtObj.mjOBJ_GEOM, ref["geom"]))
+            return -len(self._geoms_at)  # geoms from the end, bodies from the start
+        self._bodies_at.append(mujoco.mj_name2id(self.m, mujoco.mjtObj.mjOBJ_BODY, ref["body"]))
+        return len(self._bodies_at) - 1
+
+    def _where(self) -> list[list[float]]:
+        """The (x, y) of every body the spatial triggers look at, where the physics has them now: one
+        array gather for all, then plain floats."""
+        d = self.d
+        xy: list[list[float]] = d.xpos[self._bodies, :2].tolist() if len(self._bodies) else []
+        if len(self._geoms):
+            xy += d.geom_xpos[self._geoms[::-1], :2].tolist()
+        return xy
 
     def _listen_message(self, e: _Event) -> None:
         from runner.checks.expr import compile_expr
@@ -145,8 +161,9 @@ class Events:
 
         self.world.listen(key, types[key], on_message)
 
-    def _holds(self, e: _Event, now: int, tick: bool) -> str | None:
-        """Why `e` fires now, or None (`tick`: the first step of a 10 ms tick, where places are looked at)."""
+    def _holds(self, e: _Event, now: int, tick: bool, where: list[list[float]] | None = None) -> str | None:
+        """Why `e` fires now, or None (`tick`: the first step of a 10 ms tick, where places are looked at;
+        `where`: what `_where` gave, at this step, since the last firing)."""
         if e.pending is not None:
             why, e.pending = e.pending, None
             return why
@@ -157,16 +174,16 @@ class Events:
                 if e.kind == "at"
                 else f"{e.plan.when['delay_ns'] / 1e9:g} s after {e.plan.when['event']}"
             )
-        if e.kind not in ("near", "enter", "leave") or not tick:
+        if not e.spatial or not tick:
             return None
-        return self._spatial(e)
+        return self._spatial(e, where if where is not None else self._where())
 
-    def _spatial(self, e: _Event) -> str | None:
+    def _spatial(self, e: _Event, where: list[list[float]]) -> str | None:
         when = e.plan.when
-        x, y = e.body_at()  # type: ignore[attr-defined]
+        x, y = where[e.at]
         who = when["body"]["name"]
         if e.kind == "near":
-            tx, ty = e.to_at() if hasattr(e, "to_at") else when["to"]  # type: ignore[attr-defined]
+            tx, ty = where[e.to_at] if isinstance(when["to"], dict) else when["to"]
             dist = math.hypot(x - tx, y - ty)
             now_in = dist <= when["within"]
             was, e.inside = e.inside, now_in
@@ -202,12 +219,18 @@ class Events:
                 self.d.xfrc_applied[body] -= wrench
             self.pushes = [p for p in self.pushes if p[0] > now]
         tick = now >= self.next_tick
+        look = bool(self.spatial) and tick
+        where = None  # where the bodies are: gathered once, again after a firing (a teleport moves one)
         for e in self.events:
-            if e.done:
+            # (the cheap part of `_holds` first: most events, most of the time, have nothing to look at)
+            if e.done or (e.pending is None and not (e.due and e.due[0] <= now) and not (look and e.spatial)):
                 continue
-            why = self._holds(e, now, tick)
+            if look and e.spatial and where is None:
+                where = self._where()
+            why = self._holds(e, now, tick, where)
             if why is not None:
                 self._fire(e, now, why)
+                where = None
         if tick:
             if self.actors is not None:
                 self.actors.tick(now)

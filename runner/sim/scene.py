@@ -31,6 +31,7 @@ from plugins._common import tf_transforms
 from runner.frames import prefixed_urdf
 from runner.plugin.registry import drive_frames
 from runner.wire import msgs
+from runner.wire.cdr import Layout
 
 if TYPE_CHECKING:
     from runner.plan import RunPlan
@@ -228,6 +229,10 @@ class SceneFeed:
             ],
             data_offset=0,
         )
+        # both written in place every 1/tf_rate (twenty actors are twenty more transforms and poses)
+        self._state = _FixedState(T[STATE](layout=self._layout, data=np.zeros(m.nq + 7 * m.nmocap)))
+        self._tf = _FixedTf(self._frames) if self.moving else None
+        self._bodies = np.asarray(self.moving, dtype=np.int64)
 
     def hooks(self) -> list[tuple[Any, int]]:
         return [(self.slow, self.period_ns), (self.fast, self.tf_period_ns)]
@@ -243,9 +248,58 @@ class SceneFeed:
 
     def fast(self, now_ns: int) -> None:
         d = self.world.data
-        state = np.concatenate((d.qpos, d.mocap_pos.reshape(-1), d.mocap_quat.reshape(-1)))
-        self.state_out.publish(msgs.T[STATE](layout=self._layout, data=state), now_ns)
-        if self.tf_out is None:
+        self.state_out.publish_cdr(self._state.encode(d), now_ns)
+        if self.tf_out is None or self._tf is None:
             return
-        entries = [(WORLD, f, d.xpos[b], d.xquat[b]) for f, b in zip(self._frames, self.moving, strict=True)]
-        self.tf_out.publish(tf_transforms(now_ns, entries), now_ns)  # type: ignore[arg-type]
+        self.tf_out.publish_cdr(self._tf.encode(now_ns, d, self._bodies), now_ns)
+
+
+class _FixedState:
+    """`<run>/_state` written in place: qpos, then the mocap positions and orientations (the bytes rosbags
+    would write for the message)."""
+
+    def __init__(self, template: Any):
+        self.layout = Layout(STATE, template, [])
+        self.data = self.layout.view("data")
+
+    def encode(self, d: mujoco.MjData) -> bytes:
+        nq, nm = d.qpos.shape[0], d.mocap_pos.shape[0]
+        out = self.data
+        out[:nq] = d.qpos
+        out[nq : nq + 3 * nm] = d.mocap_pos.reshape(-1)
+        out[nq + 3 * nm :] = d.mocap_quat.reshape(-1)
+        return bytes(self.layout.buf)
+
+
+class _FixedTf:
+    """`world` -> each moving world body (a free model, an actor), one TFMessage of fixed shape written in
+    place with a few array operations, however many bodies: every transform's stamp and its seven numbers
+    (translation, rotation xyzw) are put at their byte offsets at once."""
+
+    def __init__(self, frames: list[str]):
+        n = len(frames)
+        zero = (np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
+        self.layout = Layout(TF, tf_transforms(0, [(WORLD, f, *zero) for f in frames]), [])
+        buf = self.layout.buf
+        spans = self.layout.spans
+        at = np.array([spans[f"transforms[{i}].transform"].offset for i in range(n)], dtype=np.int64)
+        stamp = np.array([spans[f"transforms[{i}].header.stamp"].offset for i in range(n)], dtype=np.int64)
+        # CDR aligns doubles to 8 and integers to 4 bytes after the 4-byte encapsulation header
+        assert not ((at - 4) % 8).any() and not ((stamp - 4) % 4).any()
+        self.f64 = np.frombuffer(buf, dtype="<f8", offset=4, count=(len(buf) - 4) // 8)
+        self.u32 = np.frombuffer(buf, dtype="<u4", offset=4, count=(len(buf) - 4) // 4)
+        self.at = ((at - 4) // 8)[:, None] + np.arange(7)
+        self.sec = (stamp - 4) // 4
+        self.nsec = self.sec + 1
+        self.values = np.zeros((n, 7))
+
+    def encode(self, now_ns: int, d: mujoco.MjData, bodies: np.ndarray) -> bytes:
+        v = self.values
+        v[:, :3] = d.xpos[bodies]
+        q = d.xquat[bodies]
+        v[:, 3:6] = q[:, 1:]
+        v[:, 6] = q[:, 0]
+        self.f64[self.at] = v
+        self.u32[self.sec] = now_ns // 1_000_000_000
+        self.u32[self.nsec] = now_ns % 1_000_000_000
+        return bytes(self.layout.buf)
