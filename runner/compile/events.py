@@ -15,6 +15,7 @@ from typing import Any
 
 import mujoco
 
+from runner.compile.timeline import message_of
 from runner.errors import Problem, Problems, ScenarioError
 from runner.geometry import rpy_to_quat
 from runner.plan import ActorPlan, EventPlan, RobotPlan
@@ -325,19 +326,7 @@ def _action(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
 def _publish(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
     p = act.publish
     assert p is not None
-    type_name = msgs.normalize_type(p.type)
-    if not msgs.is_known(type_name):
-        close = msgs.similar_types(p.type)
-        raise w.problem(
-            f"unknown message type {p.type!r}",
-            (*at, "type"),
-            expected="a ROS 2 message type such as geometry_msgs/msg/Twist",
-            hint=f"did you mean {close[0]!r}?" if close else None,
-        )
-    try:
-        msgs.from_data(type_name, p.data)
-    except msgs.MessageDataError as e:
-        raise w.problem(str(e), (*at, "data", *e.path), hint=e.hint) from None
+    type_name = message_of(p.type, p.data, w.doc, at)
     key = w.key(p.topic)
     wanted = w.taken.get(key)
     if wanted is not None and msgs.normalize_type(wanted) != type_name:

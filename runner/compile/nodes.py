@@ -5,11 +5,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from runner.compile.timeline import message_type
 from runner.errors import Problem, ScenarioError
 from runner.plan import NodePlan, TopicPlan
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import Scenario
-from runner.wire import msgs
 from runner.wire.transport import topic_key
 
 
@@ -102,22 +102,14 @@ def _node_topics(sc: Scenario, doc: Document, i: int, problems: list[Problem]) -
     """What node `i` says it publishes (`publishes:`), each type checked."""
     node = sc.nodes[i]
     out = []
-    for topic, type_name in node.publishes.items():
-        if not msgs.is_known(msgs.normalize_type(type_name)):
-            where: PathKey = ("nodes", i, "publishes", topic)
-            close = msgs.similar_types(type_name)
-            problems.append(
-                Problem(
-                    f"unknown message type {type_name!r}",
-                    doc.locate(where),
-                    where,
-                    expected="a ROS 2 message type such as std_msgs/msg/String",
-                    hint=f"did you mean {close[0]!r}?" if close else None,
-                )
-            )
+    for topic, type_text in node.publishes.items():
+        try:
+            type_name = message_type(type_text, doc, ("nodes", i, "publishes", topic))
+        except ScenarioError as e:
+            problems += e.problems
             continue
         key = topic_key(sc.name, node.namespace or "", topic)
-        out.append(TopicPlan(key=key, type=msgs.normalize_type(type_name), owner=node.name))
+        out.append(TopicPlan(key=key, type=type_name, owner=node.name))
     return out
 
 

@@ -3,6 +3,8 @@ type against the one its topic's subscriber takes."""
 
 from __future__ import annotations
 
+from typing import Any
+
 from runner.errors import Problem, Problems, ScenarioError
 from runner.plan import RobotPlan, TimelinePlan
 from runner.scenario.loader import Document, PathKey
@@ -23,26 +25,38 @@ def compile_timeline(
     return sorted((ev for _, ev in ordered), key=lambda ev: ev.t_ns)
 
 
-def timeline_entry(sc: Scenario, i: int, doc: Document) -> TimelinePlan:
-    ev = sc.timeline[i]
-    here: PathKey = ("timeline", i)
-    type_name = msgs.normalize_type(ev.type)
+def message_type(type_text: str, doc: Document, where: PathKey) -> str:
+    """A ROS 2 message type as written (`geometry_msgs/Twist`), normalized; unknown: a located error."""
+    type_name = msgs.normalize_type(type_text)
     if not msgs.is_known(type_name):
-        close = msgs.similar_types(ev.type)
+        close = msgs.similar_types(type_text)
         raise ScenarioError(
             Problem(
-                f"unknown message type {ev.type!r}",
-                doc.locate((*here, "type")),
-                (*here, "type"),
+                f"unknown message type {type_text!r}",
+                doc.locate(where),
+                where,
                 expected="a ROS 2 message type such as geometry_msgs/msg/Twist",
                 hint=f"did you mean {close[0]!r}?" if close else None,
             )
         )
+    return type_name
+
+
+def message_of(type_text: str, data: dict[str, Any], doc: Document, here: PathKey) -> str:
+    """The type of a message given as `type` and `data` under `here` (a timeline entry, an event's
+    `publish`), its data checked against the type's fields: each mistake located."""
+    type_name = message_type(type_text, doc, (*here, "type"))
     try:
-        msgs.from_data(type_name, ev.data)
+        msgs.from_data(type_name, data)
     except msgs.MessageDataError as e:
         where: PathKey = (*here, "data", *e.path)
         raise ScenarioError(Problem(str(e), doc.locate(where), where, hint=e.hint)) from None
+    return type_name
+
+
+def timeline_entry(sc: Scenario, i: int, doc: Document) -> TimelinePlan:
+    ev = sc.timeline[i]
+    type_name = message_of(ev.type, ev.data, doc, ("timeline", i))
     topic = ev.topic
     key = f"{sc.name}/{topic.lstrip('/')}"
     return TimelinePlan(t_ns=round(ev.t * 1e9), key=key, type=type_name, data=ev.data)

@@ -144,7 +144,11 @@ def _assertion_keys(
     published.update({f"{sc.name}/{ev.topic.strip('/')}": msgs.normalize_type(ev.type) for ev in sc.timeline})
     for node in sc.nodes:
         for topic, type_name in node.publishes.items():
-            published[topic_key(sc.name, node.namespace or "", topic)] = msgs.normalize_type(type_name)
+            key = topic_key(sc.name, node.namespace or "", topic)
+            if msgs.is_known(msgs.normalize_type(type_name)):
+                published[key] = msgs.normalize_type(type_name)
+            else:  # (the node's own mistake, said there): what reads it is not checked again
+                unloaded = [*unloaded, key]
     keys: list[str] = []
     with problems.each():
         keys = assertion_keys(sc, doc, published, unchecked=unloaded)
