@@ -10,7 +10,6 @@ import mujoco
 import numpy as np
 
 from runner.sim.faults import Fault
-from runner.wire import msgs
 
 BLOCK_FRICTION = 1e4  # N·m (or N) of dry friction on a blocked joint: no motor of a mobile robot turns it
 
@@ -21,7 +20,7 @@ def act(ev: Any, e: Any, a: dict[str, Any], now: int) -> str:
     world, m, d = ev.world, ev.m, ev.d
     if kind == "publish":
         out = world.make_publisher(a["key"], a["type"])
-        world.publish(out, msgs.from_data(a["type"], a["data"]), now)
+        world.publish(out, ev.message_of(a), now)
         return f"published on {a['key'].split('/', 1)[1]}"
     if kind in ("start", "stop"):
         if ev.actors is not None:

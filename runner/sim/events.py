@@ -80,6 +80,7 @@ class Events:
         self.spatial = [e for e in self.events if e.kind in ("near", "enter", "leave")]
         self.out = world.make_publisher(events_key(plan.name), "std_msgs/msg/String") if self.events else None
         self.log: list[dict[str, Any]] = []
+        self._messages: dict[int, Any] = {}  # publish actions' messages, by the action's id
         self._bodies_at: list[int] = []  # what spatial triggers look at (see `_locator`)
         self._geoms_at: list[int] = []
         for e in self.events:
@@ -280,6 +281,13 @@ class Events:
         from runner.sim.event_actions import act
 
         return act(self, e, a, now)
+
+    def message_of(self, action: dict[str, Any]) -> Any:
+        """The message a `publish` action sends, built once (its data never changes)."""
+        msg = self._messages.get(id(action))
+        if msg is None:
+            msg = self._messages[id(action)] = msgs.from_data(action["type"], action["data"])
+        return msg
 
     def wake(self, t_ns: int) -> None:
         """Be looked at again at `t_ns` at the latest (a fault holds a message due then)."""
