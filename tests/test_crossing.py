@@ -3,6 +3,7 @@ when its driver ignores the lidar (time and place said), and the fault-injection
 
 from __future__ import annotations
 
+import itertools
 import json
 import shutil
 from pathlib import Path
@@ -51,6 +52,18 @@ def test_a_blind_driver_runs_into_the_person_and_the_report_says_when_and_where(
 
     img = np.asarray(Image.open(tmp_path / "c.trajectory.png").convert("RGB"))
     assert int(np.all(img == ACTOR_INK, axis=2).sum()) > 100
+    # its ground truth is recorded for a 3D view: world -> walker on crossing/tf, standing, then walking
+    from runner.wire import msgs
+
+    ys = [
+        (t, tr.transform.translation.y)
+        for topic, t, data in _messages(tmp_path / "c.mcap")
+        if topic == "crossing/tf"
+        for tr in msgs.decode(data, "tf2_msgs/msg/TFMessage").transforms
+        if tr.child_frame_id == "walker"
+    ]
+    assert ys[0][1] == pytest.approx(3.5) and ys[-1][1] == pytest.approx(-3.5)
+    assert all(b[1] <= a[1] + 1e-9 for a, b in itertools.pairwise(ys))
     # the person started when r1 came within 3 m of the doorway: recorded on crossing/_events
     fired = [json.loads(d) for topic, _t, d in _events(tmp_path / "c.mcap")]
     assert [f["event"] for f in fired] == ["person_crosses"] and fired[0]["did"] == ["start walker"]
