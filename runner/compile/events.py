@@ -15,6 +15,7 @@ from typing import Any
 
 import mujoco
 
+from runner.compile.nodes import declared_topics
 from runner.compile.timeline import message_of
 from runner.errors import Problem, Problems, ScenarioError
 from runner.geometry import rpy_to_quat
@@ -23,7 +24,6 @@ from runner.plugin.registry import load
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import Action, Event, Scenario
 from runner.wire import msgs
-from runner.wire.transport import topic_key
 
 
 def _choices(names: list[str] | set[str], what: str) -> str:
@@ -142,12 +142,7 @@ def compile_events(
             if act.publish is not None:
                 published[f"{sc.name}/{act.publish.topic.strip('/')}"] = msgs.normalize_type(act.publish.type)
     taken = {t.key: t.type for r in robots for p in r.plugins for t in p.topics if t.direction == "sub"}
-    heard = {
-        topic_key(sc.name, n.namespace or "", topic): msgs.normalize_type(type_name)
-        for n in sc.nodes
-        for topic, type_name in n.publishes.items()
-        if msgs.is_known(msgs.normalize_type(type_name))
-    }
+    heard = {k: t for k, t in declared_topics(sc).items() if t is not None}
     w = _World(sc, doc, model, robots, actors, published, taken, heard, [a.name for a in sc.assertions])
     names = [e.name for e in sc.events]
     out: list[EventPlan | None] = []

@@ -10,6 +10,7 @@ from runner.errors import Problem, ScenarioError
 from runner.plan import NodePlan, TopicPlan
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import Scenario
+from runner.wire import msgs
 from runner.wire.transport import topic_key
 
 
@@ -121,4 +122,17 @@ def _lockstep_names(sc: Scenario, doc: Document, nodes: set[str]) -> list[Proble
             where: PathKey = ("lockstep", j)
             expected = "one of: " + ", ".join(sorted(nodes)) if nodes else "a node of this scenario (nodes:)"
             out.append(Problem(f"no node named {name!r}", doc.locate(where), where, expected=expected))
+    return out
+
+
+def declared_topics(sc: Scenario) -> dict[str, str | None]:
+    """What the nodes say they publish (`publishes:`): full key -> ROS type, None for a type that is not
+    known (compile_nodes says so at its line; what reads the topic is not checked again)."""
+    out: dict[str, str | None] = {}
+    for node in sc.nodes:
+        for topic, type_text in node.publishes.items():
+            type_name = msgs.normalize_type(type_text)
+            out[topic_key(sc.name, node.namespace or "", topic)] = (
+                type_name if msgs.is_known(type_name) else None
+            )
     return out

@@ -12,7 +12,7 @@ import mujoco
 from runner.checks import assertion_keys, check_names
 from runner.compile.actors import add_actors
 from runner.compile.events import compile_events
-from runner.compile.nodes import compile_nodes, host_of
+from runner.compile.nodes import compile_nodes, declared_topics, host_of
 from runner.compile.packages import PackageMap
 from runner.compile.record import record_plan
 from runner.compile.robots import add_robots
@@ -26,7 +26,6 @@ from runner.plan import NodePlan, RecordPlan, RobotPlan, RunPlan
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import NoCollision, Scenario, WorldModel
 from runner.wire import msgs
-from runner.wire.transport import topic_key
 
 _GEOM = {
     "box": mujoco.mjtGeom.mjGEOM_BOX,
@@ -142,13 +141,9 @@ def _assertion_keys(
     # cmd_vel) and those nodes say they publish
     published = {t.key: t.type for r in robots for p in r.plugins for t in p.topics}
     published.update({f"{sc.name}/{ev.topic.strip('/')}": msgs.normalize_type(ev.type) for ev in sc.timeline})
-    for node in sc.nodes:
-        for topic, type_name in node.publishes.items():
-            key = topic_key(sc.name, node.namespace or "", topic)
-            if msgs.is_known(msgs.normalize_type(type_name)):
-                published[key] = msgs.normalize_type(type_name)
-            else:  # (the node's own mistake, said there): what reads it is not checked again
-                unloaded = [*unloaded, key]
+    declared = declared_topics(sc)
+    published.update({k: t for k, t in declared.items() if t is not None})
+    unloaded = [*unloaded, *(k for k, t in declared.items() if t is None)]  # (the node's mistake, said there)
     keys: list[str] = []
     with problems.each():
         keys = assertion_keys(sc, doc, published, unchecked=unloaded)

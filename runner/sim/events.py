@@ -23,7 +23,9 @@ import numpy as np
 
 from runner.checks.judge import events_key
 from runner.plan import EventPlan, RunPlan
+from runner.scenario.schema import Region
 from runner.sim.actors import TICK_NS, Actors
+from runner.sim.event_actions import act
 from runner.sim.faults import Fault
 from runner.wire import msgs
 
@@ -56,6 +58,7 @@ class _Event:
         self.due: list[int] = []  # times to fire (`at`, delayed `after`)
         self.inside: bool | None = None  # the last look's answer (near, enter, leave)
         self.spatial = self.kind in ("near", "enter", "leave")
+        self.region = Region.model_validate(plan.when["region"]) if "region" in plan.when else None
         self.at = 0  # (spatial) where its body's (x, y) is in what `Events._where` gathers
         self.to_at = 0  # (near another body) where that body's is
         self.fired = 0
@@ -139,15 +142,14 @@ class Events:
 
     def _listen_assertion(self, e: _Event, plan: RunPlan) -> None:
         from runner.checks import specs_from_plan
-        from runner.checks.judge import Judge
+        from runner.checks.judge import Judge, judged_types
 
         when = e.plan.when
         spec = specs_from_plan([plan.assertions[when["index"]]])[0]
         key = plan.assertion_keys[when["index"]]
         judge = Judge([spec], [key])
         want = "pass" if when["becomes"] == "pass" else "fail"
-        types = {t.key: t.type for t in plan.topics()}
-        types.setdefault(f"{plan.name}/_contacts", "gazebo_msgs/msg/ContactsState")
+        types = judged_types(plan)
 
         def on_message(msg: Any, stamp_ns: int) -> None:
             if e.done or e.pending is not None:
@@ -192,11 +194,7 @@ class Events:
                 to = when["to"]["name"] if isinstance(when["to"], dict) else f"[{tx:g}, {ty:g}]"
                 return f"{who} within {when['within']:g} m of {to} ({dist:.2f} m)"
             return None
-        r = when["region"]
-        if "center" in r:
-            now_in = (x - r["center"][0]) ** 2 + (y - r["center"][1]) ** 2 <= r["radius"] ** 2
-        else:
-            now_in = r["min"][0] <= x <= r["max"][0] and r["min"][1] <= y <= r["max"][1]
+        now_in = e.region.contains(x, y)
         was, e.inside = e.inside, now_in
         if was is None:
             return None  # the first look sets where it is: entering or leaving is a change
@@ -278,8 +276,6 @@ class Events:
             )
 
     def _do(self, e: _Event, a: dict[str, Any], now: int) -> str:
-        from runner.sim.event_actions import act
-
         return act(self, e, a, now)
 
     def message_of(self, action: dict[str, Any]) -> Any:

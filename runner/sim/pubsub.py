@@ -39,27 +39,18 @@ class Outgoing:
         payload = msgs.encode(msg, self.type)
         if self.fault is not None:
             self.fault.take(self, payload, msg, stamp_ns)
-            return
-        self.send(payload, _ATT.pack(self.seq, stamp_ns))
-        self.seq += 1
-        self.last = payload
-        for _type, cb in self.local:
-            cb(msg, stamp_ns)
+        else:
+            self.deliver(payload, msg, stamp_ns)
 
     def publish_cdr(self, payload: bytes, stamp_ns: int) -> None:
         if self.fault is not None:
             self.fault.take(self, payload, None, stamp_ns)
-            return
-        self.send(payload, _ATT.pack(self.seq, stamp_ns))
-        self.seq += 1
-        self.last = payload
-        if self.local:
-            msg = msgs.decode(payload, self.type)
-            for _type, cb in self.local:
-                cb(msg, stamp_ns)
+        else:
+            self.deliver(payload, None, stamp_ns)
 
     def deliver(self, payload: bytes, msg: Any, stamp_ns: int) -> None:
-        """Send, past any fault (what a fault lets through, or releases late)."""
+        """Send, and hand to subscribers in this process (`msg`, or `payload` decoded when there is one);
+        past any fault: what `publish` sends without one, and what a fault lets through or releases late."""
         self.send(payload, _ATT.pack(self.seq, stamp_ns))
         self.seq += 1
         self.last = payload
