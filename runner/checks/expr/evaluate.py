@@ -289,7 +289,15 @@ class Expr:
             if not _is_numeric(v):
                 self._fail(f"{func.id}(a, b) needs numbers; found {_describe(v)}", node)
         if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
-            return np.minimum(a, b) if func.id == "min" else np.maximum(a, b)
+            try:
+                return np.minimum(a, b) if func.id == "min" else np.maximum(a, b)
+            except ValueError:  # sequences of different lengths
+                self._fail(
+                    f"{func.id}(a, b) of sequences needs them of one length; found {_describe(a)} and "
+                    f"{_describe(b)}",
+                    node,
+                    "compare their items, or reduce each first: min(a.min(), b.min())",
+                )
         return min(a, b) if func.id == "min" else max(a, b)
 
     def _reduce(self, name: str, v: Any, operand: ast.AST, node: ast.AST) -> Any:
