@@ -12,7 +12,7 @@ import pytest
 from runner.plugin import Plugin, Topic, registry
 from runner.sim.world import World
 from runner.wire import msgs
-from runner.wire.cdr import Layout, LayoutError, Peek
+from runner.wire.cdr import Layout, LayoutError, Peek, string_message
 from runner.wire.transport import MemoryBus
 from tests.helpers import messages, plan_of
 
@@ -350,3 +350,11 @@ def test_peek_reads_each_field_as_rosbags_decodes_it(type_name: str, msg: Any) -
     assert not Peek("sensor_msgs/msg/Imu", ["linear_acceleration"]).full
     assert Peek("sensor_msgs/msg/Imu", ["no_such_field"]).full
     assert not Peek("tf2_msgs/msg/TFMessage", ["transforms"]).full
+
+
+@pytest.mark.parametrize(
+    "text", ["", "a", "ab", "abc", "abcd", '{"event": "x", "why": "héllo ✓"}', "x" * 1000]
+)
+def test_string_message_is_what_rosbags_encodes(text: str) -> None:
+    """The events' record (`<run>/_events`, one per firing) is written without a message object."""
+    assert string_message(text) == msgs.encode(T["std_msgs/msg/String"](data=text), "std_msgs/msg/String")

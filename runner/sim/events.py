@@ -29,6 +29,7 @@ from runner.sim.actors import TICK_NS, Actors
 from runner.sim.event_actions import act
 from runner.sim.faults import Fault
 from runner.wire import msgs
+from runner.wire.cdr import string_message
 
 _EVENTS_STREAM = 1_000_003  # random streams of events' faults: (seed, this + event index)
 
@@ -92,7 +93,7 @@ class Events:
         self.spatial = [e for e in self.events if e.kind in ("near", "enter", "leave")]
         self.out = world.make_publisher(events_key(plan.name), "std_msgs/msg/String") if self.events else None
         self.log: list[dict[str, Any]] = []
-        self._messages: dict[int, Any] = {}  # publish actions' messages, by the action's id
+        self._messages: dict[int, tuple[Any, bytes]] = {}  # publish actions' messages, by the action's id
         self._bodies_at: list[int] = []  # what spatial triggers look at (see `_locator`)
         self._geoms_at: list[int] = []
         for e in self.events:
@@ -116,7 +117,7 @@ class Events:
         # what a boundary looks at, so that it does not walk every event at every step: the spatial
         # events not done (at ticks), those with times (`at`, delayed `after`), and those a message or an
         # assertion made pending since the last boundary (by plan index: they are looked at in plan order)
-        self._live_spatial = list(self.spatial)
+        self._spatial_queue = [e.index for e in self.spatial]  # those not done
         self._timed = [e for e in self.events if e.kind in ("at", "after")]
         self._flagged: list[int] = []
         self._queue: list[int] | None = None  # the indices still to look at in this boundary
@@ -227,19 +228,20 @@ class Events:
 
     # -------------------------------------------------------------------------------- the step
     def boundary(self, now: int) -> None:
-        for key, (fault, out) in list(self.faults.items()):
-            fault.release(out, now)
-            if fault.until_ns is not None and now >= fault.until_ns:
-                out.fault = None  # over: new messages go straight out...
-                fault.until_ns = None
-            if out.fault is not fault and not fault.held:  # ... and what it holds, each at its time
-                del self.faults[key]
+        if self.faults:
+            for key, (fault, out) in list(self.faults.items()):
+                fault.release(out, now)
+                if fault.until_ns is not None and now >= fault.until_ns:
+                    out.fault = None  # over: new messages go straight out...
+                    fault.until_ns = None
+                if out.fault is not fault and not fault.held:  # ... and what it holds, each at its time
+                    del self.faults[key]
         if self.pushes:
             for _until, body, wrench in [p for p in self.pushes if p[0] <= now]:
                 self.d.xfrc_applied[body] -= wrench
             self.pushes = [p for p in self.pushes if p[0] > now]
         tick = now >= self.next_tick
-        queue = [e.index for e in self._live_spatial] if tick else []  # (in plan order: a heap)
+        queue = self._spatial_queue[:] if tick else []  # (in plan order: a heap)
         if self._flagged:
             queue += self._flagged
             self._flagged = []
@@ -304,22 +306,24 @@ class Events:
     def _next(self, now: int) -> int:
         nxt = self.next_tick if (self.actors is not None or self.spatial) else 2**62
         for e in self._timed:
-            if e.due and not e.done:
-                nxt = min(nxt, e.due[0])
-        for fault, _out in self.faults.values():
-            t = fault.next_ns()
-            if t is not None:
-                nxt = min(nxt, t)
+            if e.due and not e.done and e.due[0] < nxt:
+                nxt = e.due[0]
+        if self.faults:
+            for fault, _out in self.faults.values():
+                t = fault.next_ns()
+                if t is not None and t < nxt:
+                    nxt = t
         for until, _b, _w in self.pushes:
-            nxt = min(nxt, until)
-        return max(nxt, now + 1)
+            if until < nxt:
+                nxt = until
+        return nxt if nxt > now else now + 1
 
     def _fire(self, e: _Event, now: int, why: str) -> None:
         e.fired += 1
         if not e.plan.repeat:
             e.done = True
             if e.spatial:
-                self._live_spatial = [x for x in self._live_spatial if not x.done]
+                self._spatial_queue = [x.index for x in self.spatial if not x.done]
         did = [self._do(e, a, now) for a in e.plan.do]
         end = next((a for a in e.plan.do if a["kind"] == "end"), None)
         entry = {"event": e.name, "t": now / 1e9, "why": why, "did": did, "n": e.fired}
@@ -327,7 +331,7 @@ class Events:
             entry["end"] = {"result": end["result"], "message": end["message"]}
         self.log.append(entry)
         if self.out is not None:
-            self.world.publish(self.out, msgs.T["std_msgs/msg/String"](data=json.dumps(entry)), now)
+            self.out.publish_encoded(string_message(json.dumps(entry)), None, now)
         for f in self.followers.get(e.name, ()):
             if f.done:
                 continue
@@ -346,12 +350,13 @@ class Events:
     def _do(self, e: _Event, a: dict[str, Any], now: int) -> str:
         return act(self, e, a, now)
 
-    def message_of(self, action: dict[str, Any]) -> Any:
-        """The message a `publish` action sends, built once (its data never changes)."""
-        msg = self._messages.get(id(action))
-        if msg is None:
-            msg = self._messages[id(action)] = msgs.from_data(action["type"], action["data"])
-        return msg
+    def message_of(self, action: dict[str, Any]) -> tuple[Any, bytes]:
+        """The message a `publish` action sends and its bytes, built once (its data never changes)."""
+        built = self._messages.get(id(action))
+        if built is None:
+            msg = msgs.from_data(action["type"], action["data"])
+            built = self._messages[id(action)] = (msg, msgs.encode(msg, action["type"]))
+        return built
 
     def wake(self, t_ns: int) -> None:
         """Be looked at again at `t_ns` at the latest (a fault holds a message due then)."""

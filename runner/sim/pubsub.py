@@ -41,7 +41,10 @@ class Outgoing:
         self.last: bytes | None = None  # the last message sent (what a `freeze` fault repeats)
 
     def publish(self, msg: Any, stamp_ns: int) -> None:
-        payload = msgs.encode(msg, self.type)
+        self.publish_encoded(msgs.encode(msg, self.type), msg, stamp_ns)
+
+    def publish_encoded(self, payload: bytes, msg: Any, stamp_ns: int) -> None:
+        """`msg` already encoded (`payload`): a message sent again and again, encoded once."""
         if self.fault is not None:
             self.fault.take(self, payload, msg, stamp_ns)
         else:

@@ -190,12 +190,19 @@ def _align(pos: int, size: int) -> int:
     return _HEADER + ((rel + size - 1) // size) * size
 
 
+def string_message(text: str) -> bytes:
+    """A `std_msgs/msg/String`'s bytes, as rosbags encodes them (the events' record, one per firing)."""
+    data = text.encode()
+    return b"\x00\x01\x00\x00" + _U32_PACK(len(data) + 1) + data + b"\x00"
+
+
 # ------------------------------------------------------------------------------------------------ Peek
 _UNPACK = {k: struct.Struct("<" + c).unpack_from for k, c in {
     "bool": "?", "byte": "B", "char": "B", "int8": "b", "uint8": "B", "int16": "h", "uint16": "H",
     "int32": "i", "uint32": "I", "int64": "q", "uint64": "Q", "float32": "f", "float64": "d",
 }.items()}  # fmt: skip
 _U32 = struct.Struct("<I").unpack_from
+_U32_PACK = struct.Struct("<I").pack
 
 # One step of a Peek: `op(raw, pos, values) -> pos`, `raw` the bytes after the encapsulation header (CDR
 # aligns from there), `values` the fields read so far
