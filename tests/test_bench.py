@@ -49,11 +49,11 @@ def test_bench_suite_runs_and_writes_results(tmp_path: Path) -> None:
     # the actors row ran the three worlds, and the events in it fired (the scan trigger, 10 a second)
     actors = json.loads((tmp_path / "actors.json").read_text())
     assert (actors["actors"], actors["events"]) == (20, 10)
-    assert set(actors["steps_per_s"]) == {"raw", "raw bodies", "without", "standing", "with"}
+    assert set(actors["steps_per_s"]) == {"raw", "raw bodies", "raw moving", "without", "standing", "with"}
     assert all(v > 0 for v in actors["steps_per_s"].values())
     assert actors["firings"] >= 10 * actors["sim_seconds"]
     assert "+ them walking and 10 events" in proc.stdout
-    assert "ours: walking and events, over the bodies standing" in proc.stdout
+    assert "ours: playing them and the events" in proc.stdout
 
 
 @pytest.mark.timeout(60)
