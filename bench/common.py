@@ -131,6 +131,24 @@ def world_on_zenoh(plan: RunPlan) -> WorldStats:
             bus.undeclare_all()
 
 
+def gl_renderer() -> str:
+    """The OpenGL renderer cameras render with (e.g. 'llvmpipe (LLVM 15.0.6, 256 bits)' on the CPU, the GPU's
+    name on one), read from a context of the backend mujoco loaded; '' if unknown."""
+    try:
+        from OpenGL import GL
+
+        model = mujoco.MjModel.from_xml_string("<mujoco/>")
+        r = mujoco.Renderer(model, 8, 8)
+        try:
+            r._gl_context.make_current()
+            name = GL.glGetString(GL.GL_RENDERER)
+            return name.decode() if name else ""
+        finally:
+            r.close()
+    except Exception:
+        return ""
+
+
 def best(values: Sequence[float]) -> float:
     return max(values)
 

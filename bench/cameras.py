@@ -1,0 +1,152 @@
+"""The camera scenarios as declared against their limit: physics plus MuJoCo's renderer alone.
+
+For a scenario with cameras (`block_robot`: two 800x800 RGB cameras at 30 Hz with Gazebo noise;
+`harmonic_nav`: an 800x600 RGB-D camera at 100 Hz), measured in one run, alternating, best of N:
+
+- physics: the compiled model's raw step rate (batched `mj_step`, no plugins), for the run's steps;
+- the rendering bound: `mujoco.Renderer` alone rendering the same frames (each camera's rate x the sim
+  time) at the same sizes and quality (no MSAA, no shadows, as the camera plugins render): `render()` for an
+  RGB frame, and for an RGB-D frame `render()` plus `render()` with depth rendering on (MuJoCo's renderer
+  gives one or the other per call). A stricter figure is printed beside it: one render read back as colour
+  and depth together (`mjr_render` + `mjr_readPixels`), which is what the depth camera does;
+- the limit: sim seconds / (physics wall + rendering wall), in x real time;
+- the scenario itself: `scenario run`'s path (world process + Zenoh + MCAP recorder), judged off;
+- noise: `PixelNoise.apply` on a frame of the camera's size (flipped view in, message buffer out) against
+  the plain copy it replaces, per frame, against the frame's render time.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from plugins._pixels import PixelNoise
+from plugins._render import CameraRenderer, camera_name
+from runner.plan import RunPlan
+
+
+@dataclass
+class CameraSpec:
+    name: str  # the MuJoCo camera
+    width: int
+    height: int
+    rate: float
+    depth: bool  # an RGB-D frame (colour and depth)
+    noise: float
+
+
+def camera_specs(plan: RunPlan) -> list[CameraSpec]:
+    out = []
+    for robot in plan.robots:
+        for p in robot.plugins:
+            if p.type not in ("camera", "depth_camera") or not p.rate:
+                continue
+            params = p.params
+            depth = p.type == "depth_camera"
+            out.append(
+                CameraSpec(
+                    robot.prefix + camera_name(p.name),
+                    int(params.get("width", 320)),
+                    int(params.get("height", 240)),
+                    float(p.rate),
+                    depth,
+                    float(params.get("noise_stddev", 0.0))
+                    if (not depth or params.get("publish_color", True))
+                    else 0.0,
+                )
+            )
+    return out
+
+
+def _model(plan: RunPlan) -> tuple[mujoco.MjModel, mujoco.MjData]:
+    model = mujoco.MjModel.from_xml_string(plan.mjcf)
+    model.vis.quality.offsamples = 0  # as CameraRenderer sets them
+    model.vis.quality.shadowsize = 0
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    return model, data
+
+
+def _frame(r: mujoco.Renderer, data: mujoco.MjData, camera: str) -> None:
+    r.update_scene(data, camera=camera)
+    r.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
+    r.render()
+
+
+def render_bound(plan: RunPlan, seconds: float) -> dict[str, Any]:
+    """Wall seconds `mujoco.Renderer` takes for every camera frame of `seconds` of sim time, and the one-pass
+    figure (colour and depth from one render); per camera, ms per frame."""
+    model, data = _model(plan)
+    total = one_pass_total = 0.0
+    per_camera = []
+    for spec in camera_specs(plan):
+        frames = max(1, round(spec.rate * seconds))
+        renderer = mujoco.Renderer(model, spec.height, spec.width)
+        depth_renderer = mujoco.Renderer(model, spec.height, spec.width) if spec.depth else None
+        if depth_renderer is not None:
+            depth_renderer.enable_depth_rendering()
+        try:
+            _frame(renderer, data, spec.name)  # warm
+            t0 = time.perf_counter()
+            for _ in range(frames):
+                _frame(renderer, data, spec.name)
+                if depth_renderer is not None:
+                    _frame(depth_renderer, data, spec.name)
+            wall = time.perf_counter() - t0
+        finally:
+            renderer.close()
+            if depth_renderer is not None:
+                depth_renderer.close()
+        cam = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, spec.name)
+        one = CameraRenderer(model, cam, spec.width, spec.height, 0.02, 100.0)
+        try:
+            one.update(data)
+            one._render(depth_too=spec.depth)
+            t0 = time.perf_counter()
+            for _ in range(frames):
+                one.update(data)
+                one._render(depth_too=spec.depth)  # mjr_render + mjr_readPixels, nothing else
+            one_wall = time.perf_counter() - t0
+        finally:
+            one.close()
+        total += wall
+        one_pass_total += one_wall
+        per_camera.append(
+            {
+                "camera": spec.name,
+                "size": f"{spec.width}x{spec.height}",
+                "rate": spec.rate,
+                "depth": spec.depth,
+                "frames": frames,
+                "renderer_ms_per_frame": wall / frames * 1e3,
+                "one_pass_ms_per_frame": one_wall / frames * 1e3,
+            }
+        )
+    return {"wall_s": total, "one_pass_wall_s": one_pass_total, "cameras": per_camera}
+
+
+def noise_cost(width: int, height: int, stddev: float, repeat: int = 30) -> dict[str, float]:
+    """ms per frame: the noisy write of a frame (flipped view in, message buffer out) and the plain copy
+    it replaces; their difference is what the noise costs."""
+    rng = np.random.default_rng(1)
+    raw = rng.integers(0, 256, (height, width, 3), dtype=np.uint8)
+    out = np.empty_like(raw)
+    noise = PixelNoise(stddev, np.random.default_rng(2))
+    noise.apply(raw[::-1], out)  # the table is made at setup
+
+    def best(fn: Any) -> float:
+        fn()
+        times = []
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            fn()
+            times.append(time.perf_counter() - t0)
+        return min(times) * 1e3
+
+    noisy = best(lambda: noise.apply(raw[::-1], out))
+    plain = best(lambda: np.copyto(out, raw[::-1]))
+    return {"noisy_ms": noisy, "plain_ms": plain, "noise_ms": max(0.0, noisy - plain)}
