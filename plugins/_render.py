@@ -302,7 +302,8 @@ class CameraRenderer:
         # OpenGL rows run bottom-up: pixels are read into these, then flipped into the outputs.
         self._raw_rgb = np.empty((height, width, 3), dtype=np.uint8)
         self._raw_depth = np.empty((height, width), dtype=np.float32)
-        self._depth64 = np.empty((height, width), dtype=np.float64)
+        self._depth64 = np.empty((min(height, 32), width), dtype=np.float64)  # a block of rows
+        self._beyond = np.empty((min(height, 32), width), dtype=bool)
         self._rgb = np.empty((height, width, 3), dtype=np.uint8)
         self._depth = np.empty((height, width), dtype=np.float32)
         self._clip = (np.float32(0.0), np.float32(0.0))
@@ -403,23 +404,32 @@ class CameraRenderer:
 
     def _convert_depth(self, out: np.ndarray | None = None) -> np.ndarray:
         # mujoco.Renderer's conversion (reversed Z, float32 coefficients, float64 arithmetic, float32
-        # result), on the rows flipped top-down, into reused buffers (or `out`).
+        # result), on the rows flipped top-down, into a reused buffer (or `out`), by blocks of rows that
+        # stay in the cache.
         znear, zfar = self._clip
-        d64 = self._depth64
         raw = self._raw_depth[::-1]
-        if self.scene.camera[0].orthographic:
-            np.multiply(raw, zfar - znear, out=d64, dtype=np.float64)
-            np.subtract(np.float64(zfar), d64, out=d64)
-        else:
+        depth = self._depth if out is None else out
+        ortho = bool(self.scene.camera[0].orthographic)
+        c_coef = d_coef = np.float32(0)
+        if not ortho:
             c_coef = -(zfar + znear) / (zfar - znear)
             d_coef = -(np.float32(2) * zfar * znear) / (zfar - znear)
             c_coef = np.float32(-0.5) * c_coef - np.float32(0.5)
             d_coef = np.float32(-0.5) * d_coef
-            np.add(raw, c_coef, out=d64, dtype=np.float64)
-            np.divide(np.float64(d_coef), d64, out=d64)
-        depth = self._depth if out is None else out
-        np.copyto(depth, d64, casting="same_kind")
-        np.copyto(depth, np.float32(np.inf), where=depth > np.float32(self.far))
+        far, inf = np.float32(self.far), np.float32(np.inf)
+        block = len(self._depth64)
+        for r0 in range(0, raw.shape[0], block):
+            r1 = min(raw.shape[0], r0 + block)
+            d64, beyond, o = self._depth64[: r1 - r0], self._beyond[: r1 - r0], depth[r0:r1]
+            if ortho:
+                np.multiply(raw[r0:r1], zfar - znear, out=d64, dtype=np.float64)
+                np.subtract(np.float64(zfar), d64, out=d64)
+            else:
+                np.add(raw[r0:r1], c_coef, out=d64, dtype=np.float64)
+                np.divide(np.float64(d_coef), d64, out=d64)
+            np.copyto(o, d64, casting="same_kind")
+            np.greater(o, far, out=beyond)
+            np.copyto(o, inf, where=beyond)
         return depth
 
     # ------------------------------------------------------------------------------------------ close

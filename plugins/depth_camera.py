@@ -129,18 +129,28 @@ class DepthCamera(Camera):
 
     def fill_points(self, buf: np.ndarray, depth: np.ndarray, rgb: np.ndarray | None) -> np.ndarray:
         """An organized cloud's points (H x W x fields float32) in the optical frame from a depth image (and
-        colours), written into `buf`; NaN where no return."""
-        z = buf[..., 2]
-        np.copyto(z, depth)
-        np.copyto(z, np.float32(np.nan), where=~np.isfinite(depth))
-        np.multiply(self.ray_x, z, out=buf[..., 0])
-        np.multiply(self.ray_y, z, out=buf[..., 1])
-        if rgb is not None:
-            # float32 `rgb` holding 0x00RRGGBB, little-endian: bytes B, G, R, 0
-            h, w = depth.shape
-            packed = buf.view(np.uint8).reshape(h, w, self.point_step)[..., 12:16]
-            packed[..., :3] = rgb[..., ::-1]
-            packed[..., 3] = 0
+        colours), written into `buf` by blocks of rows that stay in the cache; NaN where no return."""
+        h, w = depth.shape
+        block = min(h, 32)
+        if getattr(self, "_scratch", None) is None or self._scratch[0].shape != (block, w):
+            self._scratch = (np.empty((block, w), np.float32), np.empty((block, w), bool))
+        z_all, finite_all = self._scratch
+        packed = buf.view(np.uint8).reshape(h, w, self.point_step)[..., 12:16] if rgb is not None else None
+        nan = np.float32(np.nan)
+        for r0 in range(0, h, block):
+            r1 = min(h, r0 + block)
+            d, z, finite, b = depth[r0:r1], z_all[: r1 - r0], finite_all[: r1 - r0], buf[r0:r1]
+            np.isfinite(d, out=finite)
+            z.fill(nan)
+            np.copyto(z, d, where=finite)
+            b[..., 2] = z
+            np.multiply(self.ray_x, z, out=b[..., 0])
+            np.multiply(self.ray_y[r0:r1], z, out=b[..., 1])
+            if packed is not None and rgb is not None:
+                # float32 `rgb` holding 0x00RRGGBB, little-endian: bytes B, G, R, 0
+                p = packed[r0:r1]
+                p[..., :3] = rgb[r0:r1, :, ::-1]
+                p[..., 3] = 0
         return buf
 
     def point_cloud(self, now_ns: int, depth: np.ndarray, rgb: np.ndarray | None) -> Any:
