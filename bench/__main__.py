@@ -445,6 +445,28 @@ def cameras(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
             ("camera", "plain copy", "with noise", "noise", "render", "noise / render"),
             noise_rows,
         )
+    # a frame's bytes from the camera into the MCAP (bench/cameras.py copies)
+    sizes = bc.camera_specs(plan_from_file(REPO / "scenarios" / "block_robot.yaml", seconds=1.0))[0]
+    c = bc.copies(sizes.width, sizes.height, frames=30 if args.quick else 120)
+    doc["copies"] = c
+    unit = c["copy_ms"]
+    text += "\n\n" + table(
+        f"a {sizes.width}x{sizes.height} RGB frame ({c['frame_bytes'] / 1e6:.2f} MB) on its way into the "
+        "MCAP, ms per frame (a plain copy of its bytes is the unit)",
+        ("", "ms", "plain copies' worth"),
+        [
+            ("plain copy of the frame's bytes", unit, 1.0),
+            ("world: send from Zenoh shared memory (one copy into it, then put)", c["send_ms"],
+             c["send_ms"] / unit),
+            ("world: put the bytes as they are (Zenoh copies them, twice)", c["send_as_bytes_ms"],
+             c["send_as_bytes_ms"] / unit),
+            ("recorder: to_bytes (the one copy it makes)", c["recorder_to_bytes_ms"],
+             c["recorder_to_bytes_ms"] / unit),
+            ("recorder: all its work per frame (to_bytes, zstd, CRC, write)", c["recorder_take_ms"],
+             c["recorder_take_ms"] / unit),
+            ("  of which zstd level 1", c["recorder_zstd_ms"], c["recorder_zstd_ms"] / unit),
+        ],
+    )  # fmt: skip
     br = doc["scenarios"]["block_robot"]
     doc["targets"].update(
         {

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import mujoco
@@ -150,3 +151,107 @@ def noise_cost(width: int, height: int, stddev: float, repeat: int = 30) -> dict
     noisy = best(lambda: noise.apply(raw[::-1], out))
     plain = best(lambda: np.copyto(out, raw[::-1]))
     return {"noisy_ms": noisy, "plain_ms": plain, "noise_ms": max(0.0, noisy - plain)}
+
+
+_RECORDER = """
+import sys, time, zstandard, zenoh
+from pathlib import Path
+from runner.record import Recorder
+from runner.wire.transport import make_config
+rec = Recorder(Path(sys.argv[2]), ["cam/**"])
+take, spent, zstd = rec._take, [0.0, 0, 0.0, 0.0], zstandard.ZstdCompressor(level=1)
+def timed(sample):
+    t0 = time.perf_counter()
+    data = sample.payload.to_bytes()
+    t1 = time.perf_counter()
+    take(sample)
+    t2 = time.perf_counter()
+    zstd.compress(data)
+    spent[0] += t2 - t0; spent[1] += 1; spent[2] += t1 - t0; spent[3] += time.perf_counter() - t2
+rec._take = timed
+with zenoh.open(make_config("client", connect=[sys.argv[1]])) as s:
+    sub = s.declare_subscriber("cam/**", lambda sample: rec.on_sample(sample))
+    print("ready", flush=True)
+    sys.stdin.readline()
+    sub.undeclare()
+rec.close()
+n = max(spent[1], 1)
+# the recorder's own time per frame: `_take` (to_bytes + chunk + compression + write), less the extra to_bytes
+print(n, (spent[0] - spent[2]) / n * 1e3, spent[2] / n * 1e3, spent[3] / n * 1e3, flush=True)
+"""
+
+
+def copies(width: int, height: int, frames: int = 60) -> dict[str, Any]:
+    """What a frame's bytes cost on their way from the camera into the MCAP, ms per 800x800-like RGB frame:
+    a plain copy of that many bytes (the unit), the world's send (into Zenoh shared memory, `put`) against
+    `put` of the bytes themselves (which Zenoh copies into its buffer, then into shared memory), and in
+    the recorder process (a real `Recorder` on a subscriber): `to_bytes` (the one copy Zenoh's Python API
+    allows on the receiving side) and the recorder's whole work per frame with the zstd compression it
+    contains measured apart."""
+    import subprocess
+    import sys
+    import tempfile
+
+    import zenoh
+
+    from runner.wire.transport import ZenohBus, free_port, make_config
+
+    # a frame as a camera gives it: smooth shading, Gazebo's noise on it (compresses as rendered frames do)
+    shade = np.linspace(40, 220, width * 3, dtype=np.float32)[None, :] * np.ones((height, 1), np.float32)
+    noisy = PixelNoise(0.007, np.random.default_rng(0)).apply(
+        shade.astype(np.uint8), np.empty((height, width * 3), np.uint8)
+    )
+    frame = bytearray(60) + bytearray(noisy.tobytes())
+    size = len(frame)
+    dst = bytearray(size)
+    view_src, view_dst = np.frombuffer(frame, np.uint8), np.frombuffer(dst, np.uint8)
+    t0 = time.perf_counter()
+    for _ in range(frames):
+        np.copyto(view_dst, view_src)
+    copy_ms = (time.perf_counter() - t0) / frames * 1e3
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    with tempfile.TemporaryDirectory() as tmp, zenoh.open(make_config("router", listen=[endpoint])) as s:
+        proc = subprocess.Popen(
+            [sys.executable, "-c", _RECORDER, endpoint, str(Path(tmp) / "copies.mcap")],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        try:
+            assert proc.stdout is not None and proc.stdin is not None
+            proc.stdout.readline()
+            bus = ZenohBus(s)
+            send = bus.publisher("cam/image", "sensor_msgs/msg/Image")
+            deadline = time.monotonic() + 5
+            while not bus.all_matched() and time.monotonic() < deadline:
+                time.sleep(0.01)
+            send(frame, b"\0" * 16)  # the shared-memory pool is made on the first
+            spent = {True: 0.0, False: 0.0}
+            for i in range(frames):  # alternating: from shared memory, and put as bytes (Zenoh copies)
+                shm = i % 2 == 0
+                bus.shm.ok = shm
+                frame[-1] = i & 0xFF
+                t0 = time.perf_counter()
+                send(frame, b"\0" * 16)
+                spent[shm] += time.perf_counter() - t0
+                time.sleep(0.005)  # a camera's pace, not a burst: the pool is not the question here
+            time.sleep(0.5)  # the recorder takes the last ones
+            proc.stdin.write("\n")
+            proc.stdin.flush()
+            n, take_ms, to_bytes_ms, zstd_ms = proc.stdout.read().split()
+            shm_sent = bus.shm.sent
+            bus.undeclare_all()
+        finally:
+            proc.kill()
+            proc.wait()
+    return {
+        "frame_bytes": size,
+        "copy_ms": copy_ms,
+        "send_ms": spent[True] / (frames // 2) * 1e3,
+        "send_as_bytes_ms": spent[False] / (frames - frames // 2) * 1e3,
+        "sent_from_shared_memory": shm_sent,
+        "recorded": int(n),
+        "recorder_to_bytes_ms": float(to_bytes_ms),
+        "recorder_take_ms": float(take_ms),
+        "recorder_zstd_ms": float(zstd_ms),
+    }
