@@ -162,3 +162,20 @@ def test_large_frames_go_through_shared_memory_into_the_recording_unchanged(
         assert len(frames) == 6, key
         assert frames == published[key], key
         assert len(set(frames)) == 6, key  # the robot turns and the noise is new: every frame differs
+
+
+def test_shared_memory_sender_copies_once_and_steps_aside_when_it_cannot() -> None:
+    """A large payload is copied into a shared-memory buffer (sent from there); a pool too small for it, or
+    one whose buffers are all still held by subscribers, gives None: the bytes are put as they are."""
+    from runner.wire.transport import SharedMemorySender
+
+    payload = bytearray(range(256)) * 800  # 200 KB
+    sender = SharedMemorySender(pool_bytes=1 << 20)
+    held = [sender.buffer(payload) for _ in range(5)]
+    assert all(b is not None and bytes(b) == payload for b in held)
+    assert sender.buffer(payload) is None  # all 1 MB held
+    assert (sender.sent, sender.fallbacks, sender.ok) == (5, 1, True)
+    del held
+    assert sender.buffer(payload) is not None  # freed buffers are taken again
+    small = SharedMemorySender(pool_bytes=500_000)
+    assert small.buffer(payload) is None and not small.ok  # a pool for fewer than 4 frames is not used

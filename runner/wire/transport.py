@@ -177,6 +177,16 @@ class SharedMemorySender:
         if not self.ok:
             return None
         if self._provider is None:
+            # POSIX shared memory lives in /dev/shm: a pool larger than what is free there (a container's
+            # default is 64 MB) would crash the process when its pages are touched, so it stays well within
+            try:
+                free = os.statvfs("/dev/shm")
+                self.pool_bytes = min(self.pool_bytes, free.f_bavail * free.f_frsize // 4)
+            except OSError:
+                pass
+            if self.pool_bytes < 4 * len(payload):
+                self.ok = False
+                return None
             try:
                 from zenoh import shm
 
