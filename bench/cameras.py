@@ -181,7 +181,26 @@ print(n, (spent[0] - spent[2]) / n * 1e3, spent[2] / n * 1e3, spent[3] / n * 1e3
 """
 
 
-def copies(width: int, height: int, frames: int = 60) -> dict[str, Any]:
+def rendered_frame(plan: RunPlan) -> np.ndarray:
+    """The first camera's view of the scenario at rest, with its noise: a frame as the camera sends it
+    (it compresses as the run's frames do)."""
+    model, data = _model(plan)
+    spec = camera_specs(plan)[0]
+    cam = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, spec.name)
+    r = CameraRenderer(model, cam, spec.width, spec.height, 0.02, 100.0)
+    try:
+        r.update(data)
+        rgb = r.rgb_view()
+        out = np.empty((spec.height, spec.width, 3), np.uint8)
+        if spec.noise > 0:
+            return PixelNoise(spec.noise, np.random.default_rng(0)).apply(rgb, out)
+        np.copyto(out, rgb)
+        return out
+    finally:
+        r.close()
+
+
+def copies(pixels: np.ndarray, frames: int = 60) -> dict[str, Any]:
     """What a frame's bytes cost on their way from the camera into the MCAP, ms per 800x800-like RGB frame:
     a plain copy of that many bytes (the unit), the world's send (into Zenoh shared memory, `put`) against
     `put` of the bytes themselves (which Zenoh copies into its buffer, then into shared memory), and in
@@ -196,12 +215,7 @@ def copies(width: int, height: int, frames: int = 60) -> dict[str, Any]:
 
     from runner.wire.transport import ZenohBus, free_port, make_config
 
-    # a frame as a camera gives it: smooth shading, Gazebo's noise on it (compresses as rendered frames do)
-    shade = np.linspace(40, 220, width * 3, dtype=np.float32)[None, :] * np.ones((height, 1), np.float32)
-    noisy = PixelNoise(0.007, np.random.default_rng(0)).apply(
-        shade.astype(np.uint8), np.empty((height, width * 3), np.uint8)
-    )
-    frame = bytearray(60) + bytearray(noisy.tobytes())
+    frame = bytearray(60) + bytearray(pixels.tobytes())  # (a header's worth of bytes in front)
     size = len(frame)
     dst = bytearray(size)
     view_src, view_dst = np.frombuffer(frame, np.uint8), np.frombuffer(dst, np.uint8)

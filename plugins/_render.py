@@ -5,8 +5,10 @@
 - the parameters every camera has (`CameraParams`) and mounting a MuJoCo camera with Gazebo's convention
   (`add_camera`);
 - `CameraRenderer`: one offscreen OpenGL context per camera, set up for speed (no MSAA, no shadows, no
-  reflections), giving RGB images and metric depth, both from one render where that gives the same depth;
-- ROS message builders: `Image`, `CameraInfo`, pixel formats and intensity noise.
+  reflections), giving RGB images and metric depth, both from one render where that gives the same depth,
+  as views of the pixels read (`rgb_view`, `rgbd_views`) that the camera writes straight into its messages;
+- ROS message builders: `Image`, `CameraInfo` (pixel formats, the noise and images encoded in place are in
+  `plugins._pixels`).
 
 Conventions. A Gazebo camera looks along its link's +X axis with +Z up; a MuJoCo camera looks along its
 own -Z with +Y up. Images are in the ROS optical frame (z forward, x right, y down; row 0 is the top).

@@ -87,6 +87,8 @@ def test_the_camera_bound_renders_each_declared_camera_at_its_size_and_rate() ->
     bound = bc.render_bound(plan, 0.2)
     assert [(c["size"], c["frames"]) for c in bound["cameras"]] == [("800x800", 6), ("800x800", 6)]
     assert bound["wall_s"] > 0 and bound["one_pass_wall_s"] > 0
+    frame = bc.rendered_frame(plan)
+    assert frame.shape == (800, 800, 3) and 20 < frame.mean() < 235  # the ground and the sky, not blank
     cost = bc.noise_cost(80, 60, 0.007, repeat=2)
     assert cost["noisy_ms"] > 0 and cost["plain_ms"] > 0
     assert gl_renderer()  # e.g. llvmpipe here, the GPU's name where EGL finds one
