@@ -11,7 +11,10 @@ Sections (in order):
 - scaling: 1, 2, 4, 8, 16 robots (diff_drive + lidar + imu + joint_states + tf each), world on Zenoh and
   full recorded run: × real time and wall cost per robot-second, relative to one robot.
 - messages: encode cost by type, fixed layout (runner.wire.cdr) vs rosbags, µs per message.
-- cameras: the demo plus one 320x240 RGB camera per robot at 10 Hz, recorded.
+- cameras: the demo plus one 320x240 RGB camera per robot at 10 Hz, recorded; then the seeds' camera robots
+  as declared (block_robot, harmonic_nav) against their limit, physics + one render per frame (and
+  mujoco.Renderer's calls), the world alone and the recorded run; the noise's cost per frame against its
+  render; a frame's bytes on their way into the MCAP; the GL renderer used (bench/cameras.py).
 - realtime: `rate: realtime` for 60 s (10 s with --quick): the factor overall and over its worst second,
   and the delay from a `cmd_vel` put by another process to the controller acting on it.
 - lockstep: the go-to-goal example with its controller node in lockstep with the world, and free-running.

@@ -1,18 +1,19 @@
-"""The camera scenarios as declared against their limit: physics plus MuJoCo's renderer alone.
+"""The camera scenarios as declared against their limit: physics plus MuJoCo's rendering alone.
 
 For a scenario with cameras (`block_robot`: two 800x800 RGB cameras at 30 Hz with Gazebo noise;
 `harmonic_nav`: an 800x600 RGB-D camera at 100 Hz), measured in one run, alternating, best of N:
 
 - physics: the compiled model's raw step rate (batched `mj_step`, no plugins), for the run's steps;
-- the rendering bound: `mujoco.Renderer` alone rendering the same frames (each camera's rate x the sim
-  time) at the same sizes and quality (no MSAA, no shadows, as the camera plugins render): `render()` for an
-  RGB frame, and for an RGB-D frame `render()` plus `render()` with depth rendering on (MuJoCo's renderer
-  gives one or the other per call). A stricter figure is printed beside it: one render read back as colour
-  and depth together (`mjr_render` + `mjr_readPixels`), which is what the depth camera does;
-- the limit: sim seconds / (physics wall + rendering wall), in x real time;
-- the scenario itself: `scenario run`'s path (world process + Zenoh + MCAP recorder), judged off;
+- rendering: each camera's frames (its rate x the sim time) rendered and read back at its size and settings
+  (no MSAA, shadows or reflections), colour and depth from one render for an RGB-D camera
+  (`mjr_render` + `mjr_readPixels`, nothing else): the limit is sim seconds / (physics + rendering wall).
+  Beside it, `mujoco.Renderer` alone for the same frames at the same size and quality: `render()` for an RGB
+  frame, and `render()` plus `render()` with depth rendering on for an RGB-D one (one or the other per call);
+- the scenario: the world alone on Zenoh (nothing subscribed) and `scenario run`'s path (world process +
+  Zenoh + MCAP recorder), judged off;
 - noise: `PixelNoise.apply` on a frame of the camera's size (flipped view in, message buffer out) against
-  the plain copy it replaces, per frame, against the frame's render time.
+  the plain copy it replaces, per frame, against the frame's render time;
+- copies: a rendered frame's bytes from the world's send to the recorder's file (`copies`).
 """
 
 from __future__ import annotations
