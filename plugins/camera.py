@@ -73,6 +73,8 @@ class Camera(Plugin):
         self.image_out = ImageOut(self.image_pub, self.frame_id, p.height, p.width, p.format)
         self.info_out = self.info_pub.layout(self.make_info(0, self.frame_id), ["header.stamp"])
         self.noise = PixelNoise(p.noise_stddev, self.ctx.rng) if p.noise_stddev > 0 else None
+        if self.noise is not None:  # its table is drawn now, not in the first frame (~0.1 s)
+            self.noise.table(16 * self.image_out.pixels[0].size)
 
     def publish_color(self, rgb: np.ndarray, now_ns: int) -> None:
         """Publish an RGB frame (H x W x 3 uint8, any strides) in the configured format, with noise, and its
