@@ -48,7 +48,7 @@ class PixelNoise:
     stddev are cut), shuffled with the camera's seeded generator. Each frame, every image row reads its
     noise from the table at an offset drawn anew from that generator: along a row, neighbouring values
     are different entries of the shuffled table; rows, and the same pixel in two frames, read at
-    independent offsets. Adding them is done in int16 blocks of rows that stay in the cache (~0.6 ms
+    independent offsets. Adding them is done in int16 blocks of rows that stay in the cache (~0.5 ms
     for 800x800 RGB). tests/test_cameras.py checks the mean, the stddev, the distribution of k, the
     clamping and the independence between neighbouring pixels, channels and frames.
     """
