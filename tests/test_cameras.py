@@ -398,3 +398,51 @@ def test_a_full_hd_camera_grows_the_framebuffer(tmp_path: Path):
     assert img.shape == (1080, 1920, 3)
     red = (img[..., 0] > 120) & (img[..., 1] < 60) & (img[..., 2] < 60)
     assert red[:, 800:1120].mean() > 0.1  # the red box ahead, in the middle: the whole image is rendered
+
+
+FAULTS = f"""
+name: t
+duration: 1.2
+rate: max
+seed: 2
+world:
+  models:
+    - {{name: red, shape: box, size: [0.4, 0.4, 0.4], pose: {{xyz: [1.5, 0, 0.2]}}, rgba: [1, 0, 0, 1]}}
+robots:
+  - name: r1
+    description: "{DIFFBOT}"
+    pose: {{xyz: [0, 0, 0.05]}}
+    plugins:
+      - type: camera
+        params: {{{CAM}, noise_stddev: 0.05}}
+      - name: late
+        type: camera
+        params: {{{CAM}, noise_stddev: 0.05, image_topic: late/image, info_topic: late/info}}
+events:
+  - name: f
+    when: {{at: 0.5}}
+    do:
+      - {{fault: {{topic: r1/camera/image_raw, freeze: true, duration: 0.3}}}}
+      - {{fault: {{topic: r1/late/image, delay: 0.15, duration: 0.3}}}}
+"""
+
+
+@pytest.mark.timeout(60)
+def test_faults_on_a_camera_keep_the_frames_they_hold(tmp_path: Path):
+    """A camera writes each frame into the same buffer and publishes it borrowed: a fault that keeps a frame
+    (freeze repeats the last one, delay holds them) keeps its own copy, not the buffer the next frame fills."""
+    path = tmp_path / "faults.yaml"
+    path.write_text(FAULTS)
+    _, bus = simulate(path)
+    frames = [(t, bytes(m.data)) for t, m in messages(bus, "r1/camera/image_raw")]
+    before = next(data for t, data in frames if t == 500_000_000)
+    during = [data for t, data in frames if 500_000_000 < t <= 800_000_000]
+    assert len(during) == 3 and set(during) == {before}
+    after = [data for t, data in frames if t > 800_000_000]
+    assert len(after) >= 3 and before not in after and len(set(after)) == len(after)
+    late = messages(bus, "r1/late/image")
+    held = [(t, m) for t, m in late if m.header.stamp.sec * 10**9 + m.header.stamp.nanosec != t]
+    assert len(held) == 3
+    stamps = [m.header.stamp.sec * 10**9 + m.header.stamp.nanosec for _t, m in held]
+    assert stamps == [600_000_000, 700_000_000, 800_000_000]
+    assert len({bytes(m.data) for _t, m in late}) == len(late)  # every frame its own noise, none overwritten
