@@ -220,6 +220,8 @@ def time_hooks(plan: RunPlan) -> tuple[dict[tuple[str, str, str], list[float]], 
     for hooks in (world._before, world._after):
         for h in hooks:
             plugin = h.fn.__self__  # type: ignore[attr-defined]  (a bound hook of a plugin)
+            if plugin not in world.plugins:  # the world's own feeds (the Foxglove scene): not a plugin
+                continue
             key = (plugin.name, plugin.ctx.robot.name, h.fn.__name__)
             h.fn = timed(h.fn, samples.setdefault(key, []))
     # Subscription callbacks of plugins (commands), delivered in the loop.
