@@ -131,6 +131,24 @@ def world_on_zenoh(plan: RunPlan) -> WorldStats:
             bus.undeclare_all()
 
 
+def gl_renderer() -> str:
+    """The OpenGL renderer cameras render with (e.g. 'llvmpipe (LLVM 15.0.6, 256 bits)' on the CPU, the GPU's
+    name on one), read from a context of the backend mujoco loaded; '' if unknown."""
+    try:
+        from OpenGL import GL
+
+        model = mujoco.MjModel.from_xml_string("<mujoco/>")
+        r = mujoco.Renderer(model, 8, 8)
+        try:
+            r._gl_context.make_current()
+            name = GL.glGetString(GL.GL_RENDERER)
+            return name.decode() if name else ""
+        finally:
+            r.close()
+    except Exception:
+        return ""
+
+
 def best(values: Sequence[float]) -> float:
     return max(values)
 
@@ -173,10 +191,12 @@ def say(text: str) -> None:
 
 
 def readme_tables(block: str) -> dict[str, str]:
-    """The tables between the README's bench markers, by section (the word before the first colon of each
-    `#### ` title)."""
+    """The tables between the README's bench markers, by section: each section starts at a title
+    `#### NAME: ...` (NAME a word, the section's) and holds every table up to the next section's."""
+    import re
+
     tables: dict[str, str] = {}
-    for part in ("\n" + block).split("\n#### ")[1:]:
-        name = part.split(":", 1)[0].strip()
-        tables[name] = ("#### " + part).strip()
+    starts = [m for m in re.finditer(r"^#### (\w+):", block, re.M)]
+    for m, nxt in zip(starts, [*starts[1:], None], strict=True):
+        tables[m.group(1)] = block[m.start() : nxt.start() if nxt else len(block)].strip()
     return tables

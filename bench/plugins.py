@@ -46,6 +46,7 @@ if "MUJOCO_GL" not in os.environ:
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
+from bench.common import gl_renderer  # noqa: E402
 from plugins._render import CameraRenderer, gl_backend_in_use  # noqa: E402
 from runner.compile import compile_plan  # noqa: E402
 from runner.plan import RunPlan  # noqa: E402
@@ -175,8 +176,8 @@ class DropBus(MemoryBus):
         self.bytes = 0
         self.count = 0
 
-    def publisher(self, key: str, type_name: str) -> Callable[[bytes, bytes], None]:
-        def send(payload: bytes, attachment: bytes) -> None:
+    def publisher(self, key: str, type_name: str) -> Callable[[bytes | bytearray, bytes], None]:
+        def send(payload: bytes | bytearray, attachment: bytes) -> None:
             self.bytes += len(payload)
             self.count += 1
 
@@ -219,6 +220,8 @@ def time_hooks(plan: RunPlan) -> tuple[dict[tuple[str, str, str], list[float]], 
     for hooks in (world._before, world._after):
         for h in hooks:
             plugin = h.fn.__self__  # type: ignore[attr-defined]  (a bound hook of a plugin)
+            if plugin not in world.plugins:  # the world's own feeds (the Foxglove scene): not a plugin
+                continue
             key = (plugin.name, plugin.ctx.robot.name, h.fn.__name__)
             h.fn = timed(h.fn, samples.setdefault(key, []))
     # Subscription callbacks of plugins (commands), delivered in the loop.
@@ -396,7 +399,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
             "mujoco": mujoco.__version__,
             "mujoco_gl": os.environ.get("MUJOCO_GL", ""),
             "gl_backend": gl_backend_in_use(),
-            "gl_renderer": _gl_renderer(),
+            "gl_renderer": gl_renderer(),
         },
         "repeat": args.repeat,
         "sim_seconds": args.seconds,
@@ -487,23 +490,6 @@ def _cpu_name() -> str:
     except OSError:
         pass
     return platform.processor() or platform.machine()
-
-
-def _gl_renderer() -> str:
-    """The OpenGL renderer string (e.g. 'llvmpipe (LLVM 15.0.6, 256 bits)'), or '' if unknown."""
-    try:
-        from OpenGL import GL
-
-        model = mujoco.MjModel.from_xml_string("<mujoco/>")
-        r = mujoco.Renderer(model, 8, 8)
-        try:
-            r._gl_context.make_current()
-            name = GL.glGetString(GL.GL_RENDERER)
-            return name.decode() if name else ""
-        finally:
-            r.close()
-    except Exception:
-        return ""
 
 
 if __name__ == "__main__":

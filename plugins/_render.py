@@ -5,8 +5,10 @@
 - the parameters every camera has (`CameraParams`) and mounting a MuJoCo camera with Gazebo's convention
   (`add_camera`);
 - `CameraRenderer`: one offscreen OpenGL context per camera, set up for speed (no MSAA, no shadows, no
-  reflections), giving RGB images and metric depth, both from one render where that gives the same depth;
-- ROS message builders: `Image`, `CameraInfo`, pixel formats and intensity noise.
+  reflections), giving RGB images and metric depth, both from one render where that gives the same depth,
+  as views of the pixels read (`rgb_view`, `rgbd_views`) that the camera writes straight into its messages;
+- ROS message builders: `Image`, `CameraInfo` (pixel formats, the noise and images encoded in place are in
+  `plugins._pixels`).
 
 Conventions. A Gazebo camera looks along its link's +X axis with +Z up; a MuJoCo camera looks along its
 own -Z with +Y up. Images are in the ROS optical frame (z forward, x right, y down; row 0 is the top).
@@ -302,7 +304,8 @@ class CameraRenderer:
         # OpenGL rows run bottom-up: pixels are read into these, then flipped into the outputs.
         self._raw_rgb = np.empty((height, width, 3), dtype=np.uint8)
         self._raw_depth = np.empty((height, width), dtype=np.float32)
-        self._depth64 = np.empty((height, width), dtype=np.float64)
+        self._depth64 = np.empty((min(height, 32), width), dtype=np.float64)  # a block of rows
+        self._beyond = np.empty((min(height, 32), width), dtype=bool)
         self._rgb = np.empty((height, width, 3), dtype=np.uint8)
         self._depth = np.empty((height, width), dtype=np.float32)
         self._clip = (np.float32(0.0), np.float32(0.0))
@@ -336,11 +339,27 @@ class CameraRenderer:
         np.copyto(self._rgb, self._raw_rgb[::-1])
         return self._rgb
 
-    def depth(self) -> np.ndarray:
+    def rgb_view(self) -> np.ndarray:
+        """`rgb()` without its copy: a view of the pixels as read, rows flipped (row 0 at the top; negative
+        strides). Valid until the next render: the camera writes it straight into its message."""
+        self._render(depth_too=False)
+        return self._raw_rgb[::-1]
+
+    def rgbd_views(self, depth_out: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """`rgbd()` with the colour image as `rgb_view()` gives it and the depth written into `depth_out`
+        (H x W float32, e.g. the depth message's pixels) when given."""
+        one = self._depth_same_in_color_render()
+        self._render(depth_too=one)
+        rgb = self._raw_rgb[::-1]
+        if not one:
+            self._render_depth()
+        return rgb, self._convert_depth(depth_out)
+
+    def depth(self, out: np.ndarray | None = None) -> np.ndarray:
         """Depth along the optical axis (metres, float32, H x W) of the last `update`: +inf where nothing
-        is within `far` (nothing maps to far). A buffer reused."""
+        is within `far` (nothing maps to far). A buffer reused, or `out`."""
         self._render_depth()
-        return self._convert_depth()
+        return self._convert_depth(out)
 
     def rgbd(self) -> tuple[np.ndarray, np.ndarray]:
         """`rgb()` and `depth()` of the last `update`, from one render when the depth buffer of the colour
@@ -385,25 +404,34 @@ class CameraRenderer:
         finally:
             flags[seg], flags[idc] = old
 
-    def _convert_depth(self) -> np.ndarray:
+    def _convert_depth(self, out: np.ndarray | None = None) -> np.ndarray:
         # mujoco.Renderer's conversion (reversed Z, float32 coefficients, float64 arithmetic, float32
-        # result), on the rows flipped top-down, into reused buffers.
+        # result), on the rows flipped top-down, into a reused buffer (or `out`), by blocks of rows that
+        # stay in the cache.
         znear, zfar = self._clip
-        d64 = self._depth64
         raw = self._raw_depth[::-1]
-        if self.scene.camera[0].orthographic:
-            np.multiply(raw, zfar - znear, out=d64, dtype=np.float64)
-            np.subtract(np.float64(zfar), d64, out=d64)
-        else:
+        depth = self._depth if out is None else out
+        ortho = bool(self.scene.camera[0].orthographic)
+        c_coef = d_coef = np.float32(0)
+        if not ortho:
             c_coef = -(zfar + znear) / (zfar - znear)
             d_coef = -(np.float32(2) * zfar * znear) / (zfar - znear)
             c_coef = np.float32(-0.5) * c_coef - np.float32(0.5)
             d_coef = np.float32(-0.5) * d_coef
-            np.add(raw, c_coef, out=d64, dtype=np.float64)
-            np.divide(np.float64(d_coef), d64, out=d64)
-        depth = self._depth
-        np.copyto(depth, d64, casting="same_kind")
-        np.copyto(depth, np.float32(np.inf), where=depth > np.float32(self.far))
+        far, inf = np.float32(self.far), np.float32(np.inf)
+        block = len(self._depth64)
+        for r0 in range(0, raw.shape[0], block):
+            r1 = min(raw.shape[0], r0 + block)
+            d64, beyond, o = self._depth64[: r1 - r0], self._beyond[: r1 - r0], depth[r0:r1]
+            if ortho:
+                np.multiply(raw[r0:r1], zfar - znear, out=d64, dtype=np.float64)
+                np.subtract(np.float64(zfar), d64, out=d64)
+            else:
+                np.add(raw[r0:r1], c_coef, out=d64, dtype=np.float64)
+                np.divide(np.float64(d_coef), d64, out=d64)
+            np.copyto(o, d64, casting="same_kind")
+            np.greater(o, far, out=beyond)
+            np.copyto(o, inf, where=beyond)
         return depth
 
     # ------------------------------------------------------------------------------------------ close
@@ -496,24 +524,6 @@ def image_msg(now_ns: int, frame_id: str, pixels: np.ndarray, encoding: str) -> 
         step=row.shape[1],
         data=row.reshape(-1),
     )
-
-
-def to_format(rgb: np.ndarray, fmt: str) -> np.ndarray:
-    """An RGB uint8 image in the pixel format `fmt` (`rgb8`, `bgr8` or `mono8`: ITU-R BT.601 luma)."""
-    if fmt == "rgb8":
-        return rgb.copy()
-    if fmt == "bgr8":
-        return np.ascontiguousarray(rgb[..., ::-1])
-    luma = rgb.astype(np.uint16) @ np.array([77, 150, 29], dtype=np.uint16)  # weights sum to 256
-    return ((luma + 128) >> 8).astype(np.uint8)
-
-
-def add_noise(img: np.ndarray, stddev: float, rng: np.random.Generator) -> np.ndarray:
-    """Gaussian noise on uint8 intensities, `stddev` in 0..1 units, clamped to 0..255."""
-    if stddev <= 0:
-        return img
-    noisy = img.astype(np.float32) + rng.normal(0.0, stddev * 255.0, img.shape).astype(np.float32)
-    return np.clip(np.rint(noisy), 0, 255).astype(np.uint8)
 
 
 def encoding_channels(fmt: str) -> int:

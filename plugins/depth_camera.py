@@ -24,7 +24,8 @@ from typing import Any, ClassVar
 import numpy as np
 from pydantic import Field
 
-from plugins._render import CAMERA_INFO, IMAGE, POINT_CLOUD, CameraParams, image_msg
+from plugins._pixels import ImageOut
+from plugins._render import CAMERA_INFO, IMAGE, POINT_CLOUD, CameraParams
 from plugins.camera import Camera
 from runner.plugin import Topic
 from runner.wire import msgs
@@ -89,6 +90,18 @@ class DepthCamera(Camera):
         self.fields = [Field_(name=n, offset=4 * i, datatype=_FLOAT32, count=1) for i, n in enumerate(names)]
         self.point_step = 4 * len(names)
         self.PointCloud2 = msgs.T[POINT_CLOUD]
+        # Each frame is written into its messages' bytes: the depth image, and the cloud's points
+        self.depth_out = ImageOut(self.depth_pub, self.frame_id, p.height, p.width, "32FC1")
+        self.depth_info_out = (
+            self.depth_info_pub.layout(self.make_info(0, self.frame_id), ["header.stamp"])
+            if self.depth_info_pub is not None
+            else None
+        )
+        if self.points_pub is not None:
+            template = self.point_cloud(0, np.zeros((p.height, p.width), np.float32), None)
+            self.points_out = self.points_pub.layout(template, ["header.stamp"])
+            data = self.points_out.view("data")
+            self.points = data.view(np.float32).reshape(p.height, p.width, len(names))
 
     def color_pubs(self) -> None:
         if self.params.publish_color:
@@ -99,33 +112,51 @@ class DepthCamera(Camera):
         assert self.renderer is not None
         self.renderer.update(self.ctx.data)
         rgb = None
+        depth = self.depth_out.pixels
         if p.publish_color:
             # one scene update, and one render for both when that gives the same depth (CameraRenderer.rgbd)
-            rgb, depth = self.renderer.rgbd()
+            rgb, _ = self.renderer.rgbd_views(depth)
             self.publish_color(rgb, now_ns)
         else:
-            depth = self.renderer.depth()
-        # the renderer reuses its buffer: the message gets its own copy
-        self.depth_pub.publish(image_msg(now_ns, self.frame_id, depth.copy(), "32FC1"), now_ns)
-        if self.depth_info_pub is not None:
-            self.depth_info_pub.publish(self.make_info(now_ns, self.frame_id), now_ns)
+            self.renderer.depth(depth)
+        self.depth_pub.publish_cdr(self.depth_out.payload(now_ns), now_ns)
+        if self.depth_info_out is not None:
+            assert self.depth_info_pub is not None
+            self.depth_info_pub.publish_cdr(self.depth_info_out.encode(now_ns), now_ns)
         if self.points_pub is not None:
-            self.points_pub.publish(self.point_cloud(now_ns, depth, rgb), now_ns)
+            self.fill_points(self.points, depth, rgb)
+            self.points_pub.publish_cdr(self.points_out.fill(now_ns), now_ns)
+
+    def fill_points(self, buf: np.ndarray, depth: np.ndarray, rgb: np.ndarray | None) -> np.ndarray:
+        """An organized cloud's points (H x W x fields float32) in the optical frame from a depth image (and
+        colours), written into `buf` by blocks of rows that stay in the cache; NaN where no return."""
+        h, w = depth.shape
+        block = min(h, 32)
+        if getattr(self, "_scratch", None) is None or self._scratch[0].shape != (block, w):
+            self._scratch = (np.empty((block, w), np.float32), np.empty((block, w), bool))
+        z_all, finite_all = self._scratch
+        packed = buf.view(np.uint8).reshape(h, w, self.point_step)[..., 12:16] if rgb is not None else None
+        nan = np.float32(np.nan)
+        for r0 in range(0, h, block):
+            r1 = min(h, r0 + block)
+            d, z, finite, b = depth[r0:r1], z_all[: r1 - r0], finite_all[: r1 - r0], buf[r0:r1]
+            np.isfinite(d, out=finite)
+            z.fill(nan)
+            np.copyto(z, d, where=finite)
+            b[..., 2] = z
+            np.multiply(self.ray_x, z, out=b[..., 0])
+            np.multiply(self.ray_y[r0:r1], z, out=b[..., 1])
+            if packed is not None and rgb is not None:
+                # float32 `rgb` holding 0x00RRGGBB, little-endian: bytes B, G, R, 0
+                p = packed[r0:r1]
+                p[..., :3] = rgb[r0:r1, :, ::-1]
+                p[..., 3] = 0
+        return buf
 
     def point_cloud(self, now_ns: int, depth: np.ndarray, rgb: np.ndarray | None) -> Any:
-        """An organized cloud in the optical frame from a depth image (and colours); NaN where no return."""
+        """An organized cloud in the optical frame from a depth image (and colours), as a message."""
         h, w = depth.shape
-        buf = np.empty((h, w, self.point_step // 4), dtype=np.float32)
-        z = buf[..., 2]
-        np.copyto(z, depth)
-        np.copyto(z, np.float32(np.nan), where=~np.isfinite(depth))
-        np.multiply(self.ray_x, z, out=buf[..., 0])
-        np.multiply(self.ray_y, z, out=buf[..., 1])
-        if rgb is not None:
-            # float32 `rgb` holding 0x00RRGGBB, little-endian: bytes B, G, R, 0
-            packed = buf.view(np.uint8).reshape(h, w, self.point_step)[..., 12:16]
-            packed[..., :3] = rgb[..., ::-1]
-            packed[..., 3] = 0
+        buf = self.fill_points(np.empty((h, w, self.point_step // 4), dtype=np.float32), depth, rgb)
         return self.PointCloud2(
             header=msgs.header(now_ns, self.frame_id),
             height=h,

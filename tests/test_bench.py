@@ -100,3 +100,30 @@ def test_the_readme_bench_tables_describe_what_the_demo_publishes_now(tmp_path: 
         f"the README's two_robots table says {per_s} messages per sim second; the demo records {now:.0f} now: "
         "regenerate it with `python -m bench --only two_robots --readme` on a quiet machine"
     )
+
+
+@pytest.mark.timeout(120)
+def test_the_camera_bound_renders_each_declared_camera_at_its_size_and_rate() -> None:
+    """bench/cameras.py's rendering bound for a seed's camera robot: every camera of the scenario, at its
+    declared size, for as many frames as its rate gives; and the GL renderer it reports."""
+    import os
+
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    from bench import cameras as bc
+    from bench.common import REPO as repo
+    from bench.common import gl_renderer, plan_from_file
+
+    plan = plan_from_file(repo / "scenarios" / "block_robot.yaml", seconds=0.2)
+    specs = bc.camera_specs(plan)
+    assert [(s.name, s.width, s.height, s.rate, s.depth, s.noise) for s in specs] == [
+        ("br/vislight_cam_camera", 800, 800, 30.0, False, 0.007),
+        ("br1/vislight_cam_camera", 800, 800, 30.0, False, 0.007),
+    ]
+    bound = bc.render_bound(plan, 0.2)
+    assert [(c["size"], c["frames"]) for c in bound["cameras"]] == [("800x800", 6), ("800x800", 6)]
+    assert bound["wall_s"] > 0 and bound["one_pass_wall_s"] > 0
+    frame = bc.rendered_frame(plan)
+    assert frame.shape == (800, 800, 3) and 20 < frame.mean() < 235  # the ground and the sky, not blank
+    cost = bc.noise_cost(80, 60, 0.007, repeat=2)
+    assert cost["noisy_ms"] > 0 and cost["plain_ms"] > 0
+    assert gl_renderer()  # e.g. llvmpipe here, the GPU's name where EGL finds one

@@ -7,6 +7,7 @@ import os
 # MuJoCo picks its GL backend when it is first imported: headless EGL unless the user chose one.
 os.environ.setdefault("MUJOCO_GL", "egl")
 
+import itertools
 import math
 import textwrap
 from pathlib import Path
@@ -14,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from plugins._pixels import PixelNoise, add_noise
 from runner.errors import ScenarioError
 from tests.conftest import DIFFBOT
 from tests.helpers import messages, plan_of, simulate
@@ -136,6 +138,103 @@ def test_intensity_noise_has_the_requested_stddev(static):
     assert inside.sum() > 10_000
     assert abs(err.mean()) < 0.5
     assert 0.9 * 0.05 * 255 < err.std() < 1.1 * 0.05 * 255
+
+
+@pytest.mark.timeout(60)
+def test_noise_is_independent_between_frames_and_neighbours_in_a_real_run(static):
+    """The noisy camera and the clean one see the same frames: their difference is the noise alone."""
+    clean = dict(messages(static, "r1/camera/image_raw"))
+    noisy = messages(static, "r1/noisy/image")
+    assert len(noisy) >= 4
+    fields = []
+    for t, msg in noisy:
+        c = _image(clean[t]).astype(float)
+        fields.append((_image(msg).astype(float) - c, (c > 60) & (c < 195)))
+    for (a, ia), (b, ib) in itertools.pairwise(fields):
+        both = ia & ib
+        assert both.sum() > 10_000
+        assert abs(np.corrcoef(a[both], b[both])[0, 1]) < 0.03  # the same pixel in consecutive frames
+    err, inside = fields[-1]
+    right = inside[:, :-1] & inside[:, 1:]
+    below = inside[:-1] & inside[1:]
+    assert abs(np.corrcoef(err[:, :-1][right], err[:, 1:][right])[0, 1]) < 0.03
+    assert abs(np.corrcoef(err[:-1][below], err[1:][below])[0, 1]) < 0.03
+    assert not np.array_equal(fields[0][0], fields[1][0])
+
+
+def _noise_frames(stddev: float, value: int, frames: int, shape=(120, 200, 3), seed: int = 7) -> np.ndarray:
+    noise = PixelNoise(stddev, np.random.default_rng(seed))
+    img = np.full(shape, value, dtype=np.uint8)
+    out = np.empty((frames, *shape), dtype=np.uint8)
+    for i in range(frames):
+        noise.apply(img[::-1], out[i])  # a flipped view, as the camera hands it over
+    return out
+
+
+def _corr(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.corrcoef(a.reshape(-1), b.reshape(-1))[0, 1])
+
+
+@pytest.mark.parametrize("stddev", [0.007, 0.05, 0.3])
+def test_pixel_noise_has_gazebos_statistics(stddev: float):
+    """Gazebo's camera noise: N(0, stddev) (x 255) added to each channel of each pixel, the result rounded
+    and clamped. Away from 0 and 255: the integer noise k has P(k) = Phi((k+.5)/s) - Phi((k-.5)/s), mean 0,
+    and it is independent between neighbouring pixels (across, down), channels and frames."""
+    frames = _noise_frames(stddev, 128, 40).astype(np.int16) - 128
+    n = frames.size
+    s = stddev * 255
+    ks = np.arange(-128, 128)  # 128 + k clamped to 0..255: k = -128 is P(x < -127.5), k = 127 P(x >= 126.5)
+    cdf = np.array([0.5 * math.erfc(-(k + 0.5) / (s * math.sqrt(2))) for k in ks])
+    p = np.diff(cdf, prepend=0.0)
+    p[-1] += 1.0 - cdf[-1]
+    want_std = math.sqrt(float((p * ks**2).sum() - (p * ks).sum() ** 2))
+    assert abs(frames.mean()) < 5 * want_std / math.sqrt(n)
+    assert abs(frames.std() / want_std - 1) < 0.01
+    counts = np.bincount((frames.reshape(-1) + 128).astype(np.int64), minlength=256)
+    expected = p * n
+    big = expected > 100
+    assert np.all(np.abs(counts[big] - expected[big]) < 6 * np.sqrt(expected[big]))
+    assert counts[expected < 1e-3].sum() <= 2  # nothing where Gazebo's noise (almost) never goes
+    for a, b in (
+        (frames[:, :, :-1], frames[:, :, 1:]),  # the next pixel along a row
+        (frames[:, :-1], frames[:, 1:]),  # the pixel below
+        (frames[..., 0], frames[..., 1]),  # another channel of the same pixel
+        (frames[:-1], frames[1:]),  # the same pixel in the next frame
+        (frames[:-2], frames[2:]),
+    ):
+        assert abs(_corr(a, b)) < 0.005
+
+
+def test_pixel_noise_clamps_as_gazebo_and_is_deterministic():
+    s = 0.05 * 255
+    for value, sign in ((0, 1), (255, -1)):
+        out = _noise_frames(0.05, value, 10).astype(float)
+        ks = np.arange(0, 128)  # E[max(0, k)] at 0 (and E[min(0, k)] at 255, by symmetry)
+        cdf = np.array([0.5 * math.erfc(-(k + 0.5) / (s * math.sqrt(2))) for k in ks])
+        p = np.diff(cdf, prepend=0.5)
+        want = float((p * ks).sum())
+        assert abs(sign * (out.mean() - value) - want) < 0.05
+        assert ((out == value).mean() - cdf[0]) ** 2 < 1e-4  # clamped: k <= 0 all read 0 (or 255)
+    a, b = _noise_frames(0.05, 100, 3), _noise_frames(0.05, 100, 3)
+    assert np.array_equal(a, b)  # the scenario's seed decides
+    assert not np.array_equal(a, _noise_frames(0.05, 100, 3, seed=8))
+    assert not np.array_equal(a[0], a[1])
+
+
+def test_pixel_noise_matches_drawing_each_value_with_rng_normal():
+    """Against the reference (`add_noise`: rng.normal per value, rounded, clamped) on a real image's
+    range of values: the same mean and stddev of the result, value by value of the input."""
+    rng = np.random.default_rng(5)
+    img = rng.integers(0, 256, (150, 200, 3), dtype=np.uint8)
+    stddev = 0.02
+    noise = PixelNoise(stddev, np.random.default_rng(6))
+    fast = np.stack([noise.apply(img, np.empty_like(img)) for _ in range(12)]).astype(float)
+    slow = np.stack([add_noise(img, stddev, rng) for _ in range(12)]).astype(float)
+    for lo, hi in ((0, 3), (3, 252), (252, 256)):
+        sel = np.broadcast_to((img >= lo) & (img < hi), fast.shape)
+        d_fast, d_slow = (fast - img)[sel], (slow - img)[sel]
+        assert abs(d_fast.mean() - d_slow.mean()) < 0.05
+        assert abs(d_fast.std() / d_slow.std() - 1) < 0.02
 
 
 @pytest.mark.timeout(60)
@@ -299,3 +398,51 @@ def test_a_full_hd_camera_grows_the_framebuffer(tmp_path: Path):
     assert img.shape == (1080, 1920, 3)
     red = (img[..., 0] > 120) & (img[..., 1] < 60) & (img[..., 2] < 60)
     assert red[:, 800:1120].mean() > 0.1  # the red box ahead, in the middle: the whole image is rendered
+
+
+FAULTS = f"""
+name: t
+duration: 1.2
+rate: max
+seed: 2
+world:
+  models:
+    - {{name: red, shape: box, size: [0.4, 0.4, 0.4], pose: {{xyz: [1.5, 0, 0.2]}}, rgba: [1, 0, 0, 1]}}
+robots:
+  - name: r1
+    description: "{DIFFBOT}"
+    pose: {{xyz: [0, 0, 0.05]}}
+    plugins:
+      - type: camera
+        params: {{{CAM}, noise_stddev: 0.05}}
+      - name: late
+        type: camera
+        params: {{{CAM}, noise_stddev: 0.05, image_topic: late/image, info_topic: late/info}}
+events:
+  - name: f
+    when: {{at: 0.5}}
+    do:
+      - {{fault: {{topic: r1/camera/image_raw, freeze: true, duration: 0.3}}}}
+      - {{fault: {{topic: r1/late/image, delay: 0.15, duration: 0.3}}}}
+"""
+
+
+@pytest.mark.timeout(60)
+def test_faults_on_a_camera_keep_the_frames_they_hold(tmp_path: Path):
+    """A camera writes each frame into the same buffer and publishes it borrowed: a fault that keeps a frame
+    (freeze repeats the last one, delay holds them) keeps its own copy, not the buffer the next frame fills."""
+    path = tmp_path / "faults.yaml"
+    path.write_text(FAULTS)
+    _, bus = simulate(path)
+    frames = [(t, bytes(m.data)) for t, m in messages(bus, "r1/camera/image_raw")]
+    before = next(data for t, data in frames if t == 500_000_000)
+    during = [data for t, data in frames if 500_000_000 < t <= 800_000_000]
+    assert len(during) == 3 and set(during) == {before}
+    after = [data for t, data in frames if t > 800_000_000]
+    assert len(after) >= 3 and before not in after and len(set(after)) == len(after)
+    late = messages(bus, "r1/late/image")
+    held = [(t, m) for t, m in late if m.header.stamp.sec * 10**9 + m.header.stamp.nanosec != t]
+    assert len(held) == 3
+    stamps = [m.header.stamp.sec * 10**9 + m.header.stamp.nanosec for _t, m in held]
+    assert stamps == [600_000_000, 700_000_000, 800_000_000]
+    assert len({bytes(m.data) for _t, m in late}) == len(late)  # every frame its own noise, none overwritten

@@ -8,6 +8,7 @@ import io
 import struct
 from pathlib import Path
 
+import numpy as np
 import pytest
 import zenoh
 import zstandard
@@ -138,10 +139,16 @@ def test_mcap_layout_chunks_indexes_and_summary(tmp_path: Path):
                     assert decoded.linear.x == 1.5
             assert times == expected, reader_class
 
+    assert _check_chunks(path, min_chunks=10) == sum(map(len, expected.values()))
+
+
+def _check_chunks(path: Path, min_chunks: int) -> int:
+    """Each chunk's CRC-checked records decompress to its size, and each message index entry points at its
+    message; returns how many messages the indexes hold (= the statistics' count)."""
     raw = path.read_bytes()
     with open(path, "rb") as f:
         s = make_reader(f).get_summary()
-    assert s is not None and s.statistics is not None and len(s.chunk_indexes) > 10
+    assert s is not None and s.statistics is not None and len(s.chunk_indexes) > min_chunks
     indexed = 0
     for ci in s.chunk_indexes:
         body = raw[ci.chunk_start_offset + 9 : ci.chunk_start_offset + ci.chunk_length]
@@ -163,7 +170,59 @@ def test_mcap_layout_chunks_indexes_and_summary(tmp_path: Path):
                 assert start <= t <= end
                 indexed += 1
         assert lengths == ci.message_index_length
-    assert indexed == s.statistics.message_count == sum(map(len, expected.values()))
+    assert indexed == s.statistics.message_count
+    return indexed
+
+
+def test_messages_larger_than_a_chunk_are_chunks_of_their_own(tmp_path: Path):
+    """A message as large as a chunk (a camera frame) is written as a chunk of its own straight from the
+    received bytes (no copy into the chunk buffer): between small messages, first on its channel (the
+    channel's record goes in its chunk), and larger than the gathered-write threshold; all read back whole,
+    in order, by every reader, CRCs checked."""
+    path = tmp_path / "large.mcap"
+    rec = Recorder(path, ["r/**"], chunk_size=4096)
+    twist = _twists(1)[0]
+    image = "sensor_msgs/msg/Image"
+    rng = np.random.default_rng(3)
+
+    def frame(n: int, i: int) -> bytes:
+        pixels = rng.integers(0, 256, n, dtype=np.uint8)
+        msg = msgs.T[image](
+            header=msgs.header(i, "cam"),
+            height=1,
+            width=n,
+            encoding="mono8",
+            is_bigendian=0,
+            step=n,
+            data=pixels,
+        )
+        return msgs.encode(msg, image)
+
+    sent: dict[str, list[bytes]] = {"r/a/cmd": [], "r/cam/image": [], "r/big/image": []}
+    for i in range(40):
+        if i % 4 == 0:  # the first message of all: its schema and channel records are in its chunk
+            payload = frame(5000 + i, i)
+            rec.write("r/cam/image", image, payload, (i, i * 1000))
+            sent["r/cam/image"].append(payload)
+        rec.write("r/a/cmd", "geometry_msgs/msg/Twist", twist, (i, i * 1000 + 1))
+        sent["r/a/cmd"].append(twist)
+        if i in (7, 30):  # beyond 4 MiB compressed: written as gathered pieces
+            payload = frame(5 * 1024 * 1024, i)
+            rec.write("r/big/image", image, payload, (i, i * 1000 + 2))
+            sent["r/big/image"].append(payload)
+    rec.close()
+    for reader_class in (SeekingReader, NonSeekingReader):
+        with open(path, "rb") as f:
+            got: dict[str, list[bytes]] = {k: [] for k in sent}
+            order = []
+            for _, channel, message in reader_class(f, validate_crcs=True).iter_messages(
+                log_time_order=False
+            ):
+                got[channel.topic].append(message.data)
+                order.append(message.log_time)
+            assert got == sent, reader_class
+            assert order == sorted(order)
+    assert _check_chunks(path, min_chunks=12) == sum(map(len, sent.values()))
 
 
 def _twists(n: int) -> list[bytes]:

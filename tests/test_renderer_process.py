@@ -101,3 +101,81 @@ def test_a_renderer_that_dies_fails_the_run_and_keeps_the_recording(write_scenar
     assert "Traceback" not in err
     frames = _frames(mcap)  # finished and readable
     assert frames.get("cams/r1/camera/image_raw"), sorted(frames)
+
+
+LARGE = """
+name: big
+duration: 0.5
+rate: max
+seed: 5
+renderers: world
+world:
+  models:
+    - {name: crate, shape: box, size: [0.5, 0.5, 0.5], pose: {xyz: [1.0, 0.2, 0.25]}, rgba: [0.8, 0.3, 0.1, 1]}
+robots:
+  - name: r1
+    description: {file: "{diffbot}"}
+    pose: {xyz: [0, 0, 0.06]}
+    plugins:
+      - {type: diff_drive}
+      - {type: camera, params: {link: lidar_link, pose: {xyz: [0.04, 0, 0]}, width: 400, height: 300,
+          rate: 10, noise_stddev: 0.007}}
+      - {type: depth_camera, params: {link: lidar_link, width: 200, height: 150, rate: 10,
+          image_topic: rgbd/image, info_topic: rgbd/camera_info}}
+timeline:
+  - {t: 0.05, topic: r1/cmd_vel, type: geometry_msgs/msg/Twist, data: {angular: {z: 1.0}}}
+"""
+
+
+@pytest.mark.timeout(120)
+def test_large_frames_go_through_shared_memory_into_the_recording_unchanged(
+    write_scenario, tmp_path: Path
+) -> None:
+    """Frames over the shared-memory threshold (RGB 360 KB and 90 KB, points 480 KB, depth 120 KB), written
+    in place into reused buffers, sent from Zenoh's shared memory, the largest recorded as chunks of their
+    own: the MCAP holds, frame by frame, the bytes the same world publishes in-process (seeded noise, same
+    poses)."""
+    from runner.wire.transport import SHM_MIN_BYTES
+    from tests.helpers import simulate
+
+    path = write_scenario(LARGE, "big.yaml")
+    mcap = tmp_path / "big.mcap"
+    proc = run_cli("run", str(path), "--record", str(mcap), "-q", timeout=100)
+    assert proc.returncode == 0, proc.stderr
+    recorded: dict[str, list[tuple[int, bytes]]] = {}
+    with open(mcap, "rb") as f:
+        for _, channel, message in make_reader(f).iter_messages():
+            recorded.setdefault(channel.topic, []).append((message.log_time, bytes(message.data)))
+    _, bus = simulate(path)
+    published: dict[str, list[bytes]] = {}
+    for key, _type, payload, _att in bus.sent:
+        published.setdefault(key, []).append(payload)
+    big = [k for k, v in published.items() if len(v[0]) >= SHM_MIN_BYTES]
+    assert sorted(big) == [
+        "big/r1/camera/depth/image_raw",
+        "big/r1/camera/image_raw",
+        "big/r1/camera/points",
+        "big/r1/rgbd/image",
+    ]
+    for key in big:
+        frames = [data for _, data in recorded[key]]
+        assert len(frames) == 6, key
+        assert frames == published[key], key
+        assert len(set(frames)) == 6, key  # the robot turns and the noise is new: every frame differs
+
+
+def test_shared_memory_sender_copies_once_and_steps_aside_when_it_cannot() -> None:
+    """A large payload is copied into a shared-memory buffer (sent from there); a pool too small for it, or
+    one whose buffers are all still held by subscribers, gives None: the bytes are put as they are."""
+    from runner.wire.transport import SharedMemorySender
+
+    payload = bytearray(range(256)) * 800  # 200 KB
+    sender = SharedMemorySender(pool_bytes=1 << 20)
+    held = [sender.buffer(payload) for _ in range(5)]
+    assert all(b is not None and bytes(b) == payload for b in held)
+    assert sender.buffer(payload) is None  # all 1 MB held
+    assert (sender.sent, sender.fallbacks, sender.ok) == (5, 1, True)
+    del held
+    assert sender.buffer(payload) is not None  # freed buffers are taken again
+    small = SharedMemorySender(pool_bytes=500_000)
+    assert small.buffer(payload) is None and not small.ok  # a pool for fewer than 4 frames is not used

@@ -112,21 +112,22 @@ class Publisher:
         key: str,
         type_name: str,
         send: Callable[[Any, int], None],
-        send_cdr: Callable[[bytes, int], None] | None = None,
+        send_cdr: Callable[[bytes | bytearray, int], None] | None = None,
     ):
         self.key = key
         self.type = type_name
         # the sender's own functions, bound as attributes: no extra call per message
         self.publish: Callable[[Any, int], None] = send
         if send_cdr is not None:
-            self.publish_cdr: Callable[[bytes, int], None] = send_cdr
+            self.publish_cdr: Callable[[bytes | bytearray, int], None] = send_cdr
 
     def publish(self, msg: Any, stamp_ns: int) -> None:  # type: ignore[no-redef]  # replaced in __init__
         """Publish a rosbags message object of this topic's type."""
         raise NotImplementedError
 
-    def publish_cdr(self, payload: bytes, stamp_ns: int) -> None:  # type: ignore[no-redef]
-        """Publish bytes that are already the CDR encoding of a message of this topic's type."""
+    def publish_cdr(self, payload: bytes | bytearray, stamp_ns: int) -> None:  # type: ignore[no-redef]
+        """Publish bytes that are already the CDR encoding of a message of this topic's type. A `bytearray`
+        is borrowed (`Layout.fill`): sent at once, copied only where it is kept, free to reuse after."""
         from runner.wire import msgs
 
         self.publish(msgs.decode(payload, self.type), stamp_ns)

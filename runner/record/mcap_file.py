@@ -159,6 +159,9 @@ class McapFile:
         return ch
 
     def add_message(self, ch: RecordedChannel, sequence: int, stamp: int, data: bytes) -> None:
+        if len(data) >= self.chunk_size:
+            self._add_large(ch, sequence, stamp, data)
+            return
         chunk = self.chunk
         offset = len(chunk)
         # packed first: a stamp that does not fit (negative) raises before anything changed
@@ -168,6 +171,21 @@ class McapFile:
         ch.index.append(offset)
         if len(chunk) >= self.chunk_size:
             self.flush_chunk()
+
+    def _add_large(self, ch: RecordedChannel, sequence: int, stamp: int, data: bytes) -> None:
+        """A message as large as a chunk (a camera frame) is a chunk of its own, after the one being built,
+        compressed and written from `data` itself: never copied into the chunk buffer."""
+        head = _MESSAGE_HEAD.pack(_OP_MESSAGE, _MESSAGE_FIXED + len(data), ch.id, sequence, stamp, stamp)
+        self.flush_chunk()
+        if self.chunk:
+            # schemas and channels registered since the last chunk (no message of theirs yet) go first
+            head = bytes(self.chunk) + head
+            self.chunk.clear()
+        offset = len(head) - _MESSAGE_HEAD.size
+        index = array("Q", [stamp, offset])
+        if sys.byteorder != "little":
+            index.byteswap()
+        self._write_chunk([head, data], stamp, stamp, [(ch.id, index.tobytes())])
 
     def flush_chunk(self) -> None:
         """Compress the chunk being built and write it, then its message indexes."""
@@ -185,30 +203,42 @@ class McapFile:
                 entries.byteswap()
             indexes.append((ch.id, entries.tobytes()))
             del entries[:]
-        self._write_chunk(self.chunk, start, end, indexes)
+        self._write_chunk([self.chunk], start, end, indexes)
         self.chunk.clear()
 
-    def _write_chunk(self, chunk: bytearray, start: int, end: int, indexes: list[tuple[int, bytes]]) -> None:
-        compressed = self._zstd.compress(chunk)
+    def _write_chunk(
+        self, parts: list[bytes | bytearray], start: int, end: int, indexes: list[tuple[int, bytes]]
+    ) -> None:
+        """Write a chunk whose records are `parts` (in order; compressed as one), then its indexes."""
+        size = sum(len(part) for part in parts)
+        if len(parts) == 1:
+            compressed = [self._zstd.compress(parts[0])]
+            crc = zlib.crc32(parts[0])
+        else:
+            stream = self._zstd.compressobj(size=size)
+            compressed = [stream.compress(part) for part in parts]
+            compressed.append(stream.flush())
+            crc = 0
+            for part in parts:
+                crc = zlib.crc32(part, crc)
+        compressed_size = sum(len(c) for c in compressed)
         chunk_start = self._pos
-        out = bytearray(
-            _CHUNK_HEAD.pack(
-                int(Opcode.CHUNK),
-                _CHUNK_HEAD.size - 9 + len(compressed),
-                start,
-                end,
-                len(chunk),
-                zlib.crc32(chunk),
-                len(_ZSTD),
-                _ZSTD,
-                len(compressed),
-            )
+        head = _CHUNK_HEAD.pack(
+            int(Opcode.CHUNK),
+            _CHUNK_HEAD.size - 9 + compressed_size,
+            start,
+            end,
+            size,
+            crc,
+            len(_ZSTD),
+            _ZSTD,
+            compressed_size,
         )
-        out += compressed
-        chunk_length = len(out)
+        chunk_length = len(head) + compressed_size
+        out = bytearray()
         offsets: dict[int, int] = {}
         for channel_id, data in indexes:
-            offsets[channel_id] = chunk_start + len(out)
+            offsets[channel_id] = chunk_start + chunk_length + len(out)
             out += _MESSAGE_INDEX_HEAD.pack(int(Opcode.MESSAGE_INDEX), 6 + len(data), channel_id, len(data))
             out += data
         counts = {cid: len(data) // 16 for cid, data in indexes}  # (stamp, offset) pairs
@@ -218,15 +248,19 @@ class McapFile:
             chunk_start_offset=chunk_start,
             chunk_length=chunk_length,
             message_index_offsets=offsets,
-            message_index_length=len(out) - chunk_length,
+            message_index_length=len(out),
             compression=_ZSTD.decode(),
-            compressed_size=len(compressed),
-            uncompressed_size=len(chunk),
+            compressed_size=compressed_size,
+            uncompressed_size=size,
         )
         # One write, over the previous trailer: the chunk, its indexes and a new trailer. Handed to the OS
         # with every chunk, so a runner killed outright (kill -9) leaves a file that any MCAP reader reads
-        # up to its last chunk, which the guard then completes with its summary.
-        self._write_trailed(out)
+        # up to its last chunk, which the guard then completes with its summary. The pieces go to the OS
+        # as they are (one gathered write): the compressed data is not copied into one buffer first.
+        if len(compressed) == 1 and compressed_size < 4 * 1024 * 1024:
+            self._write_trailed(bytearray(head) + compressed[0] + out)
+        else:
+            self._write_trailed_parts([head, *compressed, out])
         index_record = _record_bytes(index)
         self._written.append((chunk_start, end, counts))
         tail = self._tail
@@ -246,6 +280,34 @@ class McapFile:
         without an index."""
         data += TRAILER
         self._write(data)
+        self._stream.seek(-len(TRAILER), os.SEEK_CUR)
+        self._pos -= len(TRAILER)
+
+    def _write_trailed_parts(self, parts: list[bytes | bytearray]) -> None:
+        """`_write_trailed` of the concatenation of `parts`, without concatenating them: one gathered write
+        (`os.writev`) where the stream has a file descriptor, else one write per part."""
+        parts = [*parts, TRAILER]
+        total = sum(len(part) for part in parts)
+        try:
+            fd = self._stream.fileno()
+        except (AttributeError, OSError):
+            fd = None
+        if fd is None:
+            for part in parts:
+                self._write(part)
+        else:
+            self._stream.flush()
+            views = [memoryview(part) for part in parts if len(part)]
+            while views:
+                n = os.writev(fd, views)
+                if n == 0:
+                    raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+                while views and n >= len(views[0]):
+                    n -= len(views[0])
+                    views.pop(0)
+                if n:
+                    views[0] = views[0][n:]
+            self._pos += total
         self._stream.seek(-len(TRAILER), os.SEEK_CUR)
         self._pos -= len(TRAILER)
 

@@ -34,7 +34,7 @@ class Fault:
         self.delay_ns = int(spec.get("delay_ns") or 0)
         self.noise = spec.get("noise")
         self.fields = spec.get("fields")
-        self.frozen = out.last if spec.get("freeze") else None
+        self.frozen = bytes(out.last) if spec.get("freeze") and out.last is not None else None
         self.freeze = bool(spec.get("freeze"))
         self.held: deque[tuple[int, bytes, Any]] = deque()
         self.until_ns = now_ns + spec["duration_ns"] if spec.get("duration_ns") else None

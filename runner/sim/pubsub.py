@@ -31,14 +31,14 @@ class Outgoing:
 
     __slots__ = ("fault", "key", "last", "local", "send", "seq", "type")
 
-    def __init__(self, key: str, type_name: str, send: Callable[[bytes, bytes], None]):
+    def __init__(self, key: str, type_name: str, send: Callable[[bytes | bytearray, bytes], None]):
         self.key = key
         self.type = type_name
         self.send = send
         self.seq = 0
         self.local: list[Local] = []
         self.fault: Any = None
-        self.last: bytes | None = None  # the last message sent (what a `freeze` fault repeats)
+        self.last: bytes | bytearray | None = None  # the last message sent (what a `freeze` fault repeats)
 
     def publish(self, msg: Any, stamp_ns: int) -> None:
         self.publish_encoded(msgs.encode(msg, self.type), msg, stamp_ns)
@@ -50,19 +50,25 @@ class Outgoing:
         else:
             self.deliver(payload, msg, stamp_ns)
 
-    def publish_cdr(self, payload: bytes, stamp_ns: int) -> None:
+    def publish_cdr(self, payload: bytes | bytearray, stamp_ns: int) -> None:
+        """Send CDR bytes. A `bytearray` is borrowed (a camera's frame, encoded in place and rewritten for
+        the next one): the bus copies it once as it sends it, and it is copied here only where it is kept
+        (a fault holding it, a subscriber in this process)."""
         if self.fault is not None:
-            self.fault.take(self, payload, None, stamp_ns)
+            self.fault.take(self, bytes(payload), None, stamp_ns)
         else:
             self.deliver(payload, None, stamp_ns)
 
-    def deliver(self, payload: bytes, msg: Any, stamp_ns: int) -> None:
+    def deliver(self, payload: bytes | bytearray, msg: Any, stamp_ns: int) -> None:
         """Send, and hand to subscribers in this process (`msg`, or `payload` decoded when there is one);
         past any fault: what `publish` sends without one, and what a fault lets through or releases late."""
         self.send(payload, _ATT.pack(self.seq, stamp_ns))
         self.seq += 1
+        # a borrowed buffer still holds this message when a fault starts (faults start between frames)
         self.last = payload
         if self.local:
+            if msg is None and not isinstance(payload, bytes):
+                payload = bytes(payload)  # (a borrowed buffer, written again by the next message)
             for _type, cb, peek in self.local:
                 if msg is None:
                     if peek is not None:  # (it reads only the fields it needs)

@@ -86,6 +86,15 @@ class Layout:
             write(value)
         return bytes(self.buf)
 
+    def fill(self, *values: Any) -> bytearray:
+        """`encode` without the copy: `values` written into `fields`, and the buffer itself returned. It is
+        borrowed: the next `fill`/`encode` (or a write through a `view`) changes it. For large messages
+        (camera frames) whose publisher hands the bytes on at once (`Publisher.publish_cdr` copies a
+        `bytearray` where it keeps one)."""
+        for write, value in zip(self._writers, values, strict=True):
+            write(value)
+        return self.buf
+
     def _make_stamp_only(self, off: int) -> Callable[[int], bytes]:
         """The common case (a stamp; the numbers written through views): one pack and one copy."""
         buf, pack = self.buf, _TIME.pack_into

@@ -144,11 +144,65 @@ def use_run_settings(settings: dict[str, Any] | None) -> None:
 class Bus(Protocol):
     """What the world process publishes on and listens to. `ZenohBus` in runs; `MemoryBus` in unit tests."""
 
-    def publisher(self, key: str, type_name: str) -> Callable[[bytes, bytes], None]: ...
+    def publisher(self, key: str, type_name: str) -> Callable[[bytes | bytearray, bytes], None]: ...
 
     def subscribe(
         self, key: str, callback: Callable[[str, bytes, bytes | None], None], type_name: str | None = None
     ) -> None: ...
+
+
+# Payloads at least this large (camera frames, point clouds) are copied once into Zenoh's shared memory
+# and sent from there: a subscriber on this host maps them, one on another host gets them over the network
+# as usual. Smaller ones are put as bytes (Zenoh copies them into its own buffer).
+SHM_MIN_BYTES = 64 * 1024
+SHM_POOL_BYTES = 64 * 1024 * 1024
+
+
+class SharedMemorySender:
+    """Copies large payloads into a Zenoh shared-memory pool (made on first use) and puts them from there:
+    one copy, where `put(bytes)` makes Zenoh copy the bytes into its own buffer and then again into shared
+    memory or a socket. When the pool is full (subscribers still hold its buffers) or shared memory is not
+    available, the payload is put as bytes instead: nothing waits for it."""
+
+    def __init__(self, pool_bytes: int = SHM_POOL_BYTES):
+        self.pool_bytes = pool_bytes
+        self._provider: Any = None
+        self._policy: Any = None
+        self.ok = True
+        self.sent = 0  # payloads sent from shared memory
+        self.fallbacks = 0  # payloads put as bytes because the pool was full
+
+    def buffer(self, payload: bytes | bytearray) -> Any:
+        """A shared-memory buffer holding a copy of `payload`, or None (put the bytes themselves)."""
+        if not self.ok:
+            return None
+        if self._provider is None:
+            # POSIX shared memory lives in /dev/shm: a pool larger than what is free there (a container's
+            # default is 64 MB) would crash the process when its pages are touched, so it stays well within
+            try:
+                free = os.statvfs("/dev/shm")
+                self.pool_bytes = min(self.pool_bytes, free.f_bavail * free.f_frsize // 4)
+            except OSError:
+                pass
+            if self.pool_bytes < 4 * len(payload):
+                self.ok = False
+                return None
+            try:
+                from zenoh import shm
+
+                self._provider = shm.ShmProvider.default_backend(self.pool_bytes)
+                self._policy = shm.GarbageCollect()
+            except Exception:
+                self.ok = False
+                return None
+        try:
+            buf = self._provider.alloc(len(payload), policy=self._policy)
+        except zenoh.ZError:
+            self.fallbacks += 1
+            return None
+        buf[:] = payload if isinstance(payload, bytes | bytearray) else bytes(payload)
+        self.sent += 1
+        return buf
 
 
 class ZenohBus:
@@ -162,8 +216,9 @@ class ZenohBus:
         self.best_effort = [zenoh.KeyExpr(e) for e in best_effort]
         self._keep: list[Any] = []
         self._pubs: list[Any] = []
+        self.shm = SharedMemorySender()
 
-    def publisher(self, key: str, type_name: str) -> Callable[[bytes, bytes], None]:
+    def publisher(self, key: str, type_name: str) -> Callable[[bytes | bytearray, bytes], None]:
         if self.graph is not None:
             self.graph.publisher(key, type_name)
         # Reliable by default: a publisher waits rather than drop (nothing recorded is lost; a slow subscriber
@@ -178,7 +233,14 @@ class ZenohBus:
         self._keep.append(pub)
         self._pubs.append(pub)
 
-        def send(payload: bytes, attachment: bytes) -> None:
+        shm = self.shm
+
+        def send(payload: bytes | bytearray, attachment: bytes) -> None:
+            if len(payload) >= SHM_MIN_BYTES:
+                buf = shm.buffer(payload)
+                if buf is not None:
+                    pub.put(buf, attachment=attachment)
+                    return
             pub.put(payload, attachment=attachment)
 
         return send
@@ -232,9 +294,9 @@ class MemoryBus:
         self.sent: list[tuple[str, str, bytes, bytes]] = []
         self._subs: dict[str, list[Callable[[str, bytes, bytes | None], None]]] = {}
 
-    def publisher(self, key: str, type_name: str) -> Callable[[bytes, bytes], None]:
-        def send(payload: bytes, attachment: bytes) -> None:
-            self.sent.append((key, type_name, payload, attachment))
+    def publisher(self, key: str, type_name: str) -> Callable[[bytes | bytearray, bytes], None]:
+        def send(payload: bytes | bytearray, attachment: bytes) -> None:
+            self.sent.append((key, type_name, bytes(payload), attachment))  # (a bytearray is borrowed)
 
         return send
 
