@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import os
 import subprocess
 import sys
@@ -789,7 +790,7 @@ def _write_readme(texts: dict[str, str], info: dict[str, Any]) -> None:
         f"{info['date'][:10]}_"
     )
     for name, t in texts.items():
-        title, _, rest = t.replace("### ", "#### ", 1).partition("\n")
+        title, _, rest = re.sub(r"^### ", "#### ", t, flags=re.M).partition("\n")
         tables[name] = f"{title}\n\n{where}\n{rest}".rstrip()
     order = [n for n in SECTIONS if n in tables] + [n for n in tables if n not in SECTIONS]
     body = "\n\n".join([README_HEAD, *[tables[n] for n in order]])
