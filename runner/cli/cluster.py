@@ -40,6 +40,7 @@ def test_on_ray(
         ray = fanout.connect(address, runtime_env)
     except RunError as e:
         raise fail(e) from None
+    interrupts.interruptible()  # (ray.init made SIGTERM exit at once: it cancels the suite as Ctrl-C does)
     started = time.perf_counter()
     try:
         cluster = fanout.cluster_info(ray)
