@@ -314,3 +314,106 @@ def test_ctrl_c_on_the_driver_cancels_every_run_and_still_writes_junit(
         else:
             assert (error.text or "").startswith("cancelled"), (name, error.text)
     assert "interrupted" in text
+
+
+GOAL = """
+name: goal
+duration: 12.0
+rate: max
+seed: 1
+robots:
+  - name: r1
+    description: {file: robots/meshbot.urdf.xacro}
+    pose: {xyz: [-1.0, -1.0, 0.06]}
+    plugins:
+      - {type: diff_drive, params: {rate: 50, odometry_source: world}}
+nodes:
+  - {name: controller, cmd: python nodes/go_to_goal.py, args: ["--x", "2.0", "--y", "1.5"], namespace: r1, required: true}
+lockstep: [controller]
+assertions:
+  - {name: r1_reaches_the_goal, type: reach, robot: r1, point: [1.0, 0.5], tolerance: 0.15, by: 12}
+"""
+
+
+@pytest.mark.timeout(240)
+def test_the_scenario_folder_reaches_workers_that_run_elsewhere(cluster: Cluster, tmp_path: Path) -> None:
+    """A robot whose chassis is a mesh (meshes/chassis.stl) and a controller node script (nodes/), beside
+    the scenario: the workers run them from the copy Ray shipped to their node, not from the driver's
+    folder, and the driver runs from a folder of its own."""
+    import trimesh
+
+    from tests.conftest import SCENARIOS
+
+    folder = _folder(tmp_path / "suite", {"goal.yaml": GOAL})
+    (folder / "meshes").mkdir()
+    trimesh.creation.box(extents=(0.30, 0.20, 0.08)).export(folder / "meshes" / "chassis.stl")
+    box = '<geometry><box size="${chassis_l} ${chassis_w} ${chassis_h}"/></geometry>'
+    robot = DIFFBOT.read_text()
+    assert robot.count(box) == 2  # the chassis' visual and collision
+    robot = robot.replace(box, '<geometry><mesh filename="../meshes/chassis.stl"/></geometry>')
+    (folder / "robots" / "meshbot.urdf.xacro").write_text(robot)
+    (folder / "nodes").mkdir()
+    (folder / "nodes" / "go_to_goal.py").write_text((SCENARIOS / "nodes" / "go_to_goal.py").read_text())
+    driver = tmp_path / "driver"
+    driver.mkdir()
+    junit = tmp_path / "j.xml"
+    proc = run_cli(
+        "test", str(folder / "goal.yaml"), "--ray", cluster.address, "--artifacts", "art", "--junit", str(junit),
+        timeout=200, cwd=driver,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    suite = _suites(junit)["goal"]
+    assert _verdicts(suite) == [
+        ("r1_reaches_the_goal", suite.find("testcase").get("time"), "")
+    ]  # the node drove it
+    with open(driver / "art" / "goal" / "goal.mcap", "rb") as f:
+        plans = [m for _s, c, m in make_reader(f).iter_messages() if c.topic == "goal/_plan"]
+    data = bytes(plans[0].data)
+    plan = json.loads(data[data.index(b"{") : data.rindex(b"}") + 1])
+    shipped = Path(plan["scenario_file"]).parent
+    assert shipped != folder and "runtime_resources/working_dir_files" in str(shipped), shipped
+    assert plan["robots"][0]["description_file"] == str(shipped / "robots" / "meshbot.urdf.xacro")
+    assert f'file="{shipped / "meshes" / "chassis.stl"}"' in plan["mjcf"]  # the mesh read there
+    assert plan["nodes"][0]["cwd"] == str(shipped) and plan["nodes"][0]["argv"][1] == "nodes/go_to_goal.py"
+
+
+def test_without_ray_installed_the_error_says_how_to_install_it(tmp_path: Path) -> None:
+    shim = tmp_path / "shim" / "ray"
+    shim.mkdir(parents=True)
+    (shim / "__init__.py").write_text("raise ImportError(\"No module named 'ray'\")\n")
+    from tests.conftest import REPO, SCENARIOS
+
+    env = dict(os.environ, PYTHONPATH=f"{shim.parent}{os.pathsep}{REPO}")
+    proc = subprocess.run(
+        scenario_cmd("test", str(SCENARIOS / "two_robots.yaml"), "--ray"),
+        capture_output=True, text=True, timeout=60, env=env, cwd=tmp_path,
+    )  # fmt: skip
+    assert proc.returncode == 1, proc.stderr
+    assert proc.stderr.strip() == (
+        'error: --ray needs Ray, an optional extra: pip install "scenario-runner[ray]" (in a checkout: '
+        'pip install -e ".[ray]")'
+    ), proc.stderr
+    assert "Traceback" not in proc.stderr
+
+
+@pytest.mark.parametrize(
+    ("args", "code", "says"),
+    [
+        (["--artifacts", "x"], 2, "--artifacts goes with --ray"),
+        (["--gpus", "1"], 2, "--gpus goes with --ray"),
+        (["--ray", "--gpus", "many"], 2, "--gpus 'many': expected auto or a number of GPUs"),
+        (
+            ["--ray", "--artifacts", "nosuchscheme://bucket/runs"],
+            1,
+            "--artifacts nosuchscheme://bucket/runs:",
+        ),
+        (["--ray", "--artifacts", "s3://bucket/runs"], 1, "--artifacts s3://bucket/runs: Install s3fs"),
+    ],
+)
+def test_ray_options_are_checked_before_anything_runs(args: list[str], code: int, says: str) -> None:
+    from tests.conftest import SCENARIOS
+
+    proc = run_cli("test", str(SCENARIOS / "two_robots.yaml"), *args, timeout=60)
+    assert proc.returncode == code, proc.stdout + proc.stderr
+    assert says in " ".join(proc.stderr.split()), proc.stderr
+    assert "Traceback" not in proc.stderr
