@@ -121,7 +121,7 @@ def test_cmd(
             metavar="[ADDRESS]",
             help="Run every scenario and variant as a task on a Ray cluster: the head's address "
             "(host:port, ray://host:10001), or none for Ray's default (RAY_ADDRESS, else a cluster "
-            "started on this machine, else a new local one). Needs the [ray] extra.",
+            "started on this machine, else a new local one). Needs Ray: the `ray` extra.",
         ),
     ] = None,
     artifacts: Annotated[
