@@ -20,7 +20,7 @@ import pytest
 from mcap.reader import make_reader
 
 from tests.conftest import DIFFBOT, run_cli, scenario_cmd
-from tests.ray_cluster import Cluster, start_cluster
+from tests.ray_cluster import LOOPBACK_ENV, Cluster, start_cluster
 
 SWEEP = """
 name: sweep
@@ -69,11 +69,19 @@ assertions:
 
 @pytest.fixture(scope="module")
 def cluster() -> Any:
+    """The cluster, and the drivers the tests start (they inherit this environment) told it has no token
+    authentication (tests/ray_cluster.py)."""
+    saved = os.environ.get("RAY_AUTH_MODE")
+    os.environ["RAY_AUTH_MODE"] = LOOPBACK_ENV["RAY_AUTH_MODE"]
     c = start_cluster(nodes=2, cpus=1)
     try:
         yield c
     finally:
         c.stop()
+        if saved is None:
+            os.environ.pop("RAY_AUTH_MODE", None)
+        else:
+            os.environ["RAY_AUTH_MODE"] = saved
 
 
 def _folder(root: Path, files: dict[str, str]) -> Path:
@@ -417,3 +425,38 @@ def test_ray_options_are_checked_before_anything_runs(args: list[str], code: int
     assert proc.returncode == code, proc.stdout + proc.stderr
     assert says in " ".join(proc.stderr.split()), proc.stderr
     assert "Traceback" not in proc.stderr
+
+
+def test_the_rayjob_example_runs_scenario_test_with_options_it_takes() -> None:
+    """docs/rayjob.yaml (shown in docs/ray.md): a RayJob whose entrypoint is a `scenario test --ray` that
+    the command parses, on the Ray version the project pins."""
+    import re
+    import shlex
+    from importlib.metadata import version
+
+    import yaml
+    from typer.main import get_command
+
+    from runner.cli import app
+    from tests.conftest import REPO
+
+    text = (REPO / "docs" / "rayjob.yaml").read_text()
+    doc = yaml.safe_load(text)
+    assert (doc["apiVersion"], doc["kind"]) == ("ray.io/v1", "RayJob")
+    spec = doc["spec"]
+    assert spec["rayClusterSpec"]["rayVersion"] == version("ray")
+    images = {
+        c["image"]
+        for g in [spec["rayClusterSpec"]["headGroupSpec"], *spec["rayClusterSpec"]["workerGroupSpecs"]]
+        for c in g["template"]["spec"]["containers"]
+    }
+    assert len(images) == 1  # the head and the workers run the same project
+    argv = shlex.split(spec["entrypoint"])
+    assert argv[:2] == ["scenario", "test"]
+    ctx = get_command(app).commands["test"].make_context("test", argv[2:])  # type: ignore[attr-defined]
+    assert ctx.params["ray"] == "" and ctx.params["artifacts"].startswith("s3://")
+    assert ctx.params["paths"] == [Path("scenarios")] and ctx.params["timeout"] == 900
+    page = (REPO / "docs" / "ray.md").read_text()
+    shown = re.search(r"```yaml\n# docs/rayjob.yaml[^\n]*\n(.*?)```", page, re.S)
+    assert shown is not None and shown.group(1) == text.split("\n", 1)[1]  # the page shows the file
+    assert f"FROM rayproject/ray:{version('ray')}-py311" in page

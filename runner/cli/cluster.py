@@ -33,6 +33,7 @@ def test_on_ray(
     if every run passed, 130 (143) when Ctrl-C (SIGTERM) cut the suite short."""
     from runner.tools import artifacts, fanout
 
+    started = time.perf_counter()
     try:
         if artifacts.is_url(where):
             artifacts.check_url(where)
@@ -41,10 +42,9 @@ def test_on_ray(
     except RunError as e:
         raise fail(e) from None
     interrupts.interruptible()  # (ray.init made SIGTERM exit at once: it cancels the suite as Ctrl-C does)
-    started = time.perf_counter()
     try:
         cluster = fanout.cluster_info(ray)
-        _say_cluster(cluster)
+        _say_cluster(cluster, time.perf_counter() - started)
         jobs, notes = fanout.plan_jobs(variants, gpus, cluster)
         for note in notes:
             err.print("note: " + note, markup=False)
@@ -58,11 +58,11 @@ def test_on_ray(
     _report(outcomes, where, junit, time.perf_counter() - started, interrupted, len(jobs))
 
 
-def _say_cluster(cluster: dict[str, Any]) -> None:
+def _say_cluster(cluster: dict[str, Any], joined_s: float) -> None:
     total = cluster["total"]
     err.print(
         f"Ray cluster: {len(cluster['nodes'])} node(s), {total.get('CPU', 0):g} CPU(s), "
-        f"{total.get('GPU', 0):g} GPU(s)",
+        f"{total.get('GPU', 0):g} GPU(s), joined in {joined_s:.1f} s",
         markup=False,
     )
 

@@ -106,11 +106,18 @@ def connect(address: str, runtime_env: dict[str, Any]) -> Any:
         ray.init(address=address or None, runtime_env=runtime_env or None, **options)
     except (ConnectionError, ValueError, RuntimeError, OSError) as e:
         where = address or os.environ.get("RAY_ADDRESS") or "a new local cluster"
+        token = (
+            "\n  hint:     a cluster with Ray's token authentication (a head started where "
+            "~/.ray/auth_token exists) also needs RAY_AUTH_MODE=token here, and its token"
+            if isinstance(e, ConnectionError) and not os.environ.get("RAY_AUTH_MODE")
+            else ""
+        )
+        first = str(e).strip().splitlines()[0] if str(e).strip() else ""
         raise RunError(
-            f"--ray {address}: cannot start the suite on {where}: {type(e).__name__}: "
-            f"{str(e).strip().splitlines()[0] if str(e).strip() else ''}\n  hint:     the head's address as "
-            "`ray start --head` printed it (host:port), or none for a cluster on this machine; a scenario "
-            "folder small enough to ship (recordings are left out)"
+            f"--ray {address}: cannot start the suite on {where}: {type(e).__name__}: {first}\n"
+            "  hint:     the head's address as `ray start --head` printed it (host:port), or none for a "
+            "cluster on this machine; a scenario folder small enough to ship (recordings are left out)"
+            + token
         ) from None
     return ray
 
@@ -123,10 +130,7 @@ class Job:
     variant: Variant
     asks: dict[str, Any]
     values: dict[str, str] = field(default_factory=dict)
-
-    @property
-    def key(self) -> str:
-        return self.variant.stem
+    key: str = ""  # its artifacts' folder and name: the variant's stem, made unique in the suite
 
 
 @dataclass
@@ -159,6 +163,7 @@ def plan_jobs(variants: list[Variant], gpus: str, cluster: dict[str, Any]) -> tu
     docs: dict[Path, tuple[list[Any], list[dict[str, str]]]] = {}
     jobs: list[Job] = []
     notes: list[str] = []
+    taken: set[str] = set()
     for v in variants:
         if v.file not in docs:
             try:
@@ -174,7 +179,9 @@ def plan_jobs(variants: list[Variant], gpus: str, cluster: dict[str, Any]) -> tu
                 plan = load_drawn_plan(found[i][1])
             except ScenarioError:
                 plan = None
-        jobs.append(Job(v, _asks(v, plan, gpus, cluster, notes), values[i] if i < len(values) else {}))
+        key = v.stem if v.stem not in taken else f"{v.stem}-{len(taken)}"  # (x.yaml of two folders)
+        taken.add(key)
+        jobs.append(Job(v, _asks(v, plan, gpus, cluster, notes), values[i] if i < len(values) else {}, key))
     return jobs, notes
 
 
@@ -402,9 +409,9 @@ def _task(spec: dict[str, Any], ledger: Any) -> dict[str, Any]:
     variant = Variant(here / spec["file"], spec["index"], spec["label"])
     scratch_root = Path(context.get_temp_dir()) / "scenario-runs"
     scratch_root.mkdir(parents=True, exist_ok=True)
-    scratch = Path(tempfile.mkdtemp(prefix=f"{variant.stem}-", dir=scratch_root))
+    scratch = Path(tempfile.mkdtemp(prefix=f"{spec['key']}-", dir=scratch_root))
     try:
-        record = scratch / f"{variant.stem}.mcap" if spec["record"] else None
+        record = scratch / f"{spec['key']}.mcap" if spec["record"] else None
         suite = run_variant(
             variant,
             record,
