@@ -120,7 +120,11 @@ def _stop(base: Path) -> None:
                 stat = (entry / "stat").read_text()
                 cmd = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
                 procs[int(entry.name)] = (int(stat[stat.rindex(")") + 2 :].split()[1]), cmd)
-    mine = {pid for pid, (_ppid, cmd) in procs.items() if str(base) in cmd}
+    above, me = set(), os.getpid()  # (never this process or those above it, whatever they name)
+    while me > 1 and me in procs:
+        above.add(me)
+        me = procs[me][0]
+    mine = {pid for pid, (_ppid, cmd) in procs.items() if str(base) in cmd} - above
     grown = True
     while grown:
         more = {pid for pid, (ppid, _cmd) in procs.items() if ppid in mine} - mine

@@ -102,7 +102,8 @@ def _wait_for_nodes(address: str, n: int, env: dict[str, str], timeout: float) -
 def stop_processes_under(base: Path, grace: float = 10.0) -> list[int]:
     """End every process whose command line names `base` (the cluster's own: GCS, raylets, agents...) and
     every descendant of them (its workers, the runs they started): SIGTERM, then SIGKILL. The pids."""
-    mine = {pid for pid, cmd in _processes().items() if str(base) in cmd}
+    above = _ancestors(os.getpid())  # (a shell whose command line names the folder is not the cluster's)
+    mine = {pid for pid, cmd in _processes().items() if str(base) in cmd} - above
     mine |= _descendants(mine)
     for sig in (signal.SIGTERM, signal.SIGKILL):
         for pid in mine:
@@ -141,6 +142,19 @@ def _descendants(roots: set[int]) -> set[int]:
     while frontier:
         frontier = {pid for pid, ppid in parent.items() if ppid in frontier} - found - roots
         found |= frontier
+    return found
+
+
+def _ancestors(pid: int) -> set[int]:
+    """`pid` and the processes above it."""
+    found = {pid}
+    while pid > 1:
+        try:
+            stat = Path(f"/proc/{pid}/stat").read_text()
+            pid = int(stat[stat.rindex(")") + 2 :].split()[1])
+        except (OSError, ValueError, IndexError):
+            break
+        found.add(pid)
     return found
 
 

@@ -95,14 +95,12 @@ def test_a_run_over_its_timeout_is_stopped_and_reported_as_an_error(write_scenar
     )
     assert proc.returncode == 1, proc.stdout + proc.stderr
     suites = {s.get("name"): s for s in ET.parse(junit).getroot().findall("testsuite")}
-    assert (
-        suites["slow[duration=1.0]"].get("errors") == "0"
-        and suites["slow[duration=1.0]"].get("failures") == "0"
-    )
-    error = suites["slow[duration=600.0]"].find("testcase[@name='run']/error")
+    short, long = suites[f"{path.stem}[duration=1.0]"], suites[f"{path.stem}[duration=600.0]"]
+    assert short.get("errors") == "0" and short.get("failures") == "0"
+    error = long.find("testcase[@name='run']/error")
     assert error is not None and "timed out: still running after 10 s of wall time (--timeout), stopped" in (
         error.text or ""
     )
     from runner.record import read_summary
 
-    assert read_summary(out / "slow-1.mcap")["topics"]  # finished, readable
+    assert read_summary(out / f"{path.stem}-1.mcap")["topics"]  # finished, readable

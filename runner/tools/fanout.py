@@ -28,6 +28,7 @@ import os
 import re
 import shutil
 import tempfile
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,6 +43,7 @@ RETRIES = 2  # a task whose worker died is run again, this many times at most
 CANCEL_WAIT_S = 30.0  # after Ctrl-C: how long cancelled runs get to stop in order
 CAMERAS = ("camera", "depth_camera")
 EXCLUDES = ["__pycache__/", ".git/", "*.mcap"]  # never shipped with a scenario's folder
+CANCELLED = "cancelled: Ctrl-C on the driver"
 INSTALL_HINT = 'pip install "scenario-runner[ray]" (in a checkout: pip install -e ".[ray]")'
 _LOOPBACK = re.compile(r"^(?:ray://)?(?:127\.\d+\.\d+\.\d+|localhost|\[::1\])(?::\d+)?$")
 
@@ -338,15 +340,17 @@ def _cancel(
     give them CANCEL_WAIT_S to end, and count each as cancelled unless it finished meanwhile."""
     for ref in pending:
         ray.cancel(ref)
+    deadline = time.monotonic() + CANCEL_WAIT_S
     with contextlib.suppress(KeyboardInterrupt):  # a second Ctrl-C: wait no more
-        ray.wait(list(pending), num_returns=len(pending), timeout=CANCEL_WAIT_S)
-    for ref, job in pending.items():
-        ready, _ = ray.wait([ref], timeout=0)
-        if ready:
-            outcome = _outcome(ray, ref, job, settings)
-        else:
-            ray.cancel(ref, force=True)
-            outcome = Outcome(job, Suite(job.variant.name, error="cancelled: Ctrl-C on the driver"))
+        while pending and time.monotonic() < deadline:
+            ready, _ = ray.wait(list(pending), num_returns=1, timeout=0.5)
+            for ref in ready:
+                outcome = _outcome(ray, ref, pending.pop(ref), settings)
+                ended[outcome.job.key] = outcome
+                on_done(outcome)
+    for ref, job in pending.items():  # still there: its worker is ended (its run told to stop)
+        ray.cancel(ref, force=True)
+        outcome = Outcome(job, Suite(job.variant.name, error=CANCELLED))
         ended[job.key] = outcome
         on_done(outcome)
 
@@ -358,7 +362,7 @@ def _outcome(ray: Any, ref: Any, job: Job, settings: Settings) -> Outcome:
     try:
         got = ray.get(ref)
     except ray.exceptions.TaskCancelledError:
-        return Outcome(job, Suite(name, error="cancelled: Ctrl-C on the driver"))
+        return Outcome(job, Suite(name, error=CANCELLED))
     except (ray.exceptions.WorkerCrashedError, ray.exceptions.NodeDiedError) as e:
         why = f"{type(e).__name__}: the worker running it died {RETRIES + 1} times"
         return Outcome(job, Suite(name, error=why))
@@ -412,14 +416,18 @@ def _task(spec: dict[str, Any], ledger: Any) -> dict[str, Any]:
     scratch = Path(tempfile.mkdtemp(prefix=f"{spec['key']}-", dir=scratch_root))
     try:
         record = scratch / f"{spec['key']}.mcap" if spec["record"] else None
-        suite = run_variant(
-            variant,
-            record,
-            allow_undecided=spec["allow_undecided"],
-            timeout_s=spec["timeout_s"],
-            cwd=here,
-            die_with_parent=True,
-        )
+        try:
+            suite = run_variant(
+                variant,
+                record,
+                allow_undecided=spec["allow_undecided"],
+                timeout_s=spec["timeout_s"],
+                cwd=here,
+                die_with_parent=True,
+                cancelled=context.is_canceled,  # (ray.cancel: the run stopped in order, its recording kept)
+            )
+        except KeyboardInterrupt:
+            suite = Suite(variant.name, error=CANCELLED)
         if record is not None and record.is_file():
             _report(record)
         files = sorted(p for p in scratch.iterdir() if p.is_file())

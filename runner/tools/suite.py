@@ -10,6 +10,8 @@ import signal
 import subprocess
 import sys
 import tempfile
+import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,6 +19,7 @@ from runner.errors import ScenarioError
 from runner.tools.report import Suite
 
 STOP_S = 15.0  # a run told to stop (SIGTERM) finishes its recording in ~2 s; then it is killed
+WAIT_S = 0.25  # a run is waited for in slices this long (see `_wait`)
 
 
 @dataclass(frozen=True)
@@ -69,12 +72,14 @@ def run_variant(
     timeout_s: float | None = None,
     cwd: Path | None = None,
     die_with_parent: bool = False,
+    cancelled: Callable[[], bool] | None = None,
 ) -> Suite:
     """`scenario run FILE [--variant N]` in a process of its own, recording to `record` (None: no
     recording), and its suite. Over `timeout_s` of wall time the run is stopped as Ctrl-C stops it (its
     recording finished) and its suite is an error. Interrupted here (Ctrl-C, a Ray task cancelled), the run
-    is stopped the same way before the interruption goes on. `die_with_parent`: the run is told to stop if
-    the process that started it dies (a Ray worker killed under it)."""
+    is stopped the same way before the interruption goes on, and so it is (then KeyboardInterrupt) when
+    `cancelled()` says so (a Ray task cancelled). `die_with_parent`: the run is told to stop if the process
+    that started it dies (a Ray worker killed under it)."""
     with tempfile.TemporaryDirectory(prefix="scenario-variant-") as tmp:
         res = Path(tmp) / "results.json"
         cmd = [sys.executable, "-m", "runner.cli", "run", str(variant.file), "-q", "--results-json", str(res)]
@@ -91,21 +96,37 @@ def run_variant(
             cwd=cwd,
             preexec_fn=_stop_with_parent if die_with_parent and sys.platform == "linux" else None,
         )
-        timed_out = False
         try:
-            stdout, stderr = proc.communicate(timeout=timeout_s)
-        except subprocess.TimeoutExpired:
-            timed_out = True
-            stdout, stderr = _stop(proc)
+            out = _wait(proc, timeout_s, cancelled)
         except BaseException:
             _stop(proc)
             raise
+        timed_out = out is None
+        stdout, stderr = _stop(proc) if out is None else out
         suite = _suite_of(variant, res, proc.returncode, stdout, stderr)
     if timed_out:
         suite.error = f"timed out: still running after {timeout_s:g} s of wall time (--timeout), stopped" + (
             f"\n{suite.error}" if suite.error else ""
         )
     return suite
+
+
+def _wait(
+    proc: subprocess.Popen[str], timeout_s: float | None, cancelled: Callable[[], bool] | None
+) -> tuple[str, str] | None:
+    """What the run printed once it ended, or None when it is still going after `timeout_s`. It is waited
+    for in slices, and `cancelled()` asked between them (KeyboardInterrupt when it says so)."""
+    deadline = None if timeout_s is None else time.monotonic() + timeout_s
+    while True:
+        if cancelled is not None and cancelled():
+            raise KeyboardInterrupt
+        left = None if deadline is None else deadline - time.monotonic()
+        if left is not None and left <= 0:
+            return None
+        try:
+            return proc.communicate(timeout=WAIT_S if left is None else min(WAIT_S, left))
+        except subprocess.TimeoutExpired:
+            continue
 
 
 def _suite_of(variant: Variant, res: Path, code: int | None, stdout: str, stderr: str) -> Suite:
