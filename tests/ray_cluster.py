@@ -99,7 +99,7 @@ def _wait_for_nodes(address: str, n: int, env: dict[str, str], timeout: float) -
     raise RuntimeError(f"only {len(seen)} of {n} Ray nodes came up at {address}")
 
 
-def stop_processes_under(base: Path, grace: float = 10.0) -> list[int]:
+def stop_processes_under(base: Path, grace: float = 3.0) -> list[int]:
     """End every process whose command line names `base` (the cluster's own: GCS, raylets, agents...) and
     every descendant of them (its workers, the runs they started): SIGTERM, then SIGKILL. The pids."""
     above = _ancestors(os.getpid())  # (a shell whose command line names the folder is not the cluster's)

@@ -460,3 +460,69 @@ def test_the_rayjob_example_runs_scenario_test_with_options_it_takes() -> None:
     shown = re.search(r"```yaml\n# docs/rayjob.yaml[^\n]*\n(.*?)```", page, re.S)
     assert shown is not None and shown.group(1) == text.split("\n", 1)[1]  # the page shows the file
     assert f"FROM rayproject/ray:{version('ray')}-py311" in page
+
+
+CAMERA_BOT = """
+name: {name}
+duration: 1.0
+rate: max
+renderers: process
+robots:
+  - name: r1
+    description: {{file: robots/diffbot.urdf.xacro}}
+    pose: {{xyz: [0, 0, 0.06]}}
+    plugins:
+      - {{type: diff_drive}}
+      - {{type: camera, params: {{link: lidar_link, width: 64, height: 48, rate: 5}}}}
+nodes:
+  - {{name: idle, cmd: python -c "pass"}}
+{resources}
+"""
+
+
+def _cluster_of(cpus: list[float], gpus: float = 0.0, **custom: float) -> dict[str, Any]:
+    """A cluster as `fanout.cluster_info` describes one: nodes with these CPUs, GPUs and custom resources."""
+    nodes = {f"n{i}": ("127.0.0.1", {"CPU": c}) for i, c in enumerate(cpus)}
+    return {"nodes": nodes, "total": {"CPU": sum(cpus), **({"GPU": gpus} if gpus else {}), **custom}}
+
+
+def test_what_a_run_asks_of_the_cluster(tmp_path: Path) -> None:
+    """A CPU per process (the world, its renderer, the node), capped at the largest node; a GPU for cameras
+    with --gpus auto on a cluster with GPUs, none without or with --gpus 0; `resources:` wins; what no node
+    has is an error before anything is sent."""
+    from runner.errors import RunError
+    from runner.tools.fanout import plan_jobs
+    from runner.tools.suite import Variant
+
+    folder = _folder(
+        tmp_path,
+        {
+            "cam.yaml": CAMERA_BOT.format(name="cam", resources=""),
+            "own.yaml": CAMERA_BOT.format(
+                name="own", resources="resources: {num_cpus: 0.5, num_gpus: 0.25, custom: {lidar_box: 1}}"
+            ),
+            "sweep.yaml": SWEEP,
+        },
+    )
+    cam, own, sweep = (Variant(folder / f"{n}.yaml", None, "") for n in ("cam", "own", "sweep"))
+    jobs, notes = plan_jobs([cam, Variant(sweep.file, 5, "x")], "auto", _cluster_of([4, 4], gpus=2))
+    assert [j.asks for j in jobs] == [
+        {"num_cpus": 3.0, "num_gpus": 1.0, "resources": {}},  # world + renderer + node; cameras: a GPU
+        {"num_cpus": 1.0, "num_gpus": 0.0, "resources": {}},
+    ]
+    assert notes == [] and jobs[1].values == {"seed": "2", "timeline[0].data.linear.x": "0.2"}
+    jobs, notes = plan_jobs([cam], "auto", _cluster_of([2, 1]))  # no GPU here; 2 CPUs at most a node
+    assert jobs[0].asks == {"num_cpus": 2.0, "num_gpus": 0.0, "resources": {}} and "it asks 2" in notes[0]
+    assert plan_jobs([cam], "0", _cluster_of([4], gpus=1))[0][0].asks["num_gpus"] == 0.0
+    assert plan_jobs([cam], "0.5", _cluster_of([4], gpus=1))[0][0].asks["num_gpus"] == 0.5
+    with pytest.raises(RunError, match=r"1 GPU\(s\) asked for a run with cameras; the cluster has 0"):
+        plan_jobs([cam], "1", _cluster_of([4]))
+    jobs, _ = plan_jobs([own], "auto", _cluster_of([4], gpus=1, lidar_box=2))
+    assert jobs[0].asks == {"num_cpus": 0.5, "num_gpus": 0.25, "resources": {"lidar_box": 1.0}}
+    with pytest.raises(RunError, match=r"resources\.custom: no node of the cluster has lidar_box"):
+        plan_jobs([own], "auto", _cluster_of([4], gpus=1))
+    big = _folder(
+        tmp_path / "big", {"big.yaml": CAMERA_BOT.format(name="big", resources="resources: {num_cpus: 8}")}
+    )
+    with pytest.raises(RunError, match=r"resources\.num_cpus 8: no node of the cluster has that many CPUs"):
+        plan_jobs([Variant(big / "big.yaml", None, "")], "auto", _cluster_of([4, 4]))
