@@ -136,6 +136,7 @@ def _report(
             _ran_on(o),
             o.attempts,
             {n: _relative(p, where) for n, p in o.files.items()},
+            o.wall_s,
         )
         for o in outcomes
     ]

@@ -145,6 +145,7 @@ class Outcome:
     node: str = ""
     attempts: int = 0
     files: dict[str, str] = field(default_factory=dict)
+    wall_s: float = 0.0  # the run's process from start to end, on the worker (its start included)
 
 
 def cluster_info(ray: Any) -> dict[str, Any]:
@@ -375,7 +376,7 @@ def _outcome(ray: Any, ref: Any, job: Job, settings: Settings) -> Outcome:
     else:
         files = artifacts.save(Path(settings.where), job.key, got["files"])
     suite.mcap = files.get(f"{job.key}.mcap")
-    return Outcome(job, suite, files=files)
+    return Outcome(job, suite, files=files, wall_s=float(got.get("wall_s", 0.0)))
 
 
 class _Ledger:
@@ -416,6 +417,7 @@ def _task(spec: dict[str, Any], ledger: Any) -> dict[str, Any]:
     scratch = Path(tempfile.mkdtemp(prefix=f"{spec['key']}-", dir=scratch_root))
     try:
         record = scratch / f"{spec['key']}.mcap" if spec["record"] else None
+        started = time.perf_counter()
         try:
             suite = run_variant(
                 variant,
@@ -428,12 +430,14 @@ def _task(spec: dict[str, Any], ledger: Any) -> dict[str, Any]:
             )
         except KeyboardInterrupt:
             suite = Suite(variant.name, error=CANCELLED)
+        wall_s = time.perf_counter() - started
         if record is not None and record.is_file():
             _report(record)
         files = sorted(p for p in scratch.iterdir() if p.is_file())
         if spec["url"]:
-            return {"suite": suite.to_json(), "links": artifacts.upload(spec["url"], spec["key"], files)}
-        return {"suite": suite.to_json(), "files": {p.name: p.read_bytes() for p in files}}
+            links = artifacts.upload(spec["url"], spec["key"], files)
+            return {"suite": suite.to_json(), "wall_s": wall_s, "links": links}
+        return {"suite": suite.to_json(), "wall_s": wall_s, "files": {p.name: p.read_bytes() for p in files}}
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
         ledger.finished.remote(spec["key"])
