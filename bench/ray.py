@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -110,6 +111,7 @@ def _cluster(tmp: Path) -> Any:
         yield f"127.0.0.1:{port}"
     finally:
         _stop(base)
+        shutil.rmtree(base, ignore_errors=True)
 
 
 def _stop(base: Path) -> None:
