@@ -364,17 +364,21 @@ def test_the_scenario_folder_reaches_workers_that_run_elsewhere(cluster: Cluster
     (folder / "nodes" / "go_to_goal.py").write_text((SCENARIOS / "nodes" / "go_to_goal.py").read_text())
     driver = tmp_path / "driver"
     driver.mkdir()
-    junit = tmp_path / "j.xml"
+    junit, shared = tmp_path / "j.xml", tmp_path / "shared"  # a folder every node mounts: file://
     proc = run_cli(
-        "test", str(folder / "goal.yaml"), "--ray", cluster.address, "--artifacts", "art", "--junit", str(junit),
-        timeout=200, cwd=driver,
+        "test", str(folder / "goal.yaml"), "--ray", cluster.address, "--artifacts", shared.as_uri(),
+        "--junit", str(junit), timeout=200, cwd=driver,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     suite = _suites(junit)["goal"]
     assert _verdicts(suite) == [
         ("r1_reaches_the_goal", suite.find("testcase").get("time"), "")
     ]  # the node drove it
-    with open(driver / "art" / "goal" / "goal.mcap", "rb") as f:
+    assert (shared / "goal" / "goal.html").is_file() and (shared / "summary.html").is_file()
+    assert f"summary: {shared.as_uri()}/summary.html" in proc.stdout
+    assert "goal: a CPU for each of its 2 processes would be more than any node has: it asks 1" in proc.stderr
+    assert "goal/goal.html" in (shared / "summary.html").read_text()  # relative: beside the page
+    with open(shared / "goal" / "goal.mcap", "rb") as f:
         plans = [m for _s, c, m in make_reader(f).iter_messages() if c.topic == "goal/_plan"]
     data = bytes(plans[0].data)
     plan = json.loads(data[data.index(b"{") : data.rindex(b"}") + 1])
@@ -383,6 +387,7 @@ def test_the_scenario_folder_reaches_workers_that_run_elsewhere(cluster: Cluster
     assert plan["robots"][0]["description_file"] == str(shipped / "robots" / "meshbot.urdf.xacro")
     assert f'file="{shipped / "meshes" / "chassis.stl"}"' in plan["mjcf"]  # the mesh read there
     assert plan["nodes"][0]["cwd"] == str(shipped) and plan["nodes"][0]["argv"][1] == "nodes/go_to_goal.py"
+    assert not (driver / "runs").exists()  # nothing went to the driver's folder
 
 
 def test_without_ray_installed_the_error_says_how_to_install_it(tmp_path: Path) -> None:
@@ -526,3 +531,30 @@ def test_what_a_run_asks_of_the_cluster(tmp_path: Path) -> None:
     )
     with pytest.raises(RunError, match=r"resources\.num_cpus 8: no node of the cluster has that many CPUs"):
         plan_jobs([Variant(big / "big.yaml", None, "")], "auto", _cluster_of([4, 4]))
+
+
+@pytest.mark.parametrize(
+    ("args", "address", "paths"),
+    [
+        (["--ray", "scenarios"], "", ["scenarios"]),  # a path after --ray is a path
+        (["scenarios", "--ray"], "", ["scenarios"]),
+        (["--ray", "127.0.0.1:6379", "scenarios"], "127.0.0.1:6379", ["scenarios"]),
+        (["--ray", "ray://head:10001", "a.yaml", "b.yaml"], "ray://head:10001", ["a.yaml", "b.yaml"]),
+        (["--ray", "auto", "-j", "2", "scenarios"], "auto", ["scenarios"]),
+        (["--ray", "-j", "2", "scenarios"], "", ["scenarios"]),
+        (["scenarios"], None, ["scenarios"]),
+    ],
+)
+def test_ray_takes_an_address_or_none(args: list[str], address: str | None, paths: list[str]) -> None:
+    from typer.main import get_command
+
+    from runner.cli import app
+    from tests.conftest import REPO
+
+    cwd = os.getcwd()
+    os.chdir(REPO)  # (`scenarios` is a folder here: never taken for an address)
+    try:
+        ctx = get_command(app).commands["test"].make_context("test", args)  # type: ignore[attr-defined]
+    finally:
+        os.chdir(cwd)
+    assert ctx.params["ray"] == address and ctx.params["paths"] == [Path(p) for p in paths]
