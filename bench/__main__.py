@@ -61,6 +61,7 @@ from bench.common import (  # noqa: E402
     plan_from_text,
     raw_driving_rate,
     raw_rate,
+    readme_tables,
     say,
     table,
     world_on_zenoh,
@@ -675,20 +676,31 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _write_readme(texts: dict[str, str], info: dict[str, Any]) -> None:
+    """The tables of the sections that ran written into README.md between the bench markers, each with the
+    machine and day it was measured on; the tables of sections that did not run are kept as they are (with
+    their own machine line), all in the suite's order."""
     readme = REPO / "README.md"
     text = readme.read_text()
     begin, end = "<!-- bench:begin -->", "<!-- bench:end -->"
     if begin not in text or end not in text:
         say("README.md has no bench markers; tables not written")
         return
-    head = (
-        f"Measured by `python -m bench` on {info['cpu']} ({info['cpus']} cpus), Python {info['python']}, "
-        f"MuJoCo {info['mujoco']}, {info['date'][:10]}."
-    )
-    body = "\n\n".join([head, *[t.replace("### ", "#### ") for t in texts.values()]])
     a, b = text.index(begin) + len(begin), text.index(end)
+    tables = readme_tables(text[a:b])
+    where = (
+        f"_{info['cpu']} ({info['cpus']} cpus), Python {info['python']}, MuJoCo {info['mujoco']}, "
+        f"{info['date'][:10]}_"
+    )
+    for name, t in texts.items():
+        title, _, rest = t.replace("### ", "#### ", 1).partition("\n")
+        tables[name] = f"{title}\n\n{where}\n{rest}".rstrip()
+    order = [n for n in SECTIONS if n in tables] + [n for n in tables if n not in SECTIONS]
+    body = "\n\n".join([README_HEAD, *[tables[n] for n in order]])
     readme.write_text(text[:a] + "\n" + body + "\n" + text[b:])
     say("README.md tables updated")
+
+
+README_HEAD = "Measured by `python -m bench`; under each table, the machine and the day it was measured on."
 
 
 if __name__ == "__main__":

@@ -11,7 +11,11 @@ add, and looking at the events. The events mix every kind that keeps being looke
 every scan at 10 Hz, firing each time; the IMU's at 100 Hz, never firing). Their actions keep firing: repeat
 publishes, start/stop of actors, and a delay fault on the joint states for five seconds.
 
-The two worlds are run alternately, best of N each, so a machine busy with something else slows both."""
+The worlds are run alternately, best of N each, so a machine busy with something else slows them all.
+Beside them, in the same run, raw MuJoCo steps the compiled model with and without the actors' bodies
+(no plugins, nothing played): what MuJoCo itself pays for twenty more bodies (kinematics, broad phase) is
+part of the limit, not ours. Ours is the rest: playing the actors and looking at the events, measured as
+the world with them walking and the events against the same world with their bodies standing."""
 
 from __future__ import annotations
 
@@ -19,7 +23,7 @@ from typing import Any
 
 import yaml
 
-from bench.common import DIFFBOT, TWO_ROBOTS, plan_from_text, say, table, world_on_zenoh
+from bench.common import DIFFBOT, TWO_ROBOTS, plan_from_text, raw_rate, say, table, world_on_zenoh
 from runner.plan import RunPlan
 
 TARGET = 0.15  # at most 15 % more wall time per sim second
@@ -142,9 +146,12 @@ def run(quick: bool, repeat: int) -> tuple[dict[str, Any], str]:
     rounds = 1 if quick else max(repeat, 5)
     base, standing, busy = plans(seconds)
     dt = base.step_ns / 1e9
-    rates: dict[str, list[float]] = {"without": [], "standing": [], "with": []}
+    rates: dict[str, list[float]] = {"raw": [], "raw bodies": [], "without": [], "standing": [], "with": []}
     fired = 0
-    for _ in range(rounds):  # alternating: whatever else the machine does slows all three
+    raw_steps = round(seconds * 1e9 / base.step_ns)
+    for _ in range(rounds):  # alternating: whatever else the machine does slows them all
+        rates["raw"].append(raw_rate(base, raw_steps))
+        rates["raw bodies"].append(raw_rate(standing, raw_steps))
         for label, plan in (("without", base), ("standing", standing), ("with", busy)):
             stats = world_on_zenoh(plan)
             rates[label].append(stats.steps / stats.wall_s)
@@ -154,8 +161,17 @@ def run(quick: bool, repeat: int) -> tuple[dict[str, Any], str]:
     best = {k: max(v) for k, v in rates.items()}
     # wall time per sim second, relative to the world without them
     cost = {k: best["without"] / v - 1.0 for k, v in best.items()}
+    bodies_raw = best["raw"] / best["raw bodies"] - 1.0  # MuJoCo's own cost of the bodies
+    ours = best["standing"] / best["with"] - 1.0  # playing them and the events, over the bodies standing
     n_a, n_e = len(busy.actors), len(busy.events)
     rows = [
+        ("raw MuJoCo, the demo's compiled model (the limit)", best["raw"], best["raw"] * dt, ""),
+        (
+            f"  + {n_a} actors' bodies (the limit with them: MuJoCo's own cost)",
+            best["raw bodies"],
+            best["raw bodies"] * dt,
+            f"{bodies_raw * 100:+.1f} %",
+        ),
         ("world, all plugins publishing, nothing subscribed", best["without"], best["without"] * dt, ""),
         (
             f"  + {n_a} actors' bodies, standing (MuJoCo: physics, rays)",
@@ -168,6 +184,12 @@ def run(quick: bool, repeat: int) -> tuple[dict[str, Any], str]:
             best["with"],
             best["with"] * dt,
             f"{cost['with'] * 100:+.1f} %",
+        ),
+        (
+            "  ours: walking and events, over the bodies standing",
+            "",
+            "",
+            f"{ours * 100:+.1f} %",
         ),
     ]
     text = table(
@@ -186,7 +208,12 @@ def run(quick: bool, repeat: int) -> tuple[dict[str, Any], str]:
         "all_steps_per_s": rates,
         "overhead": cost["with"],
         "overhead_bodies_only": cost["standing"],
-        "targets": {f"actors and events cost <= {TARGET * 100:.0f} % wall time": cost["with"] <= TARGET},
+        "mujoco_bodies": bodies_raw,
+        "ours": ours,
+        "targets": {
+            f"actors and events cost <= {TARGET * 100:.0f} % wall time": cost["with"] <= TARGET,
+            f"playing them and the events <= {TARGET * 100:.0f} % over their bodies standing": ours <= TARGET,
+        },
     }
     return doc, text
 

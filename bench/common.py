@@ -170,3 +170,13 @@ def _fmt(v: Any) -> str:
 def say(text: str) -> None:
     print(text, flush=True)
     sys.stdout.flush()
+
+
+def readme_tables(block: str) -> dict[str, str]:
+    """The tables between the README's bench markers, by section (the word before the first colon of each
+    `#### ` title)."""
+    tables: dict[str, str] = {}
+    for part in ("\n" + block).split("\n#### ")[1:]:
+        name = part.split(":", 1)[0].strip()
+        tables[name] = ("#### " + part).strip()
+    return tables

@@ -233,3 +233,82 @@ def test_an_impulse_changes_velocity_by_j_over_m(tmp_path):
     rid = ran.world.model.body(root(ran.world)).id
     dof = int(ran.world.model.jnt_dofadr[ran.world.model.body_jntadr[rid]])
     assert ran.world.data.qvel[dof + 2] == pytest.approx(1.0 / mass, rel=0.05)
+
+
+def test_played_poses_are_each_actors_path_at_its_own_clock_through_windows_starts_and_stops():
+    """`Actors` gathers the next WINDOW ticks of every moving actor's poses at once; whatever the starts,
+    stops and teleports in between (some mid-window), each tick's pose must be the sampled path's at that
+    actor's own clock: the sample of its own tick count, looped or held at the path's end."""
+    import mujoco
+
+    from runner.plan import ActorPlan
+    from runner.sim.actors import TICK_NS, WINDOW, Actors, sample_path
+
+    xml = (
+        "<mujoco><worldbody>"
+        + "".join(f'<body name="a{i}" mocap="true"><geom size="0.1"/></body>' for i in range(4))
+        + "</worldbody></mujoco>"
+    )
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    plans = [
+        ActorPlan(
+            name="a0",
+            start_ns=0,
+            pos=[0, 0, 0],
+            quat=[1, 0, 0, 0],
+            times=[0, 1.3],
+            points=[[0, 0, 0], [1.3, 0, 0]],
+            loop=True,
+        ),
+        ActorPlan(
+            name="a1",
+            start_ns=None,
+            pos=[0, 1, 0],
+            quat=[1, 0, 0, 0],
+            times=[0, 0.7, 2.0],
+            points=[[0, 1, 0], [0.7, 1, 0], [0.7, 2.3, 0]],
+            travel=True,
+        ),
+        ActorPlan(
+            name="a2",
+            start_ns=250_000_000,
+            pos=[0, 2, 0],
+            quat=[1, 0, 0, 0],
+            times=[0, 3.1],
+            points=[[0, 2, 0], [3.1, 2, 0]],
+            loop=True,
+        ),
+        ActorPlan(
+            name="a3",
+            start_ns=0,
+            pos=[0, 3, 0],
+            quat=[1, 0, 0, 0],
+            times=[0, 0.5],
+            points=[[0, 3, 0], [0.5, 3, 0]],
+        ),
+    ]
+    actors = Actors(m, d, plans)
+    tables = [sample_path(p) for p in plans]
+    clocks = [0, 0, 0, 0]
+    moving = [False] * 4
+    rng = np.random.default_rng(3)
+    for k in range(7 * WINDOW + 13):
+        now = k * TICK_NS
+        for i, p in enumerate(plans):
+            if p.start_ns == now:  # (a start time starts it, whatever happened before)
+                moving[i] = True
+        if k % 37 == 5:  # a start or a stop now and then, mid-window
+            i = int(rng.integers(4))
+            (actors.stop if moving[i] else actors.start)(i)
+            moving[i] = not moving[i]
+        actors.tick(now)
+        for i, (pos, quat) in enumerate(tables):
+            if not moving[i]:
+                continue
+            n = len(pos)
+            j = clocks[i] % (n - 1) if plans[i].loop and n > 1 else min(clocks[i], n - 1)
+            assert np.array_equal(d.mocap_pos[i], pos[j]), (k, i)
+            assert np.array_equal(d.mocap_quat[i], quat[j]), (k, i)
+            clocks[i] += 1
+    assert sum(clocks) > 3 * WINDOW  # they did move, across several windows

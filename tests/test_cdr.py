@@ -12,7 +12,7 @@ import pytest
 from runner.plugin import Plugin, Topic, registry
 from runner.sim.world import World
 from runner.wire import msgs
-from runner.wire.cdr import Layout, LayoutError
+from runner.wire.cdr import Layout, LayoutError, Peek, string_message
 from runner.wire.transport import MemoryBus
 from tests.helpers import messages, plan_of
 
@@ -274,3 +274,87 @@ def test_a_local_subscriber_gets_the_fixed_layout_messages_decoded(
     for (t1, a), (t2, b) in zip(sent, ScanListener.heard, strict=True):
         assert t1 == t2
         assert msgs.encode(a, "sensor_msgs/msg/LaserScan") == msgs.encode(b, "sensor_msgs/msg/LaserScan")
+
+
+def _same_field(a: Any, b: Any) -> bool:
+    if isinstance(a, np.ndarray):
+        return type(b) is np.ndarray and a.dtype == b.dtype and np.array_equal(a, b, equal_nan=True)
+    if hasattr(a, "__dataclass_fields__"):
+        return type(a) is type(b) and all(
+            _same_field(getattr(a, f), getattr(b, f)) for f in a.__dataclass_fields__
+        )
+    if isinstance(a, list):
+        return type(b) is list and len(a) == len(b) and all(map(_same_field, a, b))
+    return type(a) is type(b) and a == b
+
+
+def _peek_cases() -> list[tuple[str, Any]]:
+    rng = np.random.default_rng(5)
+    cases = []
+    for frame in FRAMES:
+        cases.append(
+            ("sensor_msgs/msg/Imu", imu(12_345, frame, rng.normal(size=4), rng.normal(size=3), [0, 0, 9.8]))
+        )
+        cases.append(
+            (
+                "nav_msgs/msg/Odometry",
+                odom(7, frame, frame[::-1] + "x", rng.normal(size=7), rng.normal(size=6)),
+            )
+        )
+    for n in (0, 1, 3, 360):
+        for k in (0, n):
+            cases.append(("sensor_msgs/msg/LaserScan", scan(5, "r1/l", rng.random(n), rng.random(k))))
+    cases.append(
+        (
+            "sensor_msgs/msg/JointState",
+            joint_state(3, ["a", "bb"], np.array([1.0, 2.0]), np.array([0.5, 0.0]), np.zeros(0)),
+        )
+    )
+    cases.append(("sensor_msgs/msg/JointState", joint_state(3, [], np.zeros(0), np.zeros(0), np.zeros(0))))
+    cases.append(
+        (
+            "tf2_msgs/msg/TFMessage",
+            tf(
+                9, [("w", "r1/b"), ("r1/b", "r1/wheel_l"), ("x", "y")], [rng.normal(size=7) for _ in range(3)]
+            ),
+        )
+    )
+    cases.append(("tf2_msgs/msg/TFMessage", tf(9, [("w", "r1/b")], [rng.normal(size=7)])))
+    cases.append(
+        (
+            "sensor_msgs/msg/NavSatFix",
+            msgs.from_data(
+                "sensor_msgs/msg/NavSatFix",
+                {"header": {"frame_id": "g"}, "status": {"status": 2}, "latitude": 1.5},
+            ),
+        )
+    )
+    return cases
+
+
+@pytest.mark.parametrize("type_name, msg", _peek_cases())
+def test_peek_reads_each_field_as_rosbags_decodes_it(type_name: str, msg: Any) -> None:
+    """`Peek` (what message triggers read of each message) gives every top-level field, alone or with
+    others, exactly as the full decode does: same class, same type, same values; fields it cannot peek at
+    (after a sequence of messages) fall back to the full decode."""
+    payload = msgs.encode(msg, type_name)
+    full = msgs.decode(payload, type_name)
+    names = [n for n, _ in msgs.TYPESTORE.get_msgdef(type_name).fields]
+    for i, name in enumerate(names):
+        for fields in ([name], [names[0], name], names[i:]):
+            peek = Peek(type_name, fields)
+            got = peek.peek(payload)
+            assert type(got) is type(full)
+            for f in fields:
+                assert _same_field(getattr(got, f), getattr(full, f)), (type_name, fields, f)
+    assert not Peek("sensor_msgs/msg/Imu", ["linear_acceleration"]).full
+    assert Peek("sensor_msgs/msg/Imu", ["no_such_field"]).full
+    assert not Peek("tf2_msgs/msg/TFMessage", ["transforms"]).full
+
+
+@pytest.mark.parametrize(
+    "text", ["", "a", "ab", "abc", "abcd", '{"event": "x", "why": "héllo ✓"}', "x" * 1000]
+)
+def test_string_message_is_what_rosbags_encodes(text: str) -> None:
+    """The events' record (`<run>/_events`, one per firing) is written without a message object."""
+    assert string_message(text) == msgs.encode(T["std_msgs/msg/String"](data=text), "std_msgs/msg/String")

@@ -292,6 +292,9 @@ def test_runtime_type_errors(scan, joints):
     assert "len() needs a sequence or a string" in error("len(range_min) > 0", scan).message
     assert "abs() needs a number" in error("abs(header.frame_id) > 0", scan).message
     assert "cannot be indexed" in error("range_min[0] > 0", scan).message
+    e = error("min(ranges, intensities).min() > 0", scan)  # (no intensities: lengths 4 and 0)
+    assert "min(a, b) of sequences needs them of one length; found an array of 4" in e.message
+    assert e.hint.startswith("compare their items")
 
 
 def test_short_circuit(scan):
@@ -451,3 +454,141 @@ def test_check_fields_condition():
     check_fields(compile_expr("abs(ranges) * 2"), "sensor_msgs/msg/LaserScan", condition=False)
     e = error("ranges > 0.25", type_name="sensor_msgs/msg/LaserScan")
     assert "ranges.min() > 0.25" in e.hint
+
+
+# ------------------------------------------------------------------------------------------ fast path
+_ATOMS = [
+    "ranges", "ranges[0]", "ranges[-1]", "ranges[9]", "range_min", "range_max", "intensities",
+    "header.frame_id", "header.stamp.sec", "header.stamp", "angle_increment", "nothing", "header.nope",
+    "0", "1.5", "-2", "True", "False", "'r1/laser'", "0.0",
+]  # fmt: skip
+
+
+def _expressions():
+    from hypothesis import strategies as st
+
+    atoms = st.sampled_from(_ATOMS)
+
+    def grow(inner):
+        return st.one_of(
+            st.tuples(inner, st.sampled_from([".min()", ".max()", ".mean()", ".sum()", ".std()"])).map(
+                lambda t: f"({t[0]}){t[1]}"
+            ),
+            st.tuples(st.sampled_from(["len", "abs"]), inner).map(lambda t: f"{t[0]}({t[1]})"),
+            st.tuples(st.sampled_from(["min", "max"]), inner, inner).map(lambda t: f"{t[0]}({t[1]}, {t[2]})"),
+            st.tuples(inner, st.sampled_from(["+", "-", "*", "/", "%"]), inner).map(" ".join),
+            st.tuples(inner, st.sampled_from(["<", "<=", ">", ">=", "==", "!="]), inner).map(" ".join),
+            st.tuples(inner, st.sampled_from(["<", ">="]), inner, st.sampled_from(["<", "!="]), inner).map(
+                " ".join
+            ),
+            st.tuples(inner, st.sampled_from(["and", "or"]), inner).map(" ".join),
+            st.tuples(st.sampled_from(["not ", "-"]), inner).map(lambda t: f"{t[0]}({t[1]})"),
+        )
+
+    return st.recursive(atoms, grow, max_leaves=6)
+
+
+def _outcome(fn):
+    try:
+        return ("value", fn())
+    except ExprError as e:
+        return ("error", e.message, e.column)
+
+
+def _same(a, b) -> bool:
+    if a[0] != b[0]:
+        return False
+    if a[0] == "error":
+        return a == b
+    x, y = a[1], b[1]
+    if type(x) is not type(y):
+        return False
+    if isinstance(x, np.ndarray):
+        return x.dtype == y.dtype and np.array_equal(x, y, equal_nan=True)
+    return x == y or (isinstance(x, float) and math.isnan(x) and math.isnan(y))
+
+
+@pytest.mark.filterwarnings("ignore:Generating overly large repr")  # (hypothesis, of the grammar itself)
+def test_fast_path_agrees_with_the_interpreter():
+    """`test()` runs closures made once from the tree; whatever they give must be what the interpreter
+    gives (value and type), and test()'s answer or error the same as the interpreter's, on generated
+    expressions over a real decoded message (arrays, strings, scalars, missing fields, wrong kinds)."""
+    from hypothesis import HealthCheck, given, settings
+
+    from runner.checks.expr.evaluate import _describe
+    from runner.checks.expr.fast import compile_fast
+
+    msg = decode(
+        encode(
+            from_data(
+                "sensor_msgs/msg/LaserScan",
+                {
+                    "header": {"frame_id": "r1/laser", "stamp": {"sec": 3}},
+                    "range_min": 0.1,
+                    "range_max": 0.0,
+                    "angle_increment": 0.5,
+                    "ranges": [0.5, INF, 1.25, 2.0, float("nan")],
+                },
+            ),
+            "sensor_msgs/msg/LaserScan",
+        ),
+        "sensor_msgs/msg/LaserScan",
+    )
+    checked = [0]
+
+    @settings(
+        max_examples=600,
+        deadline=None,
+        database=None,
+        suppress_health_check=list(HealthCheck),
+        print_blob=False,
+    )
+    @given(_expressions())
+    def check(text):
+        try:
+            e = compile_expr(text)
+        except ExprError:
+            return
+        slow = _outcome(lambda: e.evaluate(msg))
+        try:
+            with np.errstate(all="ignore"):
+                fast = ("value", compile_fast(e._tree.body)(msg))
+        except Exception:
+            fast = None  # it hands the message to the interpreter
+        if fast is not None:
+            assert _same(fast, slow), (text, fast, slow)
+            checked[0] += 1
+
+        def interpreter_test():
+            v = e.evaluate(msg)
+            if isinstance(v, bool | np.bool_):
+                return bool(v)
+            raise ExprError(f"the expression must be true or false; it gives {_describe(v)}")
+
+        want, got = _outcome(interpreter_test), _outcome(lambda: e.test(msg))
+        assert want[0] == got[0] and (want[1] == got[1] if want[0] == "value" else want[1] in got[1]), text
+
+    check()
+    assert checked[0] > 100  # most generated expressions do take the fast path
+
+
+def test_fast_path_on_peeked_messages():
+    """The events' message triggers read only the fields their expression names (runner.wire.cdr.Peek):
+    the same answers as on the fully decoded message."""
+    from runner.wire.cdr import Peek
+
+    payload = encode(
+        from_data(
+            "sensor_msgs/msg/Imu",
+            {
+                "header": {"frame_id": "r2/imu_link"},
+                "linear_acceleration": {"z": 9.85},
+                "orientation": {"w": 1},
+            },
+        ),
+        "sensor_msgs/msg/Imu",
+    )
+    for text in ["linear_acceleration.z < 5.0", "linear_acceleration.z > 5.0 and orientation.w == 1"]:
+        e = compile_expr(text)
+        peeked = Peek("sensor_msgs/msg/Imu", sorted(e.fields)).peek(payload)
+        assert e.test(peeked) == e.test(decode(payload, "sensor_msgs/msg/Imu"))

@@ -1,6 +1,7 @@
 """Actors played in the world: each a mocap body whose pose is set every `TICK_NS` of sim time from a table
-of its path sampled at that period (made once, at start), so that moving twenty actors costs a few array
-operations per tick, not a Python loop over their waypoints.
+of its path sampled at that period (made once, at start), so that moving twenty actors costs two array
+copies per tick (the next second of every moving actor's poses is gathered at once), not a Python loop
+over their waypoints.
 
 An actor's clock runs only while it moves: `stop` freezes it where it is, `start` resumes from there. At a
 tick where an actor moves, its pose is the path's at its own time; the physics from that tick to the next
@@ -18,6 +19,7 @@ from runner.plan import ActorPlan
 
 TICK_NS = 10_000_000  # actors move, and events look at the world, every 10 ms of sim time
 MAX_SAMPLES = 360_000  # an hour of a path at TICK_NS: a longer path holds at the hour's point
+WINDOW = 100  # ticks of poses gathered at once for the actors that move
 
 
 def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -118,15 +120,18 @@ class Actors:
         self.pending = sorted(
             ((a.start_ns, i) for i, a in enumerate(plans) if a.start_ns is not None), reverse=True
         )
-        self._moved: tuple[np.ndarray | None, Any, Any] | None = None  # what `tick` writes (see _which)
+        # the poses of the next WINDOW ticks of the actors that move (see `_window`), and how many of them
+        # have been played: a tick is two array copies
+        self._win: tuple[np.ndarray, Any, np.ndarray, np.ndarray] | None = None
+        self._played = 0
 
     def start(self, i: int) -> None:
+        self._commit()
         self.moving[i] = True
-        self._moved = None
 
     def stop(self, i: int) -> None:
+        self._commit()
         self.moving[i] = False
-        self._moved = None
 
     def place(self, i: int, pos: list[float], quat: list[float]) -> None:
         """Teleported: it stops, and stands there until started again (then it goes on along its path)."""
@@ -134,32 +139,43 @@ class Actors:
         self.data.mocap_pos[self.mocap[i]] = pos
         self.data.mocap_quat[self.mocap[i]] = quat
 
-    def _which(self) -> tuple[np.ndarray | None, Any, Any]:
-        """The actors that move (None: all of them) and where their poses go in the mocap arrays: a slice
-        when their mocap bodies are consecutive (every actor of the world, usually), else their indices.
-        Worked out again only when an actor starts or stops, not every tick."""
+    def _commit(self) -> None:
+        """The ticks played from the window counted into each actor's own clock; the window dropped (the
+        set of moving actors changes, or it is used up)."""
+        if self._win is not None:
+            self.ticks[self._win[0]] += self._played
+        self._win = None
+        self._played = 0
+
+    def _window(self) -> tuple[np.ndarray, Any, np.ndarray, np.ndarray]:
+        """The actors that move, where their poses go in the mocap arrays (a slice when their mocap bodies
+        are consecutive, as every actor of a world's are, else their indices), and their positions and
+        orientations at each of the next WINDOW ticks of their own clocks: one gather for them all."""
         rows = np.flatnonzero(self.moving)
         ids = self.mocap[rows]
         where: Any = ids
         if len(ids) and np.array_equal(ids, np.arange(ids[0], ids[0] + len(ids))):
             where = slice(int(ids[0]), int(ids[0]) + len(ids))
-        self._moved = (None if len(rows) == len(self.moving) else rows, where, rows)
-        return self._moved
+        idx = self.ticks[rows][None, :] + np.arange(WINDOW)[:, None]  # (WINDOW, moving)
+        idx %= self.lap[rows]
+        np.minimum(idx, self.last[rows], out=idx)
+        idx += self.base[rows]
+        pose = self.pose[idx]
+        self._win = (rows, where, np.ascontiguousarray(pose[..., :3]), np.ascontiguousarray(pose[..., 3:]))
+        return self._win
 
     def tick(self, now_ns: int) -> None:
         while self.pending and self.pending[-1][0] <= now_ns:
+            self._commit()
             self.moving[self.pending.pop()[1]] = True
-            self._moved = None
-        select, where, rows = self._moved or self._which()
+        win = self._win
+        if win is None or self._played == WINDOW:
+            self._commit()
+            win = self._window()
+        rows, where, pos, quat = win
         if not len(rows):
             return
-        idx = self.ticks % self.lap
-        np.minimum(idx, self.last, out=idx)
-        idx += self.base
-        pose = self.pose[idx if select is None else idx[select]]
-        self.data.mocap_pos[where] = pose[:, :3]
-        self.data.mocap_quat[where] = pose[:, 3:]
-        if select is None:
-            self.ticks += 1
-        else:
-            self.ticks[select] += 1
+        k = self._played
+        self.data.mocap_pos[where] = pos[k]
+        self.data.mocap_quat[where] = quat[k]
+        self._played = k + 1

@@ -19,8 +19,8 @@ def act(ev: Any, e: Any, a: dict[str, Any], now: int) -> str:
     kind = a["kind"]
     world, m, d = ev.world, ev.m, ev.d
     if kind == "publish":
-        out = world.make_publisher(a["key"], a["type"])
-        world.publish(out, ev.message_of(a), now)
+        msg, payload = ev.message_of(a)
+        world.make_publisher(a["key"], a["type"]).publish_encoded(payload, msg, now)
         return f"published on {a['key'].split('/', 1)[1]}"
     if kind in ("start", "stop"):
         if ev.actors is not None:

@@ -13,6 +13,7 @@ events (actors move after them, on ticks), then controllers act on the commands,
 
 from __future__ import annotations
 
+import heapq
 import json
 import math
 from collections.abc import Callable
@@ -28,6 +29,7 @@ from runner.sim.actors import TICK_NS, Actors
 from runner.sim.event_actions import act
 from runner.sim.faults import Fault
 from runner.wire import msgs
+from runner.wire.cdr import string_message
 
 _EVENTS_STREAM = 1_000_003  # random streams of events' faults: (seed, this + event index)
 
@@ -41,7 +43,13 @@ class EventWorld(Protocol):
 
     def make_publisher(self, key: str, type_name: str) -> Any: ...
     def publish(self, out: Any, msg: Any, stamp_ns: int) -> None: ...
-    def listen(self, key: str, type_name: str, callback: Callable[[Any, int], None]) -> None: ...
+    def listen(
+        self,
+        key: str,
+        type_name: str,
+        callback: Callable[[Any, int], None],
+        fields: list[str] | None = None,
+    ) -> None: ...
     def plugin_at(self, index: int) -> Any: ...
     def set_rate(self, index: int, rate: float, now_ns: int) -> None: ...
     def end_here(self, why: str) -> None: ...
@@ -62,6 +70,8 @@ class _Event:
         self.at = 0  # (spatial) where its body's (x, y) is in what `Events._where` gathers
         self.to_at = 0  # (near another body) where that body's is
         self.fired = 0
+        # (spatial) `look(where)`: why it fires at this look, or None (made by `Events._looker`)
+        self.look: Callable[[list[list[float]]], str | None] | None = None
 
 
 class Events:
@@ -83,7 +93,7 @@ class Events:
         self.spatial = [e for e in self.events if e.kind in ("near", "enter", "leave")]
         self.out = world.make_publisher(events_key(plan.name), "std_msgs/msg/String") if self.events else None
         self.log: list[dict[str, Any]] = []
-        self._messages: dict[int, Any] = {}  # publish actions' messages, by the action's id
+        self._messages: dict[int, tuple[Any, bytes]] = {}  # publish actions' messages, by the action's id
         self._bodies_at: list[int] = []  # what spatial triggers look at (see `_locator`)
         self._geoms_at: list[int] = []
         for e in self.events:
@@ -102,6 +112,16 @@ class Events:
                     e.to_at = self._locator(when["to"])
         self._bodies = np.asarray(self._bodies_at, dtype=np.int64)
         self._geoms = np.asarray(self._geoms_at, dtype=np.int64)
+        for e in self.spatial:
+            e.look = self._looker(e)
+        # what a boundary looks at, so that it does not walk every event at every step: the spatial
+        # events not done (at ticks), those with times (`at`, delayed `after`), and those a message or an
+        # assertion made pending since the last boundary (by plan index: they are looked at in plan order)
+        self._spatial_queue = [e.index for e in self.spatial]  # those not done
+        self._timed = [e for e in self.events if e.kind in ("at", "after")]
+        self._flagged: list[int] = []
+        self._queue: list[int] | None = None  # the indices still to look at in this boundary
+        self._current = -1  # the index being looked at
 
     # -------------------------------------------------------------------------------- triggers
     def _locator(self, ref: dict[str, Any]) -> int:
@@ -136,9 +156,10 @@ class Events:
                 return
             if ok:
                 e.pending = f"`{when['expr']}` on {when['topic']}"
+                self._flag(e)
                 self.next_ns = 0
 
-        self.world.listen(when["key"], when["type"], on_message)
+        self.world.listen(when["key"], when["type"], on_message, sorted(expr.fields))
 
     def _listen_assertion(self, e: _Event, plan: RunPlan) -> None:
         from runner.checks import specs_from_plan
@@ -160,99 +181,149 @@ class Events:
                 e.pending = (
                     f"assertion {when['name']!r} {'passed' if want == 'pass' else 'failed'}: {result.message}"
                 )
+                self._flag(e)
                 self.next_ns = 0
 
         self.world.listen(key, types[key], on_message)
 
-    def _holds(self, e: _Event, now: int, tick: bool, where: list[list[float]] | None = None) -> str | None:
-        """Why `e` fires now, or None (`tick`: the first step of a 10 ms tick, where places are looked at;
-        `where`: what `_where` gave, at this step, since the last firing)."""
-        if e.pending is not None:
-            why, e.pending = e.pending, None
-            return why
-        if e.due and e.due[0] <= now:
-            e.due.pop(0)
-            return (
-                f"at {now / 1e9:g} s"
-                if e.kind == "at"
-                else f"{e.plan.when['delay_ns'] / 1e9:g} s after {e.plan.when['event']}"
-            )
-        if not e.spatial or not tick:
-            return None
-        return self._spatial(e, where if where is not None else self._where())
-
-    def _spatial(self, e: _Event, where: list[list[float]]) -> str | None:
+    def _looker(self, e: _Event) -> Callable[[list[list[float]]], str | None]:
+        """`look(where)` for a spatial event: whether its body came near, entered or left, at this look
+        (`where`: what `_where` gathered at this step), with its numbers bound once."""
         when = e.plan.when
-        x, y = where[e.at]
-        who = when["body"]["name"]
+        at, who = e.at, when["body"]["name"]
         if e.kind == "near":
-            tx, ty = where[e.to_at] if isinstance(when["to"], dict) else when["to"]
-            dist = math.hypot(x - tx, y - ty)
-            now_in = dist <= when["within"]
+            within = when["within"]
+            to_body = isinstance(when["to"], dict)
+            to_at = e.to_at
+            tx0, ty0 = (0.0, 0.0) if to_body else when["to"]
+
+            def near(where: list[list[float]]) -> str | None:
+                x, y = where[at]
+                tx, ty = where[to_at] if to_body else (tx0, ty0)
+                dist = math.hypot(x - tx, y - ty)
+                now_in = dist <= within
+                was, e.inside = e.inside, now_in
+                if now_in and not was:
+                    to = when["to"]["name"] if to_body else f"[{tx:g}, {ty:g}]"
+                    return f"{who} within {within:g} m of {to} ({dist:.2f} m)"
+                return None
+
+            return near
+        contains = e.region.contains  # type: ignore[union-attr]
+        entering = e.kind == "enter"
+
+        def crossing(where: list[list[float]]) -> str | None:
+            x, y = where[at]
+            now_in = contains(x, y)
             was, e.inside = e.inside, now_in
-            if now_in and not was:
-                to = when["to"]["name"] if isinstance(when["to"], dict) else f"[{tx:g}, {ty:g}]"
-                return f"{who} within {when['within']:g} m of {to} ({dist:.2f} m)"
+            if was is None or was == now_in:
+                return None  # (the first look sets where it is: entering or leaving is a change)
+            if entering and now_in:
+                return f"{who} entered {when['label']} at ({x:.2f}, {y:.2f})"
+            if not entering and not now_in:
+                return f"{who} left {when['label']} at ({x:.2f}, {y:.2f})"
             return None
-        now_in = e.region.contains(x, y)
-        was, e.inside = e.inside, now_in
-        if was is None:
-            return None  # the first look sets where it is: entering or leaving is a change
-        if e.kind == "enter" and now_in and not was:
-            return f"{who} entered {when['label']} at ({x:.2f}, {y:.2f})"
-        if e.kind == "leave" and was and not now_in:
-            return f"{who} left {when['label']} at ({x:.2f}, {y:.2f})"
-        return None
+
+        return crossing
 
     # -------------------------------------------------------------------------------- the step
     def boundary(self, now: int) -> None:
-        for key, (fault, out) in list(self.faults.items()):
-            fault.release(out, now)
-            if fault.until_ns is not None and now >= fault.until_ns:
-                out.fault = None  # over: new messages go straight out...
-                fault.until_ns = None
-            if out.fault is not fault and not fault.held:  # ... and what it holds, each at its time
-                del self.faults[key]
+        if self.faults:
+            for key, (fault, out) in list(self.faults.items()):
+                fault.release(out, now)
+                if fault.until_ns is not None and now >= fault.until_ns:
+                    out.fault = None  # over: new messages go straight out...
+                    fault.until_ns = None
+                if out.fault is not fault and not fault.held:  # ... and what it holds, each at its time
+                    del self.faults[key]
         if self.pushes:
             for _until, body, wrench in [p for p in self.pushes if p[0] <= now]:
                 self.d.xfrc_applied[body] -= wrench
             self.pushes = [p for p in self.pushes if p[0] > now]
         tick = now >= self.next_tick
-        look = bool(self.spatial) and tick
-        where = None  # where the bodies are: gathered once, again after a firing (a teleport moves one)
-        for e in self.events:
-            # (the cheap part of `_holds` first: most events, most of the time, have nothing to look at)
-            if e.done or (e.pending is None and not (e.due and e.due[0] <= now) and not (look and e.spatial)):
-                continue
-            if look and e.spatial and where is None:
-                where = self._where()
-            why = self._holds(e, now, tick, where)
-            if why is not None:
-                self._fire(e, now, why)
-                where = None
+        queue = self._spatial_queue[:] if tick else []  # (in plan order: a heap)
+        if self._flagged:
+            queue += self._flagged
+            self._flagged = []
+        for e in self._timed:
+            if e.due and e.due[0] <= now:
+                queue.append(e.index)
+        if queue:
+            heapq.heapify(queue)
+            self._queue = queue
+            self._look(queue, now, tick)
+            self._queue = None
         if tick:
             if self.actors is not None:
                 self.actors.tick(now)
             self.next_tick = (now // TICK_NS + 1) * TICK_NS
         self.next_ns = self._next(now)
 
+    def _look(self, queue: list[int], now: int, tick: bool) -> None:
+        """The events of `queue` (plan indices) in plan order, each fired if its trigger holds now: made
+        pending (by a message, an assertion, the event it follows), due (its time has come), or, at a tick,
+        its body near or across a border. Where the bodies are is gathered once, and again after a firing
+        (a teleport moves one)."""
+        events = self.events
+        where = None
+        last = -1
+        while queue:
+            i = heapq.heappop(queue)
+            if i == last:
+                continue
+            last = self._current = i
+            e = events[i]
+            if e.done:
+                continue
+            if e.pending is not None:
+                why, e.pending = e.pending, None
+            elif e.due and e.due[0] <= now:
+                e.due.pop(0)
+                why = (
+                    f"at {now / 1e9:g} s"
+                    if e.kind == "at"
+                    else f"{e.plan.when['delay_ns'] / 1e9:g} s after {e.plan.when['event']}"
+                )
+            elif tick and e.look is not None:
+                if where is None:
+                    where = self._where()
+                why = e.look(where)
+            else:
+                continue
+            if why is not None:
+                self._fire(e, now, why)
+                where = None
+
+    def _flag(self, e: _Event) -> None:
+        """`e` has become pending: looked at in this boundary if it comes later in the plan than the event
+        being looked at (an event that follows another, by `after` or a message it publishes, does), else
+        at the next boundary."""
+        if self._queue is not None and e.index > self._current:
+            heapq.heappush(self._queue, e.index)
+        else:
+            self._flagged.append(e.index)
+
     def _next(self, now: int) -> int:
         nxt = self.next_tick if (self.actors is not None or self.spatial) else 2**62
-        for e in self.events:
-            if e.due and not e.done:
-                nxt = min(nxt, e.due[0])
-        for fault, _out in self.faults.values():
-            t = fault.next_ns()
-            if t is not None:
-                nxt = min(nxt, t)
+        for e in self._timed:
+            if e.due and not e.done and e.due[0] < nxt:
+                nxt = e.due[0]
+        if self.faults:
+            for fault, _out in self.faults.values():
+                t = fault.next_ns()
+                if t is not None and t < nxt:
+                    nxt = t
         for until, _b, _w in self.pushes:
-            nxt = min(nxt, until)
-        return max(nxt, now + 1)
+            if until < nxt:
+                nxt = until
+        return nxt if nxt > now else now + 1
 
     def _fire(self, e: _Event, now: int, why: str) -> None:
         e.fired += 1
         if not e.plan.repeat:
             e.done = True
+            if e.spatial:
+                self._spatial_queue = [x.index for x in self.spatial if not x.done]
         did = [self._do(e, a, now) for a in e.plan.do]
         end = next((a for a in e.plan.do if a["kind"] == "end"), None)
         entry = {"event": e.name, "t": now / 1e9, "why": why, "did": did, "n": e.fired}
@@ -260,13 +331,14 @@ class Events:
             entry["end"] = {"result": end["result"], "message": end["message"]}
         self.log.append(entry)
         if self.out is not None:
-            self.world.publish(self.out, msgs.T["std_msgs/msg/String"](data=json.dumps(entry)), now)
+            self.out.publish_encoded(string_message(json.dumps(entry)), None, now)
         for f in self.followers.get(e.name, ()):
             if f.done:
                 continue
             delay = f.plan.when["delay_ns"]
             if delay == 0:
                 f.pending = f"after {e.name}"
+                self._flag(f)
             else:
                 f.due.append(now + delay)
                 f.due.sort()
@@ -278,12 +350,13 @@ class Events:
     def _do(self, e: _Event, a: dict[str, Any], now: int) -> str:
         return act(self, e, a, now)
 
-    def message_of(self, action: dict[str, Any]) -> Any:
-        """The message a `publish` action sends, built once (its data never changes)."""
-        msg = self._messages.get(id(action))
-        if msg is None:
-            msg = self._messages[id(action)] = msgs.from_data(action["type"], action["data"])
-        return msg
+    def message_of(self, action: dict[str, Any]) -> tuple[Any, bytes]:
+        """The message a `publish` action sends and its bytes, built once (its data never changes)."""
+        built = self._messages.get(id(action))
+        if built is None:
+            msg = msgs.from_data(action["type"], action["data"])
+            built = self._messages[id(action)] = (msg, msgs.encode(msg, action["type"]))
+        return built
 
     def wake(self, t_ns: int) -> None:
         """Be looked at again at `t_ns` at the latest (a fault holds a message due then)."""

@@ -19,6 +19,11 @@ if TYPE_CHECKING:
     from runner.sim.links import Lockstep
 
 
+# A subscriber in this process: (type, callback, peek): `peek(payload)` gives what the callback reads of
+# each message this process publishes (runner.wire.cdr.Peek), or None for the whole decoded message
+Local = tuple[str, Callable[[Any, int], None], Callable[[bytes], Any] | None]
+
+
 class Outgoing:
     """One published key: sends CDR bytes with the (sequence, stamp) attachment and hands the message to
     subscribers inside this process (decoded only when there is one). While an event's fault is on the key
@@ -31,12 +36,15 @@ class Outgoing:
         self.type = type_name
         self.send = send
         self.seq = 0
-        self.local: list[tuple[str, Callable[[Any, int], None]]] = []
+        self.local: list[Local] = []
         self.fault: Any = None
         self.last: bytes | None = None  # the last message sent (what a `freeze` fault repeats)
 
     def publish(self, msg: Any, stamp_ns: int) -> None:
-        payload = msgs.encode(msg, self.type)
+        self.publish_encoded(msgs.encode(msg, self.type), msg, stamp_ns)
+
+    def publish_encoded(self, payload: bytes, msg: Any, stamp_ns: int) -> None:
+        """`msg` already encoded (`payload`): a message sent again and again, encoded once."""
         if self.fault is not None:
             self.fault.take(self, payload, msg, stamp_ns)
         else:
@@ -55,8 +63,12 @@ class Outgoing:
         self.seq += 1
         self.last = payload
         if self.local:
-            msg = msg if msg is not None else msgs.decode(payload, self.type)
-            for _type, cb in self.local:
+            for _type, cb, peek in self.local:
+                if msg is None:
+                    if peek is not None:  # (it reads only the fields it needs)
+                        cb(peek(payload), stamp_ns)
+                        continue
+                    msg = msgs.decode(payload, self.type)
                 cb(msg, stamp_ns)
 
 
@@ -72,7 +84,7 @@ class PubSub:
 
     def _init_pubsub(self) -> None:
         self._out: dict[str, Outgoing] = {}
-        self._local: dict[str, list[tuple[str, Callable[[Any, int], None]]]] = {}
+        self._local: dict[str, list[Local]] = {}
         self._remote_subscribed: set[str] = set()
         self._inbox: queue.SimpleQueue[tuple[str, bytes, bytes | None]] = queue.SimpleQueue()
         self._received: dict[str, int] = {}  # messages from other processes, per key
@@ -105,7 +117,7 @@ class PubSub:
         def subscribe(topic: str, type_name: str, callback: Callable[[Any, int], None]) -> None:
             key = topic_key(self.plan.name, namespace, topic)
             # the same list as the publisher's `local`, if this process also publishes the key
-            self._local.setdefault(key, []).append((msgs.normalize_type(type_name), callback))
+            self._local.setdefault(key, []).append((msgs.normalize_type(type_name), callback, None))
             if key not in self._remote_subscribed:
                 self._remote_subscribed.add(key)
                 self.bus.subscribe(key, self._on_remote, msgs.normalize_type(type_name))
@@ -127,7 +139,7 @@ class PubSub:
                 key, payload, _att = self._inbox.get_nowait()
             except queue.Empty:
                 return
-            for type_name, cb in self._local.get(key, ()):
+            for type_name, cb, _peek in self._local.get(key, ()):
                 try:
                     msg = msgs.decode(payload, type_name)
                 except Exception:

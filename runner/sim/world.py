@@ -26,7 +26,7 @@ from __future__ import annotations
 import gc
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -44,7 +44,7 @@ from runner.sim.schedule import Hook, next_due, sleep_until
 if TYPE_CHECKING:
     from runner.sim.events import Events
 from runner.wire import msgs
-from runner.wire.cdr import Layout
+from runner.wire.cdr import Layout, Peek
 from runner.wire.transport import Bus
 
 # Without anything due, the loop still stops this often (sim time) to take input and check for a stop.
@@ -248,16 +248,25 @@ class World(PubSub):
         self.render_plugins[index].after_step(now_ns)
 
     # ----------------------------------------------------------------------- what events act on
-    def listen(self, key: str, type_name: str, callback: Callable[[Any, int], None]) -> None:
+    def listen(
+        self,
+        key: str,
+        type_name: str,
+        callback: Callable[[Any, int], None],
+        fields: Sequence[str] | None = None,
+    ) -> None:
         """`callback(msg, stamp_ns)` for each message on a full key: handed over at once when this world
-        publishes it, else at the next boundary from other processes (a node's topic, `publishes:`)."""
+        publishes it, else at the next boundary from other processes (a node's topic, `publishes:`).
+        With `fields`, the callback reads only those top-level fields of what this world publishes: they
+        alone are read from the bytes (`Peek`), unless the message object is at hand."""
         plan = self.plan
         own = {t.key for r in plan.robots for p in r.plugins for t in p.topics if t.direction == "pub"}
         own |= set(self._out) | {ev.key for ev in plan.timeline}
         own |= {a["key"] for e in plan.events for a in e.do if a["kind"] == "publish"}
         own.add(f"{plan.name}/_contacts")  # (not a node's topic, though a node declares it: `publishes:`)
         if key in own:
-            self._local.setdefault(key, []).append((type_name, callback))
+            peek = Peek(type_name, fields).peek if fields else None
+            self._local.setdefault(key, []).append((type_name, callback, peek))
         else:
             self._subscriber_factory("")("/" + key.split("/", 1)[1], type_name, callback)
 

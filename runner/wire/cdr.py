@@ -188,3 +188,246 @@ class Layout:
 def _align(pos: int, size: int) -> int:
     rel = pos - _HEADER
     return _HEADER + ((rel + size - 1) // size) * size
+
+
+def string_message(text: str) -> bytes:
+    """A `std_msgs/msg/String`'s bytes, as rosbags encodes them (the events' record, one per firing)."""
+    data = text.encode()
+    return b"\x00\x01\x00\x00" + _U32_PACK(len(data) + 1) + data + b"\x00"
+
+
+# ------------------------------------------------------------------------------------------------ Peek
+_UNPACK = {k: struct.Struct("<" + c).unpack_from for k, c in {
+    "bool": "?", "byte": "B", "char": "B", "int8": "b", "uint8": "B", "int16": "h", "uint16": "H",
+    "int32": "i", "uint32": "I", "int64": "q", "uint64": "Q", "float32": "f", "float64": "d",
+}.items()}  # fmt: skip
+_U32 = struct.Struct("<I").unpack_from
+_U32_PACK = struct.Struct("<I").pack
+
+# One step of a Peek: `op(raw, pos, values) -> pos`, `raw` the bytes after the encapsulation header (CDR
+# aligns from there), `values` the fields read so far
+_Op = Callable[[memoryview, int, dict[str, Any]], int]
+
+
+class Peek:
+    """Some top-level fields of a message read straight from its CDR bytes, the rest skipped: what a
+    `message` trigger needs of every message of a sensor topic (`linear_acceleration`, `ranges`), at a
+    fraction of decoding it all. `peek(payload)` gives a message of the type's own class with only those
+    fields set, each exactly as `msgs.decode` gives it (the same class, a Python number, a numpy array of
+    the same dtype over the bytes). Only for bytes encoded by this process (it checks no lengths): a
+    payload from elsewhere is decoded with `msgs.decode`, which refuses what does not fit.
+
+    A field the type does not have makes `peek` the full `msgs.decode` (`Peek.full` is True): what the
+    expression then says of it is what it says of a decoded message."""
+
+    def __init__(self, type_name: str, fields: Sequence[str]):
+        self.type = msgs.normalize_type(type_name)
+        msgdef = msgs.TYPESTORE.get_msgdef(self.type)
+        self.cls = msgdef.cls
+        names = [n for n, _ in msgdef.fields]
+        wanted = [f for f in fields if f in names]
+        self.full = len(wanted) != len(set(fields)) or not wanted
+        if not self.full:
+            last = max(names.index(f) for f in wanted)
+            self._ops = _merge(
+                [
+                    op
+                    for name, desc in msgdef.fields[: last + 1]
+                    for op in (_read(name, desc) if name in wanted else _skip(desc))
+                ]
+            )
+        if self.full:
+            self.peek = self._decode  # type: ignore[method-assign]
+
+    def _decode(self, payload: bytes | memoryview) -> Any:
+        return msgs.decode(payload, self.type)
+
+    def peek(self, payload: bytes | memoryview) -> Any:
+        raw = memoryview(payload)[_HEADER:]
+        values: dict[str, Any] = {}
+        pos = 0
+        for op in self._ops:
+            pos = op(raw, pos, values)
+        msg = self.cls.__new__(self.cls)
+        msg.__dict__.update(values)
+        return msg
+
+
+# A run of fields of fixed size is one step: where it ends depends only on where it starts modulo 8 (no
+# alignment is over 8), so it is a table of 8 distances. (align, size) pairs until merged.
+_Fixed = tuple[int, int]
+
+
+def _first_align(desc: tuple[Any, Any]) -> int:
+    node, args = desc
+    if node == Nodetype.BASE:
+        return 4 if args[0] in ("string", "wstring") else _SIZE[args[0]]
+    if node == Nodetype.NAME:
+        return _first_align(msgs.TYPESTORE.get_msgdef(args).fields[0][1])
+    if node == Nodetype.SEQUENCE:
+        return 4
+    return _first_align(args[0])
+
+
+def _skip(desc: tuple[Any, Any]) -> list[_Op | _Fixed]:
+    """The steps that step over a field."""
+    node, args = desc
+    if node == Nodetype.NAME:
+        return [op for _n, d in msgs.TYPESTORE.get_msgdef(args).fields for op in _skip(d)]
+    if node == Nodetype.BASE:
+        if args[0] in ("string", "wstring"):
+            return [_skip_string]
+        return [(_SIZE[args[0]], _SIZE[args[0]])]
+    sub, length = args
+    numeric = sub[0] == Nodetype.BASE and sub[1][0] not in ("string", "wstring")
+    if node == Nodetype.ARRAY:
+        if numeric:
+            return [(_SIZE[sub[1][0]], length * _SIZE[sub[1][0]])] if length else []
+        return [op for _ in range(length) for op in _skip(sub)]
+    if not numeric:
+        item = _merge(_skip(sub))  # a sequence of strings or messages: each item stepped over
+
+        def skip_items(raw: memoryview, pos: int, values: dict[str, Any]) -> int:
+            pos = (pos + 3) & -4
+            n = _U32(raw, pos)[0]
+            pos += 4
+            for _ in range(n):
+                for op in item:
+                    pos = op(raw, pos, values)
+            return pos
+
+        return [skip_items]
+    size = _SIZE[sub[1][0]]
+
+    def skip_sequence(raw: memoryview, pos: int, values: dict[str, Any]) -> int:
+        pos = (pos + 3) & -4
+        n = _U32(raw, pos)[0]
+        pos += 4
+        if n:
+            pos = ((pos + size - 1) & -size) + n * size
+        return pos
+
+    return [skip_sequence]
+
+
+def _skip_string(raw: memoryview, pos: int, values: dict[str, Any]) -> int:
+    pos = (pos + 3) & -4
+    return pos + 4 + _U32(raw, pos)[0]
+
+
+def _read(name: str, desc: tuple[Any, Any]) -> list[_Op | _Fixed]:
+    """The step that reads a field into `values[name]`, as rosbags decodes it."""
+    node, args = desc
+    if node == Nodetype.NAME:
+        msgdef = msgs.TYPESTORE.get_msgdef(args)
+        deserialize, cls, store = msgdef.deserialize_cdr_le, msgdef.cls, msgs.TYPESTORE
+        a = _first_align(desc)
+
+        def read_message(raw: memoryview, pos: int, values: dict[str, Any]) -> int:
+            values[name], pos = deserialize(raw, (pos + a - 1) & -a, cls, store)
+            return pos
+
+        return [read_message]
+    if node == Nodetype.BASE:
+        kind = args[0]
+        if kind in ("string", "wstring"):
+
+            def read_string(raw: memoryview, pos: int, values: dict[str, Any]) -> int:
+                pos = (pos + 3) & -4
+                n = _U32(raw, pos)[0]
+                values[name] = bytes(raw[pos + 4 : pos + 3 + n]).decode()
+                return pos + 4 + n
+
+            return [read_string]
+        size, unpack = _SIZE[kind], _UNPACK[kind]
+
+        def read_number(raw: memoryview, pos: int, values: dict[str, Any]) -> int:
+            pos = (pos + size - 1) & -size
+            values[name] = unpack(raw, pos)[0]
+            return pos + size
+
+        return [read_number]
+    sub, length = args
+    if sub[0] != Nodetype.BASE or sub[1][0] in ("string", "wstring"):
+        return [_read_items(name, sub, length if node == Nodetype.ARRAY else None)]
+    kind = sub[1][0]
+    size, dtype = _SIZE[kind], msgs._NUMPY[kind]
+    if node == Nodetype.ARRAY:
+
+        def read_array(raw: memoryview, pos: int, values: dict[str, Any]) -> int:
+            if length:
+                pos = (pos + size - 1) & -size
+            values[name] = np.frombuffer(raw, dtype=dtype, count=length, offset=pos)
+            return pos + length * size
+
+        return [read_array]
+
+    def read_sequence(raw: memoryview, pos: int, values: dict[str, Any]) -> int:
+        pos = (pos + 3) & -4
+        n = _U32(raw, pos)[0]
+        pos += 4
+        if n:
+            pos = (pos + size - 1) & -size
+        values[name] = np.frombuffer(raw, dtype=dtype, count=n, offset=pos)
+        return pos + n * size
+
+    return [read_sequence]
+
+
+def _read_items(name: str, sub: tuple[Any, Any], length: int | None) -> _Op:
+    """Reads an array (`length`) or a sequence (None) of strings or messages into a list, as rosbags does."""
+    (item,) = _read("item", sub)
+    assert callable(item)
+
+    def read_items(raw: memoryview, pos: int, values: dict[str, Any]) -> int:
+        n = length
+        if n is None:
+            pos = (pos + 3) & -4
+            n = _U32(raw, pos)[0]
+            pos += 4
+        one: dict[str, Any] = {}
+        items = []
+        for _ in range(n):
+            pos = item(raw, pos, one)
+            items.append(one["item"])
+        values[name] = items
+        return pos
+
+    return read_items
+
+
+def _merge(steps: list[_Op | _Fixed]) -> list[_Op]:
+    """Runs of fixed-size steps merged into one step each (a table by the start's place modulo 8)."""
+    ops: list[_Op] = []
+    run: list[_Fixed] = []
+    for step in [*steps, None]:
+        if isinstance(step, tuple):
+            run.append(step)
+            continue
+        if run:
+            ops.append(_fixed(run))
+            run = []
+        if step is not None:
+            ops.append(step)
+    return ops
+
+
+def _fixed(run: list[_Fixed]) -> _Op:
+    table = []
+    for start in range(8):
+        pos = start
+        for a, size in run:
+            pos = ((pos + a - 1) & -a) + size
+        table.append(pos - start)
+    if len(set(table)) == 1:
+        d = table[0]
+
+        def skip_same(raw: memoryview, pos: int, values: dict[str, Any]) -> int:
+            return pos + d
+
+        return skip_same
+
+    def skip_fixed(raw: memoryview, pos: int, values: dict[str, Any]) -> int:
+        return pos + table[pos & 7]
+
+    return skip_fixed

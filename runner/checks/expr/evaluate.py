@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from runner.checks.expr.fast import Fn, compile_fast
 from runner.checks.expr.language import (
     ARRAY_HINT,
     BINOPS,
@@ -101,6 +102,9 @@ def _compare(op: type[ast.cmpop], a: Any, b: Any) -> Any:
     return a != b
 
 
+_SLOW = object()
+
+
 class Expr:
     """A checked expression. `evaluate(msg)` gives its value; `test(msg)` requires true or false."""
 
@@ -109,6 +113,10 @@ class Expr:
         self._tree = tree
         self._s = source
         self._paths = paths
+        self._fast: Fn | None = None  # test()'s closures (runner.checks.expr.fast), made at its first call
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {**self.__dict__, "_fast": None}  # (closures do not pickle; made again where it is used)
 
     def __repr__(self) -> str:
         return f"Expr({self.text!r})"
@@ -126,8 +134,18 @@ class Expr:
             return self._eval(self._tree.body, msg)
 
     def test(self, msg: Any) -> bool:
-        value = self.evaluate(msg)
-        if isinstance(value, bool | np.bool_):
+        fast = self._fast
+        if fast is None:
+            fast = self._fast = compile_fast(self._tree.body)
+        try:
+            value = fast(msg)
+        except Exception:  # (Slow, or what Python refuses): the interpreter gives the value or the error
+            value = _SLOW
+        if value is _SLOW:
+            value = self.evaluate(msg)
+        if value is True or value is False:
+            return value
+        if isinstance(value, np.bool_):
             return bool(value)
         hint = ARRAY_HINT if isinstance(value, np.ndarray | list) else "compare it: speed < 0.5"
         raise ExprError(
@@ -271,7 +289,15 @@ class Expr:
             if not _is_numeric(v):
                 self._fail(f"{func.id}(a, b) needs numbers; found {_describe(v)}", node)
         if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
-            return np.minimum(a, b) if func.id == "min" else np.maximum(a, b)
+            try:
+                return np.minimum(a, b) if func.id == "min" else np.maximum(a, b)
+            except ValueError:  # sequences of different lengths
+                self._fail(
+                    f"{func.id}(a, b) of sequences needs them of one length; found {_describe(a)} and "
+                    f"{_describe(b)}",
+                    node,
+                    "compare their items, or reduce each first: min(a.min(), b.min())",
+                )
         return min(a, b) if func.id == "min" else max(a, b)
 
     def _reduce(self, name: str, v: Any, operand: ast.AST, node: ast.AST) -> Any:
