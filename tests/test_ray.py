@@ -376,7 +376,10 @@ def test_the_scenario_folder_reaches_workers_that_run_elsewhere(cluster: Cluster
     ]  # the node drove it
     assert (shared / "goal" / "goal.html").is_file() and (shared / "summary.html").is_file()
     assert f"summary: {shared.as_uri()}/summary.html" in proc.stdout
-    assert "goal: a CPU for each of its 2 processes would be more than any node has: it asks 1" in proc.stderr
+    assert (
+        "goal.yaml: a CPU for each of a run's 2 processes would be more than any node has: each run asks 1"
+        in (" ".join(proc.stderr.split()))
+    )
     assert "goal/goal.html" in (shared / "summary.html").read_text()  # relative: beside the page
     with open(shared / "goal" / "goal.mcap", "rb") as f:
         plans = [m for _s, c, m in make_reader(f).iter_messages() if c.topic == "goal/_plan"]
@@ -517,7 +520,11 @@ def test_what_a_run_asks_of_the_cluster(tmp_path: Path) -> None:
     ]
     assert notes == [] and jobs[1].values == {"seed": "2", "timeline[0].data.linear.x": "0.2"}
     jobs, notes = plan_jobs([cam], "auto", _cluster_of([2, 1]))  # no GPU here; 2 CPUs at most a node
-    assert jobs[0].asks == {"num_cpus": 2.0, "num_gpus": 0.0, "resources": {}} and "it asks 2" in notes[0]
+    assert (
+        jobs[0].asks == {"num_cpus": 2.0, "num_gpus": 0.0, "resources": {}} and "each run asks 2" in notes[0]
+    )
+    jobs, notes = plan_jobs([cam, cam], "auto", _cluster_of([2]))
+    assert len(notes) == 1  # said once for the file
     assert plan_jobs([cam], "0", _cluster_of([4], gpus=1))[0][0].asks["num_gpus"] == 0.0
     assert plan_jobs([cam], "0.5", _cluster_of([4], gpus=1))[0][0].asks["num_gpus"] == 0.5
     with pytest.raises(RunError, match=r"1 GPU\(s\) asked for a run with cameras; the cluster has 0"):

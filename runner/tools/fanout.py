@@ -198,10 +198,11 @@ def _asks(v: Variant, plan: Any, gpus: str, cluster: dict[str, Any], notes: list
     if cpus is None:
         cpus = procs
         if biggest and cpus > biggest:
-            notes.append(
-                f"{v.name}: a CPU for each of its {procs:g} processes would be more than any node has: "
-                f"it asks {biggest:g} (`resources: {{num_cpus: N}}` says otherwise)"
+            note = (
+                f"{v.file.name}: a CPU for each of a run's {procs:g} processes would be more than any node "
+                f"has: each run asks {biggest:g} (`resources: {{num_cpus: N}}` says otherwise)"
             )
+            notes += [] if note in notes else [note]  # (once for a file's variants)
             cpus = biggest
     elif cpus > biggest:
         raise RunError(
