@@ -27,6 +27,9 @@ Sections (in order):
   N (bench/actors.py). Target: at most 15 % more wall time per sim second.
 - meshes: static non-convex collision meshes split into convex pieces (bench/meshes.py): a 50k-triangle
   one-mesh building the first time and from the cache (targets: < 10 s, < 0.2 s), and the worst case.
+- ray: a suite of 24 short variants as `scenario test -j 2` and as `scenario test --ray` on the same 2
+  cores, with a running cluster and with `--ray` starting its own (bench/ray.py): variants per minute and
+  Ray's overhead per variant (target: under 1 s).
 
 Results go to bench/results/<section>.json (with machine info); `--readme` also writes the tables into
 README.md between the `bench:begin`/`bench:end` markers.
@@ -84,6 +87,7 @@ SECTIONS = (
     "plugins",
     "meshes",
     "actors",
+    "ray",
 )
 
 
@@ -713,6 +717,12 @@ def actors(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     return ba.run(args.quick, args.repeat)
 
 
+def ray(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
+    from bench import ray as br
+
+    return br.run(args.quick, args.repeat)
+
+
 RUNNERS = {
     "two_robots": two_robots,
     "scaling": scaling,
@@ -725,6 +735,7 @@ RUNNERS = {
     "plugins": plugins,
     "meshes": meshes,
     "actors": actors,
+    "ray": ray,
 }
 
 

@@ -175,6 +175,8 @@ class RunPlan(BaseModel):
     host: str | None = None  # with hosts: the host that simulates this world (None: the first)
     variant: str = ""  # the matrix variant's label ("" without a matrix): its values, sample, drawn values
     drawn: dict[str, Any] = {}  # values drawn at random (runner.scenario.draws): {path: value}
+    # what one run asks of a cluster (`resources:`; `scenario test --ray`): {num_cpus, num_gpus, custom}
+    resources: dict[str, Any] | None = None
 
     def parts(self) -> list[RunPlan]:
         """The world plans of the run: `worlds`, or this plan itself."""

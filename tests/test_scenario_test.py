@@ -70,3 +70,37 @@ def test_scenario_test_writes_and_links_a_report_per_scenario(tmp_path: Path):
     page = out / "two_robots.html"
     assert page.is_file() and "9 of 9 assertions pass" in page.read_text()
     assert "two_robots.html" in proc.stdout  # the table's report column
+
+
+@pytest.mark.timeout(120)
+def test_a_run_over_its_timeout_is_stopped_and_reported_as_an_error(write_scenario, tmp_path: Path):
+    """--timeout without --ray (the same code runs each variant on Ray): the run is stopped as Ctrl-C stops
+    it, its recording finished, and its suite is an error; the other variant passes."""
+    path = write_scenario(
+        """
+        name: slow
+        duration: 1.0
+        rate: realtime
+        robots:
+          - {name: r1, description: {file: "{diffbot}"}, pose: {xyz: [0, 0, 0.06]}, plugins: [{type: diff_drive}]}
+        matrix:
+          duration: [1.0, 600.0]
+        assertions:
+          - {name: stays_near, type: stay_within, robot: r1, region: {center: [0, 0], radius: 1}}
+        """
+    )
+    junit, out = tmp_path / "j.xml", tmp_path / "runs"
+    proc = run_cli(
+        "test", str(path), "-j", "2", "--timeout", "10", "--out", str(out), "--junit", str(junit), timeout=100
+    )
+    assert proc.returncode == 1, proc.stdout + proc.stderr
+    suites = {s.get("name"): s for s in ET.parse(junit).getroot().findall("testsuite")}
+    short, long = suites[f"{path.stem}[duration=1.0]"], suites[f"{path.stem}[duration=600.0]"]
+    assert short.get("errors") == "0" and short.get("failures") == "0"
+    error = long.find("testcase[@name='run']/error")
+    assert error is not None and "timed out: still running after 10 s of wall time (--timeout), stopped" in (
+        error.text or ""
+    )
+    from runner.record import read_summary
+
+    assert read_summary(out / f"{path.stem}-1.mcap")["topics"]  # finished, readable

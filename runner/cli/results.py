@@ -1,5 +1,6 @@
 """Assertion verdicts on the terminal, as `run` and `check` print them: the table, the pass/fail summary
-line, and the trajectory plot written beside the recording when an assertion failed."""
+line, and the trajectory plot written beside the recording when an assertion failed; and `test`'s table of
+scenario runs and their failures."""
 
 from __future__ import annotations
 
@@ -73,3 +74,60 @@ def print_events(events: list[dict[str, Any]]) -> None:
         table.caption = f"and {left} more firing(s): every one is on the run's `_events` topic"
         table.caption_justify = "left"
     out.print(table)
+
+
+def suites_table(suites: list[Any], reports: dict[str, str], where: dict[str, str] | None = None) -> Table:
+    """One row per scenario run (`scenario test`): assertions passed, failed (not decided), events fired
+    (when some run had events), verdict, time, where it ran (with --ray: {name: node and attempts}), report
+    link (a path, or a URL)."""
+    any_undecided = any(s.undecided for s in suites)
+    any_events = any(s.events for s in suites)
+    table = Table(
+        "scenario",
+        "assertions",
+        "passed",
+        "failed",
+        *(["not decided"] if any_undecided else []),
+        *(["events fired"] if any_events else []),
+        "result",
+        "time (s)",
+        *(["ran on"] if where else []),
+        *(["report"] if reports else []),
+        title="Scenarios",
+        title_justify="left",
+    )
+    for s in suites:
+        failed = sum(1 for r in s.results if r.status == "fail")
+        verdict = "[green]pass[/]" if s.passed else ("[bold red]ERROR[/]" if s.error else "[bold red]FAIL[/]")
+        link = [_link(reports[s.name])] if s.name in reports else []
+        table.add_row(
+            s.name,
+            str(len(s.results)),
+            str(len(s.results) - failed - s.undecided),
+            str(failed),
+            *([str(s.undecided)] if any_undecided else []),
+            *([str(len(s.events))] if any_events else []),
+            verdict,
+            f"{s.time_s:.1f}",
+            *([where.get(s.name, "")] if where else []),
+            *(link or ([""] if reports else [])),
+        )
+    return table
+
+
+def _link(target: str) -> str:
+    """A terminal link to a report: a file, or a URL as it is."""
+    url = target if "://" in target else f"file://{Path(target).resolve()}"
+    return f"[link={url}]{target}[/link]"
+
+
+def print_failures(suites: list[Any]) -> None:
+    """Each run's error and each failed assertion, named by its scenario."""
+    for s in suites:
+        if s.error:
+            err.print(f"{s.name}: {s.error}", markup=False, style="red")
+        for r in s.results:
+            if not r.passed:
+                from runner.tools.report import failure_text
+
+                err.print(f"{s.name}: {failure_text(r)}", markup=False, style="red")

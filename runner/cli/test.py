@@ -1,22 +1,22 @@
 """Commands that judge scenarios for CI: `check` (judge a recording with a scenario's assertions) and `test`
-(run many scenarios, each in its own process, and report them in one table and one JUnit file). The
-pytest plugin (`runner.cli.pytest_plugin`) runs scenarios the same way from pytest."""
+(run many scenarios, each in its own process, and report them in one table and one JUnit file; here with
+`-j N`, or on a Ray cluster with `--ray`: runner.cli.cluster). The pytest plugin
+(`runner.cli.pytest_plugin`) runs scenarios the same way from pytest."""
 
 from __future__ import annotations
 
-import json
-import sys
+import re
 from functools import partial
 from pathlib import Path
 from typing import Annotated, Any
 
 import typer
-from rich.table import Table
 
 from runner.cli.console import err, fail, out
+from runner.cli.help import Command
 from runner.cli.options import AllowUndecided, RecordingArg
 from runner.cli.plans import load_variants
-from runner.cli.results import plot_failure, print_events, print_results
+from runner.cli.results import plot_failure, print_events, print_failures, print_results, suites_table
 from runner.errors import RunError, ScenarioError
 
 
@@ -75,8 +75,22 @@ def check(
     raise typer.Exit(0 if suite.passed else 1)
 
 
-# A scenario run of `test`: the file, its variant's index (None without a matrix) and the variant's label.
-Task = tuple[Path, int | None, str]
+# `--ray ADDRESS`: what Ray takes as a cluster's address (anything else after `--ray` is not its value)
+_RAY_ADDRESS = re.compile(r"^(auto|local|ray://\S+|\S+:\d+)$")
+
+
+class TestCommand(Command):
+    """`scenario test`, whose `--ray` takes an address or none: `--ray` followed by something that is not a
+    Ray address (a scenario path, another option, nothing) means Ray's own default (`ray.init()`)."""
+
+    def parse_args(self, ctx: Any, args: list[str]) -> list[str]:
+        fixed: list[str] = []
+        for i, arg in enumerate(args):
+            nxt = args[i + 1] if i + 1 < len(args) else ""
+            if arg == "--ray" and not (_RAY_ADDRESS.match(nxt) and not Path(nxt).exists()):
+                arg = "--ray="
+            fixed.append(arg)
+        return super().parse_args(ctx, fixed)
 
 
 def test_cmd(
@@ -92,29 +106,104 @@ def test_cmd(
         bool, typer.Option("--no-record", help="Judge live only; write no recordings.")
     ] = False,
     allow_undecided: AllowUndecided = False,
+    timeout: Annotated[
+        float | None,
+        typer.Option(
+            metavar="SECONDS",
+            help="Stop a run that takes longer than this (wall time); it is reported as an error.",
+            min=0.001,
+        ),
+    ] = None,
+    ray: Annotated[
+        str | None,
+        typer.Option(
+            "--ray",
+            metavar="[ADDRESS]",
+            help="Run every scenario and variant as a task on a Ray cluster: the head's address "
+            "(host:port, ray://host:10001), or none for Ray's default (RAY_ADDRESS, else a cluster "
+            "started on this machine, else a new local one). Needs Ray: the `ray` extra.",
+        ),
+    ] = None,
+    artifacts: Annotated[
+        str | None,
+        typer.Option(
+            metavar="URL",
+            help="With --ray: where recordings, reports, plots and summary.html go, one folder per "
+            "variant: a local folder (default: --out; the workers send the files back) or an fsspec URL "
+            "the workers write to (s3://bucket/runs, gs://..., file:///shared/mount).",
+        ),
+    ] = None,
+    gpus: Annotated[
+        str,
+        typer.Option(
+            metavar="auto|N",
+            help="With --ray: GPUs a run with cameras asks for: auto (1 when the cluster has GPUs, else "
+            "none) or a number (0: never). A scenario's `resources:` says otherwise.",
+        ),
+    ] = "auto",
 ) -> None:
-    """Run many scenarios (in parallel processes), print a results table, write JUnit XML; exit 0 only if
-    every run completes and every assertion passes.
+    """Run many scenarios (in parallel processes, or on a Ray cluster), print a results table, write JUnit
+    XML; exit 0 only if every run completes and every assertion passes.
 
-    Example: scenario test scenarios/ -j 2 --junit report.xml
+    Examples:
+      scenario test scenarios/ -j 2 --junit report.xml
+      scenario test scenarios/ --ray --junit report.xml
+      scenario test scenarios/ --ray 10.0.0.1:6379 --artifacts s3://bucket/runs --timeout 600
     """
+    from runner.tools.suite import scenario_files, variants_of
+
+    _check_ray_options(ray, artifacts, gpus)
+    files = scenario_files(paths)
+    if not files:
+        raise fail(RunError("no scenario files found in " + ", ".join(map(str, paths))))
+    if ray is not None:
+        from runner.cli.cluster import test_on_ray
+
+        where = artifacts if artifacts is not None else str(out_dir)
+        test_on_ray(variants_of(files), ray, where, not no_record, allow_undecided, timeout, gpus, junit)
+        return
+    _test_here(variants_of(files), jobs, junit, out_dir, no_record, allow_undecided, timeout)
+
+
+def _check_ray_options(ray: str | None, artifacts: str | None, gpus: str) -> None:
+    """--artifacts and --gpus go with --ray; --gpus is `auto` or a number."""
+    if ray is None:
+        for option, given in (("--artifacts", artifacts is not None), ("--gpus", gpus != "auto")):
+            if given:
+                raise typer.BadParameter(f"{option} goes with --ray (without it, recordings go to --out)")
+    if gpus != "auto":
+        try:
+            ok = float(gpus) >= 0
+        except ValueError:
+            ok = False
+        if not ok:
+            raise typer.BadParameter(f"--gpus {gpus!r}: expected auto or a number of GPUs (0 or more)")
+
+
+def _test_here(
+    variants: list[Any],
+    jobs: int,
+    junit: Path | None,
+    out_dir: Path,
+    no_record: bool,
+    allow_undecided: bool,
+    timeout: float | None,
+) -> None:
+    """The suite on this machine, `jobs` runs at once."""
     import concurrent.futures
 
     from runner.tools.report import write_junit
 
-    files: list[Path] = []
-    for p in paths:
-        files += sorted(p.glob("*.yaml")) if p.is_dir() else [p]
-    if not files:
-        raise fail(RunError("no scenario files found in " + ", ".join(map(str, paths))))
     if not no_record:
         out_dir.mkdir(parents=True, exist_ok=True)
-    run_one = partial(_run_in_process, out_dir=out_dir, no_record=no_record, allow_undecided=allow_undecided)
+    run_one = partial(
+        _run_here, out_dir=out_dir, no_record=no_record, allow_undecided=allow_undecided, timeout=timeout
+    )
     with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
-        suites = list(pool.map(run_one, _tasks(files)))
+        suites = list(pool.map(run_one, variants))
     reports = {} if no_record else _write_reports(suites)  # one page per scenario, beside its recording
-    out.print(_suites_table(suites, reports))
-    _print_failures(suites)
+    out.print(suites_table(suites, reports))
+    print_failures(suites)
     if junit is not None:
         write_junit(junit, suites)
     ok = sum(1 for s in suites if s.passed)
@@ -122,48 +211,14 @@ def test_cmd(
     raise typer.Exit(0 if ok == len(suites) else 1)
 
 
-def _tasks(files: list[Path]) -> list[Task]:
-    """Every run of the files: one per file, or one per variant of a file's matrix."""
-    from runner.scenario.loader import load_file
-    from runner.scenario.matrix import variants
+def _run_here(
+    variant: Any, out_dir: Path, no_record: bool, allow_undecided: bool, timeout: float | None
+) -> Any:
+    """`scenario run` of one variant in a process of its own (runner.tools.suite, as a Ray task runs it)."""
+    from runner.tools.suite import run_variant
 
-    tasks: list[Task] = []
-    for f in files:
-        try:
-            labels = [label for label, _ in variants(load_file(f))]
-        except ScenarioError:
-            labels = [""]  # the run itself reports the error
-        tasks += [(f, i if len(labels) > 1 else None, label) for i, label in enumerate(labels)]
-    return tasks
-
-
-def _run_in_process(task: Task, out_dir: Path, no_record: bool, allow_undecided: bool) -> Any:
-    """`scenario run` of one task in a process of its own: its suite, read back from --results-json (or
-    the process's last words as the suite's error)."""
-    import subprocess
-    import tempfile
-
-    from runner.tools.report import Suite
-
-    f, index, label = task
-    name = f"{f.stem}[{label}]" if label else f.stem
-    with tempfile.TemporaryDirectory() as tmp:
-        res = Path(tmp) / "results.json"
-        cmd = [sys.executable, "-m", "runner.cli", "run", str(f), "-q", "--results-json", str(res)]
-        stem = f.stem if index is None else f"{f.stem}-{index}"
-        cmd += ["--no-record"] if no_record else ["--record", str(out_dir / f"{stem}.mcap")]
-        if index is not None:
-            cmd += ["--variant", str(index)]
-        if allow_undecided:
-            cmd += ["--allow-undecided"]
-        proc = subprocess.run(cmd, capture_output=True, text=True)
-        if res.is_file():
-            suite = Suite.from_json(json.loads(res.read_text()))
-            # the run's own label: a pose drawn in collision was drawn again there
-            suite.name = f"{f.stem}[{suite.label}]" if suite.label else name
-            return suite
-        why = (proc.stderr.strip() or proc.stdout.strip() or f"exit {proc.returncode}").splitlines()
-        return Suite(name, error="\n".join(why[-12:]))
+    record = None if no_record else out_dir / f"{variant.stem}.mcap"
+    return run_variant(variant, record, allow_undecided=allow_undecided, timeout_s=timeout)
 
 
 def _write_reports(suites: list[Any]) -> dict[str, str]:
@@ -180,55 +235,3 @@ def _write_reports(suites: list[Any]) -> dict[str, str]:
             except Exception as e:  # a report is a convenience: never a failed test run
                 err.print(f"{s.name}: no report: {e}", markup=False)
     return reports
-
-
-def _suites_table(suites: list[Any], reports: dict[str, str]) -> Table:
-    """One row per scenario run: assertions passed, failed (not decided), events fired (when some run had
-    events), verdict, time, report link."""
-    any_undecided = any(s.undecided for s in suites)
-    any_events = any(s.events for s in suites)
-    table = Table(
-        "scenario",
-        "assertions",
-        "passed",
-        "failed",
-        *(["not decided"] if any_undecided else []),
-        *(["events fired"] if any_events else []),
-        "result",
-        "time (s)",
-        *(["report"] if reports else []),
-        title="Scenarios",
-        title_justify="left",
-    )
-    for s in suites:
-        failed = sum(1 for r in s.results if r.status == "fail")
-        verdict = "[green]pass[/]" if s.passed else ("[bold red]ERROR[/]" if s.error else "[bold red]FAIL[/]")
-        link = (
-            [f"[link=file://{Path(reports[s.name]).resolve()}]{reports[s.name]}[/link]"]
-            if s.name in reports
-            else []
-        )
-        table.add_row(
-            s.name,
-            str(len(s.results)),
-            str(len(s.results) - failed - s.undecided),
-            str(failed),
-            *([str(s.undecided)] if any_undecided else []),
-            *([str(len(s.events))] if any_events else []),
-            verdict,
-            f"{s.time_s:.1f}",
-            *(link or ([""] if reports else [])),
-        )
-    return table
-
-
-def _print_failures(suites: list[Any]) -> None:
-    """Each run's error and each failed assertion, named by its scenario."""
-    for s in suites:
-        if s.error:
-            err.print(f"{s.name}: {s.error}", markup=False, style="red")
-        for r in s.results:
-            if not r.passed:
-                from runner.tools.report import failure_text
-
-                err.print(f"{s.name}: {failure_text(r)}", markup=False, style="red")

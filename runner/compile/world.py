@@ -110,6 +110,7 @@ def compile_world(
         nodes=nodes,
         lockstep=list(sc.lockstep),
         hosts={name: h.endpoint for name, h in sc.hosts.items()},
+        resources=sc.resources.model_dump() if sc.resources else None,
         host=host,
     )
 

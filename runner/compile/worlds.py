@@ -97,6 +97,7 @@ def compile_worlds(
         renderers=sc.renderers,
         nodes=nodes,
         hosts={name: h.endpoint for name, h in sc.hosts.items()},
+        resources=sc.resources.model_dump() if sc.resources else None,
         lockstep=list(sc.lockstep),
         worlds=plans,
     )

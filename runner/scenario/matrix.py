@@ -110,6 +110,20 @@ def variants(doc: Document) -> list[tuple[str, Document]]:
     return out
 
 
+def variant_values(doc: Document) -> list[dict[str, str]]:
+    """Each variant's matrix values, as its label writes them ({key: value}, and `sample` with `samples:`),
+    in the order of `variants` ([{}] without a matrix): what a suite's pass rate is broken down by."""
+    data = doc.data
+    if not isinstance(data, dict) or not data.get("matrix"):
+        return [{}]
+    paths, samples = _matrix(doc)
+    out: list[dict[str, str]] = []
+    for combo in itertools.product(*[data["matrix"][k] for k, _ in paths]):
+        values = {key: _label(v) for (key, _), v in zip(paths, combo, strict=True)}
+        out += [{**values, **({"sample": str(i)} if samples else {})} for i in range(samples or 1)]
+    return out
+
+
 def _matrix(doc: Document) -> tuple[list[tuple[str, tuple[str | int, ...]]], int | None]:
     """The matrix's paths (key, parsed) and `samples` (None without), every mistake in it at once."""
     matrix = doc.data["matrix"]

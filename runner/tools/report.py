@@ -125,6 +125,8 @@ class Suite:
     interrupted: str | None = None  # "interrupted at t=...": why the run ended before its planned end
     label: str = ""  # the matrix variant's label (its values and drawn values), "" without a matrix
     events: list[dict[str, Any]] = field(default_factory=list)  # the events' firings (`firings`)
+    # said of the run as JUnit <properties> (`scenario test --ray`: the node it ran on, its attempts)
+    properties: dict[str, str] = field(default_factory=dict)
 
     @property
     def passed(self) -> bool:
@@ -154,6 +156,7 @@ class Suite:
             },
             "results": [r.to_json() for r in self.results],
             "events": self.events,
+            **({"properties": self.properties} if self.properties else {}),
         }
 
     @classmethod
@@ -182,6 +185,7 @@ class Suite:
             interrupted=data.get("interrupted"),
             label=data.get("label", ""),
             events=list(data.get("events") or []),
+            properties={str(k): str(v) for k, v in (data.get("properties") or {}).items()},
         )
 
 
@@ -224,7 +228,7 @@ def write_junit(path: Path, suites: list[Suite]) -> None:
             hostname=socket.gethostname() or "localhost",
         )
         wall += s.time_s
-        _event_properties(suite, s.events)  # (first: Ant's schema orders properties, testcases, output)
+        _properties(suite, s.events, s.properties)  # (first: Ant's schema orders properties, testcases...)
         if s.error:
             case = ET.SubElement(suite, "testcase", classname=s.name, name="run", time=f"{s.sim_s:.3f}")
             ET.SubElement(
@@ -262,12 +266,14 @@ def write_junit(path: Path, suites: list[Suite]) -> None:
 JUNIT_EVENT_LINES = 1000  # firings written to a suite's <system-out>, at most (a repeating event...)
 
 
-def _event_properties(suite: ET.Element, events: list[dict[str, Any]]) -> None:
-    """`event.NAME` = the sim time it first fired (and `event.NAME.fired` = how often, when more than
-    once), for CI readers that show a suite's properties."""
-    if not events:
+def _properties(suite: ET.Element, events: list[dict[str, Any]], said: dict[str, str]) -> None:
+    """The suite's own properties (`said`), and `event.NAME` = the sim time it first fired (and
+    `event.NAME.fired` = how often, when more than once), for CI readers that show a suite's properties."""
+    if not events and not said:
         return
     props = ET.SubElement(suite, "properties")
+    for name, value in said.items():
+        ET.SubElement(props, "property", name=name, value=value)
     seen: dict[str, list[float]] = {}
     for f in events:
         seen.setdefault(f["event"], []).append(f["t"])

@@ -6,7 +6,7 @@ No I/O happens here: files named in a scenario are read by the compile pass.
 
 One module per section of the format: `base` (the shared base model, name patterns, vectors, poses),
 `world`, `robots`, `assertions`, `messages` (timeline, qos, record, foxglove), `network` (hosts, nodes,
-zenoh, ros2, bridges) and `scenario` (the file as a whole). Every model is importable from here.
+resources, zenoh, ros2, bridges) and `scenario` (the file as a whole). Every model is importable from here.
 """
 
 from runner.scenario.schema.assertions import (
@@ -49,7 +49,15 @@ from runner.scenario.schema.events import (
     When,
 )
 from runner.scenario.schema.messages import Foxglove, QosRule, Record, TimelineEntry
-from runner.scenario.schema.network import Bridge, BridgeDirection, Host, Node, Ros2, ZenohSettings
+from runner.scenario.schema.network import (
+    Bridge,
+    BridgeDirection,
+    Host,
+    Node,
+    Resources,
+    Ros2,
+    ZenohSettings,
+)
 from runner.scenario.schema.robots import Description, PluginEntry, Robot, XacroArg
 from runner.scenario.schema.scenario import MAX_DURATION, SCHEMA_VERSION, Scenario
 from runner.scenario.schema.world import Ground, NamedWorld, Physics, World, WorldModel
@@ -93,6 +101,7 @@ __all__ = [
     "Reach",
     "Record",
     "Region",
+    "Resources",
     "Rgba",
     "Robot",
     "Ros2",

@@ -1,6 +1,7 @@
-"""The run beyond its world: the machines it spans (`hosts:`), the processes started with it (`nodes:`),
-its Zenoh configuration (`zenoh:`), how ROS 2 sees it over rmw_zenoh (`ros2:`) and the topics it
-re-exposes under other keys (`bridges:`, like ros_gz_bridge)."""
+"""The run beyond its world: the machines it spans (`hosts:`), what one run asks of a cluster
+(`resources:`), the processes started with it (`nodes:`), its Zenoh configuration (`zenoh:`), how ROS 2
+sees it over rmw_zenoh (`ros2:`) and the topics it re-exposes under other keys (`bridges:`, like
+ros_gz_bridge)."""
 
 from __future__ import annotations
 
@@ -69,6 +70,34 @@ class Node(Strict):
         description="With `worlds:`, the world whose key space the node works in (`SCENARIO_RUN` is "
         "`<run>/<world>`; default: the world of the robot named by its namespace, else the first).",
     )
+
+
+class Resources(Strict):
+    """What one run of the scenario asks of a cluster (`scenario test --ray`): Ray schedules each run (each
+    matrix variant) where these are free. Without it, a run asks one CPU per world, node and renderer
+    process, and with `--gpus` a GPU when it has cameras."""
+
+    num_cpus: PositiveFloat | None = Field(
+        None, description="CPUs one run takes (fractions allowed, e.g. 0.5); default: its processes."
+    )
+    num_gpus: Annotated[float, Field(ge=0)] | None = Field(
+        None,
+        description="GPUs one run takes (fractions share one, e.g. 0.25); default: per `scenario test "
+        "--gpus` (auto: 1 for a run with cameras when the cluster has GPUs).",
+    )
+    custom: dict[Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_.:-]*$")], PositiveFloat] = Field(
+        default_factory=dict,
+        description="The cluster's own resources one run takes, by name (as `ray start --resources` "
+        "declares them), e.g. `{lidar_box: 1}`.",
+    )
+
+    @field_validator("custom")
+    @classmethod
+    def _not_builtin(cls, v: dict[str, float]) -> dict[str, float]:
+        for name in v:
+            if name in ("CPU", "GPU", "memory", "object_store_memory"):
+                raise ValueError(f"custom.{name}: say it with num_cpus / num_gpus, not as a custom resource")
+        return v
 
 
 class Ros2(Strict):

@@ -12,7 +12,7 @@ from runner.scenario.schema.assertions import Assertion, Region
 from runner.scenario.schema.base import IDENT_RE, NODE_NAME_RE, Rate, RunName, Strict
 from runner.scenario.schema.events import Event
 from runner.scenario.schema.messages import Foxglove, QosRule, Record, TimelineEntry
-from runner.scenario.schema.network import Bridge, Host, Node, Ros2, ZenohSettings
+from runner.scenario.schema.network import Bridge, Host, Node, Resources, Ros2, ZenohSettings
 from runner.scenario.schema.robots import Robot
 from runner.scenario.schema.world import NamedWorld, World
 
@@ -96,6 +96,11 @@ class Scenario(Strict):
         description="Machines of the run by name; worlds and nodes say where they run (`host:`). Without "
         "it, everything runs on this machine. `scenario run FILE` plays the first host (it records and "
         "judges), `scenario run FILE --host NAME` another one, `--local` all of them here.",
+    )
+    resources: Resources | None = Field(
+        None,
+        description="What one run asks of a cluster under `scenario test --ray` (CPUs, GPUs, custom "
+        "resources); default: a CPU per process of the run, a GPU for cameras per `--gpus`.",
     )
     foxglove: Foxglove = Field(
         default_factory=Foxglove, description="The 3D view a recording carries (Foxglove-ready)."
