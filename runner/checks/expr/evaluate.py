@@ -13,6 +13,7 @@ import numpy as np
 
 from runner.checks.expr.fast import Fn, compile_fast
 from runner.checks.expr.language import (
+    APPLY,
     ARRAY_HINT,
     BINOPS,
     CMPOPS,
@@ -21,6 +22,9 @@ from runner.checks.expr.language import (
     Source,
     did_you_mean,
     index_value,
+    is_number,
+    is_numeric,
+    scalar,
 )
 
 
@@ -57,49 +61,6 @@ def _describe(v: Any) -> str:
     if v is None:
         return "None"
     return f"a {type(v).__name__}"
-
-
-def _is_number(v: Any) -> bool:
-    return isinstance(v, int | float | np.number) and not isinstance(v, bool | np.bool_)
-
-
-def _is_numeric(v: Any) -> bool:
-    return _is_number(v) or (isinstance(v, np.ndarray) and v.dtype.kind in "iuf")
-
-
-def _scalar(v: Any) -> Any:
-    """A numpy scalar (an item of an array, a reducer's result) as the Python number it equals, as message
-    scalar fields are: no integer wraparound, and `x > 1e308` or `x == 0.1` mean what they say for a
-    float32 (numpy would round the Python number to float32 first)."""
-    if isinstance(v, np.generic):
-        return v.item()
-    return v
-
-
-def _binop(op: type[ast.operator], a: Any, b: Any) -> Any:
-    if op is ast.Add:
-        return a + b
-    if op is ast.Sub:
-        return a - b
-    if op is ast.Mult:
-        return a * b
-    if op is ast.Div:
-        return a / b
-    return a % b
-
-
-def _compare(op: type[ast.cmpop], a: Any, b: Any) -> Any:
-    if op is ast.Lt:
-        return a < b
-    if op is ast.LtE:
-        return a <= b
-    if op is ast.Gt:
-        return a > b
-    if op is ast.GtE:
-        return a >= b
-    if op is ast.Eq:
-        return a == b
-    return a != b
 
 
 _SLOW = object()
@@ -174,7 +135,7 @@ class Expr:
             v = self._eval(node.operand, msg)
             if isinstance(node.op, ast.Not):
                 return not self._bool(v, node.operand, "not")
-            if not _is_numeric(v):
+            if not is_numeric(v):
                 sym = "-" if isinstance(node.op, ast.USub) else "+"
                 self._fail(f"unary '{sym}' needs a number; found {_describe(v)}", node)
             return -v if isinstance(node.op, ast.USub) else +v
@@ -184,10 +145,10 @@ class Expr:
             sym = BINOPS[type(node.op)]
             col = self._s.between(node.left, node.right, sym)
             for v in (a, b):
-                if not _is_numeric(v):
+                if not is_numeric(v):
                     self._fail(f"'{sym}' needs numbers; found {_describe(v)}", node, column=col)
             try:
-                return _binop(type(node.op), a, b)
+                return APPLY[type(node.op)](a, b)
             except ZeroDivisionError:
                 self._fail(f"division by zero in '{ast.unparse(node)}'", node, column=col)
             except (TypeError, ValueError, ArithmeticError) as e:
@@ -199,7 +160,7 @@ class Expr:
                 sym = CMPOPS[type(op)]
                 col = self._s.between(left_node, right_node, sym)
                 try:
-                    r = _compare(type(op), left, right)
+                    r = APPLY[type(op)](left, right)
                 except (TypeError, ValueError, ArithmeticError):
                     self._fail(
                         f"cannot compare {_describe(left)} with {_describe(right)} using '{sym}'",
@@ -237,7 +198,7 @@ class Expr:
             self._fail(f"'{shown}' cannot be indexed; it is {_describe(seq)}", node.slice)
         if not -len(seq) <= i < len(seq):
             self._fail(f"index {i} is out of range: '{shown}' has {len(seq)} items", node.slice)
-        return _scalar(seq[i])
+        return scalar(seq[i])
 
     def _field(self, obj: Any, name: str, owner: ast.AST | None, node: ast.AST) -> Any:
         fields = getattr(type(obj), "__dataclass_fields__", None)
@@ -279,14 +240,14 @@ class Expr:
             return len(v)
         if func.id == "abs":
             (v,) = args
-            if not _is_numeric(v):
+            if not is_numeric(v):
                 self._fail(f"abs() needs a number; found {_describe(v)}", node)
             return abs(v)
         if len(args) == 1:
             return self._reduce(func.id, args[0], node.args[0], node)
         a, b = args
         for v in (a, b):
-            if not _is_numeric(v):
+            if not is_numeric(v):
                 self._fail(f"{func.id}(a, b) needs numbers; found {_describe(v)}", node)
         if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
             try:
@@ -302,7 +263,7 @@ class Expr:
 
     def _reduce(self, name: str, v: Any, operand: ast.AST, node: ast.AST) -> Any:
         shown = ast.unparse(operand)
-        if isinstance(v, list | tuple) and all(_is_number(x) or isinstance(x, bool | np.bool_) for x in v):
+        if isinstance(v, list | tuple) and all(is_number(x) or isinstance(x, bool | np.bool_) for x in v):
             v = np.asarray(v)
         if not isinstance(v, np.ndarray):
             self._fail(f"{name}() needs a sequence of numbers; '{shown}' is {_describe(v)}", node)
@@ -310,4 +271,4 @@ class Expr:
             self._fail(f"{name}() needs a sequence of numbers; '{shown}' is {_describe(v)}", node)
         if v.size == 0:
             self._fail(f"{name} of an empty sequence ('{shown}' has no items)", node)
-        return _scalar(getattr(np, name)(v))
+        return scalar(getattr(np, name)(v))

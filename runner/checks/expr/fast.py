@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from runner.checks.expr.language import index_value
+from runner.checks.expr.language import APPLY, index_value, is_numeric, scalar
 
 Fn = Callable[[Any], Any]
 
@@ -23,45 +23,12 @@ class Slow(Exception):
     """Let the interpreter evaluate this message (it knows what to say)."""
 
 
-_NUMBER = (int, float)  # what rosbags gives for scalar fields (bools are refused separately)
-_ARRAY_KINDS = frozenset("iuf")
-_BINOPS: dict[type[ast.operator], Callable[[Any, Any], Any]] = {
-    ast.Add: operator.add,
-    ast.Sub: operator.sub,
-    ast.Mult: operator.mul,
-    ast.Div: operator.truediv,
-    ast.Mod: operator.mod,
-}
-_CMPOPS: dict[type[ast.cmpop], Callable[[Any, Any], Any]] = {
-    ast.Lt: operator.lt,
-    ast.LtE: operator.le,
-    ast.Gt: operator.gt,
-    ast.GtE: operator.ge,
-    ast.Eq: operator.eq,
-    ast.NotEq: operator.ne,
-}
-
-
-def _numeric(v: Any) -> bool:
-    """As the interpreter's `_is_numeric`: a number that is not a bool, or an array of numbers."""
-    t = type(v)
-    if t is float or t is int:
-        return True
-    if t is np.ndarray:
-        return v.dtype.kind in _ARRAY_KINDS
-    return isinstance(v, int | float | np.number) and not isinstance(v, bool | np.bool_)
-
-
 def _truth(v: Any) -> bool:
     if v is True or v is False:
         return v
     if isinstance(v, np.bool_):
         return bool(v)
     raise Slow
-
-
-def _scalar(v: Any) -> Any:
-    return v.item() if isinstance(v, np.generic) else v
 
 
 def compile_fast(node: ast.AST) -> Fn:
@@ -80,10 +47,10 @@ def compile_fast(node: ast.AST) -> Fn:
     if isinstance(node, ast.UnaryOp):
         return _unary(node.op, compile_fast(node.operand))
     if isinstance(node, ast.BinOp):
-        return _binop(_BINOPS[type(node.op)], compile_fast(node.left), compile_fast(node.right))
+        return _binop(APPLY[type(node.op)], compile_fast(node.left), compile_fast(node.right))
     if isinstance(node, ast.Compare):
         return _compare(
-            [_CMPOPS[type(op)] for op in node.ops], [compile_fast(n) for n in [node.left, *node.comparators]]
+            [APPLY[type(op)] for op in node.ops], [compile_fast(n) for n in [node.left, *node.comparators]]
         )
     if isinstance(node, ast.Call):
         return _call(node)
@@ -108,7 +75,7 @@ def _index(seq_fn: Fn, i: int | None) -> Fn:
         seq = seq_fn(msg)
         if not isinstance(seq, np.ndarray | list | tuple | str) or not -len(seq) <= i < len(seq):
             raise Slow
-        return _scalar(seq[i])
+        return scalar(seq[i])
 
     return index
 
@@ -130,7 +97,7 @@ def _unary(op: ast.unaryop, fn: Fn) -> Fn:
 
     def unary(msg: Any) -> Any:
         v = fn(msg)
-        if not _numeric(v):
+        if not is_numeric(v):
             raise Slow
         return -v if negate else +v
 
@@ -140,7 +107,7 @@ def _unary(op: ast.unaryop, fn: Fn) -> Fn:
 def _binop(op: Callable[[Any, Any], Any], left: Fn, right: Fn) -> Fn:
     def binop(msg: Any) -> Any:
         a, b = left(msg), right(msg)
-        if not (_numeric(a) and _numeric(b)):
+        if not (is_numeric(a) and is_numeric(b)):
             raise Slow
         if type(a) is np.ndarray or type(b) is np.ndarray:
             with np.errstate(all="ignore"):
@@ -199,7 +166,7 @@ def _call(node: ast.Call) -> Fn:
 
         def absolute(msg: Any) -> Any:
             v = arg(msg)
-            if not _numeric(v):
+            if not is_numeric(v):
                 raise Slow
             return abs(v)
 
@@ -211,7 +178,7 @@ def _call(node: ast.Call) -> Fn:
 
     def two(msg: Any) -> Any:
         a, b = first(msg), second(msg)
-        if not (_numeric(a) and _numeric(b)):
+        if not (is_numeric(a) and is_numeric(b)):
             raise Slow
         if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
             with np.errstate(all="ignore"):
@@ -230,8 +197,8 @@ def _reduce(name: str, fn: Fn) -> Fn:
         if type(v) is not np.ndarray or v.dtype.kind not in "iufb" or v.size == 0:
             raise Slow  # (a list of numbers, too: the interpreter makes it an array)
         if quiet:
-            return _scalar(method(v))
+            return scalar(method(v))
         with np.errstate(all="ignore"):
-            return _scalar(method(v))
+            return scalar(method(v))
 
     return reduce

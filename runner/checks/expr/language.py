@@ -1,5 +1,6 @@
 """What the expression language is made of, shared by its parts (checking, evaluating, checking by
-type): the operators, functions and reducers it allows, the error it raises (`ExprError`, with a caret
+type): the operators, functions and reducers it allows (and what the operators compute, what counts as a
+number), the error it raises (`ExprError`, with a caret
 under the column), where in the user's text a node of the tree stands (`Source`) and the field paths an
 expression reads (`FieldPath`)."""
 
@@ -8,6 +9,11 @@ from __future__ import annotations
 import ast
 import dataclasses
 import difflib
+import operator
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
 
 REDUCERS = ("min", "max", "mean", "sum", "std")
 FUNCTIONS = ("abs", "len", "min", "max")
@@ -34,6 +40,42 @@ CMPOPS: dict[type[ast.cmpop], str] = {
     ast.Eq: "==",
     ast.NotEq: "!=",
 }
+# ... and what they compute
+APPLY: dict[type[ast.operator] | type[ast.cmpop], Callable[[Any, Any], Any]] = {
+    ast.Add: operator.add,
+    ast.Sub: operator.sub,
+    ast.Mult: operator.mul,
+    ast.Div: operator.truediv,
+    ast.Mod: operator.mod,
+    ast.Lt: operator.lt,
+    ast.LtE: operator.le,
+    ast.Gt: operator.gt,
+    ast.GtE: operator.ge,
+    ast.Eq: operator.eq,
+    ast.NotEq: operator.ne,
+}
+
+
+def is_number(v: Any) -> bool:
+    """A number that is not a bool (scalar fields are Python numbers; items and reductions become them)."""
+    t = type(v)
+    if t is float or t is int:
+        return True
+    return isinstance(v, int | float | np.number) and not isinstance(v, bool | np.bool_)
+
+
+def is_numeric(v: Any) -> bool:
+    """A number (not a bool) or an array of numbers: what arithmetic takes."""
+    if isinstance(v, np.ndarray):
+        return v.dtype.kind in "iuf"
+    return is_number(v)
+
+
+def scalar(v: Any) -> Any:
+    """A numpy scalar (an item of an array, a reducer's result) as the Python number it equals, as message
+    scalar fields are: no integer wraparound, and `x > 1e308` or `x == 0.1` mean what they say for a
+    float32 (numpy would round the Python number to float32 first)."""
+    return v.item() if isinstance(v, np.generic) else v
 
 
 class ExprError(ValueError):
