@@ -42,7 +42,6 @@ class EventWorld(Protocol):
     data: mujoco.MjData
 
     def make_publisher(self, key: str, type_name: str) -> Any: ...
-    def publish(self, out: Any, msg: Any, stamp_ns: int) -> None: ...
     def listen(
         self,
         key: str,
@@ -118,7 +117,9 @@ class Events:
         # events not done (at ticks), those with times (`at`, delayed `after`), and those a message or an
         # assertion made pending since the last boundary (by plan index: they are looked at in plan order)
         self._spatial_queue = [e.index for e in self.spatial]  # those not done
-        self._timed = [e for e in self.events if e.kind in ("at", "after")]
+        self._timed = [
+            e for e in self.events if e.kind == "at" or (e.kind == "after" and e.plan.when["delay_ns"])
+        ]
         self._flagged: list[int] = []
         self._queue: list[int] | None = None  # the indices still to look at in this boundary
         self._current = -1  # the index being looked at

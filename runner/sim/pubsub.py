@@ -43,7 +43,7 @@ class Outgoing:
     def publish(self, msg: Any, stamp_ns: int) -> None:
         self.publish_encoded(msgs.encode(msg, self.type), msg, stamp_ns)
 
-    def publish_encoded(self, payload: bytes, msg: Any, stamp_ns: int) -> None:
+    def publish_encoded(self, payload: bytes | bytearray, msg: Any, stamp_ns: int) -> None:
         """`msg` already encoded (`payload`): a message sent again and again, encoded once."""
         if self.fault is not None:
             self.fault.take(self, payload, msg, stamp_ns)
@@ -54,10 +54,7 @@ class Outgoing:
         """Send CDR bytes. A `bytearray` is borrowed (a camera's frame, encoded in place and rewritten for
         the next one): the bus copies it once as it sends it, and it is copied here only where it is kept
         (a fault holding it, a subscriber in this process)."""
-        if self.fault is not None:
-            self.fault.take(self, bytes(payload), None, stamp_ns)
-        else:
-            self.deliver(payload, None, stamp_ns)
+        self.publish_encoded(payload if self.fault is None else bytes(payload), None, stamp_ns)
 
     def deliver(self, payload: bytes | bytearray, msg: Any, stamp_ns: int) -> None:
         """Send, and hand to subscribers in this process (`msg`, or `payload` decoded when there is one);

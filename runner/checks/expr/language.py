@@ -1,8 +1,7 @@
 """What the expression language is made of, shared by its parts (checking, evaluating, checking by
 type): the operators, functions and reducers it allows (and what the operators compute, what counts as a
-number), the error it raises (`ExprError`, with a caret
-under the column), where in the user's text a node of the tree stands (`Source`) and the field paths an
-expression reads (`FieldPath`)."""
+number), the error it raises (`ExprError`, with a caret under the column), where in the user's text a node
+of the tree stands (`Source`) and the field paths an expression reads (`FieldPath`)."""
 
 from __future__ import annotations
 
