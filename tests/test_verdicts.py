@@ -358,3 +358,63 @@ def test_validate_warns_of_what_would_decide_nothing_and_strict_makes_it_an_erro
     assert f"--strict: {len(expected)} warning(s) about the scenario are errors" in strict.stderr
     assert "Traceback" not in strict.stderr
     assert run_cli("validate", str(REPO / "scenarios" / "two_robots.yaml"), "--strict").returncode == 0
+
+
+def test_the_judge_waits_for_the_messages_still_in_flight_on_its_own_subscriptions(write_scenario):
+    """Without a recording the judge subscribes itself; at the end it waits, as the recorder does, until it
+    has every message the world says it published: the last ones decide a verdict. (Real Zenoh sessions;
+    the supervisor's view of the run is a stand-in whose world ended having published N messages.)"""
+    import threading
+    from types import SimpleNamespace
+
+    import zenoh
+
+    from runner.launch.parts import JudgePart
+    from runner.wire.transport import free_port, make_config, pack_attachment
+
+    path = write_scenario(
+        BASE.format(
+            assertion="{name: a, type: message, topic: r1/cmd_vel, mode: eventually, expr: 'linear.x > 1'}"
+        )
+    )
+    plan = plan_of(path)
+    key = f"{plan.name}/r1/cmd_vel"
+    judge = judge_for(plan)
+    assert judge is not None and key in judge.keys
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    n = 40
+    twist = "geometry_msgs/msg/Twist"
+    slow = msgs.encode(msgs.from_data(twist, {}), twist)
+    fast = msgs.encode(msgs.from_data(twist, {"linear": {"x": 2.0}}), twist)
+    with zenoh.open(make_config("router", listen=[endpoint])) as session:
+        world = SimpleNamespace(
+            child=object(), remote_host=None, ended=threading.Event(), end_info={"published": {key: n}}
+        )
+        world.ended.set()
+        run = SimpleNamespace(
+            plan=plan, session=session, subs=[], worlds=[world], recorder=None, reason="completed",
+            error=None, hurry=threading.Event(), wait=lambda event, timeout_s: event.wait(timeout_s),
+        )  # fmt: skip
+        part = JudgePart(judge)
+        part.start(run)
+        with zenoh.open(make_config("client", connect=[endpoint])) as other:
+            pub = other.declare_publisher(key)
+            time.sleep(0.3)  # (the client's connection and the judge's subscription are declared)
+
+            def publish() -> None:  # the world's last messages, still on their way when the drain begins
+                for i in range(n):
+                    time.sleep(0.02)
+                    pub.put(fast if i == n - 1 else slow, attachment=pack_attachment(i, (i + 1) * 1_000_000))
+
+            sender = threading.Thread(target=publish)
+            sender.start()
+            try:
+                part.drain(run)
+                got = dict(part.own)
+            finally:
+                sender.join(timeout=10)
+                for sub in run.subs:
+                    sub.undeclare()
+    assert got == {key: n}
+    (result,) = judge.finish(n * 1_000_000)
+    assert result.passed, result.to_json()

@@ -11,6 +11,7 @@ from __future__ import annotations
 import sys
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -52,6 +53,27 @@ class Run(Protocol):
     def reached(self) -> int: ...
 
     def ending(self) -> str: ...
+
+
+def wait_for_published(run: Run, counts: Callable[[], dict[str, int]], wanted: Callable[[str], bool]) -> None:
+    """Wait until `counts()` holds, for every key `wanted` that a world says it published, as many messages
+    as it published (or a timeout: DRAIN_TIMEOUT_S, DRAIN_HURRIED_S once interrupted, none after a second
+    signal). What a part that takes the worlds' messages (the recorder, the judge's own subscriptions) does
+    at the end, so that the last messages in flight are not lost to it."""
+    hurried = run.reason == "interrupted"
+    for world in run.worlds:
+        if world.child is None and world.remote_host is None:
+            continue  # never started (stopped while starting)
+        # its end message comes just before it exits (it has by now): interrupted, do not linger
+        if not run.wait(world.ended, 0.2 if hurried else 0.5) or run.hurry.is_set():
+            continue
+        published: dict[str, int] = world.end_info.get("published", {})
+        deadline = time.monotonic() + (DRAIN_HURRIED_S if hurried else DRAIN_TIMEOUT_S)
+        while time.monotonic() < deadline and not run.hurry.is_set():
+            got = counts()
+            if all(got.get(k, 0) >= n for k, n in published.items() if wanted(k)):
+                break
+            run.hurry.wait(0.01)
 
 
 class Part:
@@ -211,20 +233,7 @@ class RecorderPart(Part):
         """Wait until the recorder holds every message each world says it published (or a timeout; a
         shorter one once interrupted, and none at all after a second signal)."""
         recorder = self.recorder
-        hurried = run.reason == "interrupted"
-        for world in run.worlds:
-            if world.child is None and world.remote_host is None:
-                continue  # never started (stopped while starting)
-            # its end message comes just before it exits (it has by now): interrupted, do not linger
-            if not run.wait(world.ended, 0.2 if hurried else 0.5) or run.hurry.is_set():
-                continue
-            published: dict[str, int] = world.end_info.get("published", {})
-            deadline = time.monotonic() + (DRAIN_HURRIED_S if hurried else DRAIN_TIMEOUT_S)
-            while time.monotonic() < deadline and not run.hurry.is_set():
-                got = recorder.counts()
-                if all(got.get(k, 0) >= n for k, n in published.items() if recorder.wanted(k)):
-                    break
-                run.hurry.wait(0.01)
+        wait_for_published(run, recorder.counts, recorder.wanted)
 
     def close(self, run: Run) -> None:
         # how the run ended, for judging the recording by itself later (`scenario check`)
@@ -242,13 +251,15 @@ class JudgePart(Part):
     def __init__(self, judge: Any):
         self.judge = judge
         self.decided = threading.Event()
+        self.own: dict[str, int] = {}  # messages taken by its own subscriptions (keys not recorded), per key
+        self._lock = threading.Lock()
 
     def start(self, run: Run) -> None:
         from runner.checks.judge import judged_types
 
         plan, judge = run.plan, self.judge
         types = judged_types(plan)
-        lock = threading.Lock()
+        lock = self._lock
 
         def feed(key: str, stamp_ns: int, payload: bytes) -> None:
             msg = msgs.decode(payload, types[key])
@@ -264,15 +275,32 @@ class JudgePart(Part):
             tapped = [k for k in keys if run.recorder.recorder.wanted(k)]
             run.recorder.recorder.tap(tapped, feed)
             keys = [k for k in keys if k not in tapped]
+        own = self.own
         for key in keys:
+            own[key] = 0
 
             def on_sample(sample: zenoh.Sample) -> None:
                 att = sample.attachment
                 parsed = unpack_attachment(att.to_bytes()) if att is not None else None
                 if parsed is not None:
-                    feed(str(sample.key_expr), parsed[1], sample.payload.to_bytes())
+                    key = str(sample.key_expr)
+                    feed(key, parsed[1], sample.payload.to_bytes())
+                    with lock:
+                        own[key] = own.get(key, 0) + 1
 
             run.subs.append(run.session.declare_subscriber(key, on_sample))
+
+    def drain(self, run: Run) -> None:
+        """As the recorder does: wait for the messages still in flight on the keys it subscribed itself
+        (without a recording, every key it judges), so that the last ones are judged too."""
+        own, lock = self.own, self._lock
+
+        def counts() -> dict[str, int]:
+            with lock:
+                return dict(own)
+
+        if own:
+            wait_for_published(run, counts, own.__contains__)
 
     def poll(self, run: Run) -> None:
         if self.decided.is_set() and run.reason == "completed":

@@ -202,8 +202,13 @@ class Supervisor:
 
     def _drain(self) -> None:
         self._set(State.DRAINING)
-        if self.recorder is not None and not any(w.died for w in self.worlds):
+        if any(w.died for w in self.worlds):
+            return
+        if self.recorder is not None:
             self.recorder.drain(self)
+        for part in self.parts:
+            if isinstance(part, JudgePart):
+                part.drain(self)
 
     def _close(self) -> None:
         """DONE: everything released in order, whatever happened before."""
