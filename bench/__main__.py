@@ -5,11 +5,15 @@ Sections (in order):
 
 - two_robots: the demo scenario (lidar 10 Hz, imu 100 Hz, odom/tf/joint_states 50 Hz per robot),
   judging off. The raw MuJoCo step rate of its compiled model (no plugins, robots at rest) is the limit;
-  then the world with every plugin publishing on a real Zenoh session and nothing subscribed, the full
+  then the world's floor (its loop and hooks at their rates, each hook only putting its messages, encoded
+  beforehand, and making MuJoCo's own calls for its sensor: the lidars' ray casts; bench.common.world_floor:
+  what no implementation of the plugins can go below), the world with every plugin publishing on a real
+  Zenoh session and nothing subscribed, the full
   `scenario run` (world process + Zenoh + MCAP recorder), and the same with an external subscriber
   process taking every message too. Ratio to the limit and × real time.
-- scaling: 1, 2, 4, 8, 16 robots (diff_drive + lidar + imu + joint_states + tf each), world on Zenoh and
-  full recorded run: × real time and wall cost per robot-second, relative to one robot.
+- scaling: 1, 2, 4, 8, 16 robots (diff_drive + lidar + imu + joint_states + tf each), the world's floor,
+  world on Zenoh and full recorded run: × real time and wall cost per robot-second, relative to one robot;
+  the recorded run against raw MuJoCo.
 - messages: encode cost by type, fixed layout (runner.wire.cdr) vs rosbags, µs per message.
 - cameras: the demo plus one 320x240 RGB camera per robot at 10 Hz, recorded; then the seeds' camera robots
   as declared (block_robot, harmonic_nav) against their limit, physics + one render per frame (and
@@ -69,6 +73,7 @@ from bench.common import (  # noqa: E402
     readme_tables,
     say,
     table,
+    world_floor,
     world_on_zenoh,
 )
 from runner.launch.run import run_plan  # noqa: E402
@@ -158,6 +163,7 @@ def two_robots(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str
     loop = max(raw_rate(plan, steps, batched=False) for _ in range(rep))
     driving = max(raw_driving_rate(plan) for _ in range(rep))
     say("  raw MuJoCo done")
+    floor = max(s.steps / s.wall_s for s in (world_floor(plan) for _ in range(rep)))
     quiet = max(s.steps / s.wall_s for s in (world_on_zenoh(plan) for _ in range(rep)))
     say("  world on Zenoh done")
     runs = [_full_run(plan, tmp, f"two_robots{i}") for i in range(rep)]
@@ -170,6 +176,12 @@ def two_robots(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str
         ("raw MuJoCo, batched mj_step (the limit)", limit, limit * dt, 1.0),
         ("raw MuJoCo, mj_step per call from Python", loop, loop * dt, loop / limit),
         ("raw MuJoCo replaying the run's controls (robots driving)", driving, driving * dt, driving / limit),
+        (
+            "world floor: its loop, its messages put (encoded beforehand), the lidars' ray casts",
+            floor,
+            floor * dt,
+            floor / limit,
+        ),
         ("world, all plugins publishing, nothing subscribed", quiet, quiet * dt, quiet / limit),
         ("scenario run: world process + Zenoh + MCAP recorder", recorded, recorded * dt, recorded / limit),
         ("  + an external subscriber process", external, external * dt, external / limit),
@@ -187,6 +199,7 @@ def two_robots(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str
         "steps_per_s": {
             "raw_batched": limit,
             "raw_loop": loop,
+            "world_floor": floor,
             "world_zenoh": quiet,
             "recorded": recorded,
             "recorded_external_subscriber": external,
@@ -198,15 +211,19 @@ def two_robots(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str
             "recorded_external_subscriber": external * dt,
         },
         "ratio_to_limit": {
+            "world_floor": floor / limit,
             "world_zenoh": quiet / limit,
             "recorded": recorded / limit,
             "recorded_external_subscriber": external / limit,
         },
         "lost": [r[2] for r in runs],
         "external_subscriber_received": [r[2] for r in ext],
+        # the issue's (24): recorded >= 0.5 of raw, the world alone >= 0.7 (the floor says how far that
+        # can go: the loop, the puts and the ray casts alone, no plugin computing anything)
         "targets": {
             "x_real_time_recorded >= 50": recorded * dt >= 50,
-            "ratio_to_limit_recorded >= 0.6": recorded / limit >= 0.6,
+            "ratio_to_limit_recorded >= 0.5": recorded / limit >= 0.5,
+            "ratio_to_limit_world >= 0.7": quiet / limit >= 0.7,
         },
     }
     return doc, text
@@ -261,14 +278,19 @@ def scaling(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
         plan = plan_from_text(_robots_scene(n, seconds), seconds=seconds)
         dt = plan.step_ns / 1e9
         limit = max(raw_rate(plan, plan.duration_ns // plan.step_ns) for _ in range(args.repeat))
+        floor = max(s.steps / s.wall_s for s in (world_floor(plan) for _ in range(args.repeat)))
         quiet = max(s.steps / s.wall_s for s in (world_on_zenoh(plan) for _ in range(args.repeat)))
         recorded = max(_full_run(plan, tmp, f"scale{n}_{i}")[0] for i in range(args.repeat))
         out.append(
             {
                 "robots": n,
                 "raw_x_real_time": limit * dt,
+                "floor_x_real_time": floor * dt,
                 "world_x_real_time": quiet * dt,
                 "recorded_x_real_time": recorded * dt,
+                "floor_of_raw": floor / limit,
+                "world_of_raw": quiet / limit,
+                "recorded_of_raw": recorded / limit,
                 # wall milliseconds per robot per sim second
                 "world_ms_per_robot_second": 1e3 / (quiet * dt) / n,
                 "recorded_ms_per_robot_second": 1e3 / (recorded * dt) / n,
@@ -283,10 +305,12 @@ def scaling(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
         (
             r["robots"],
             r["raw_x_real_time"],
+            r["floor_x_real_time"],
             r["world_x_real_time"],
             r["world_ms_per_robot_second"],
             r["world_cost_vs_1"],
             r["recorded_x_real_time"],
+            r["recorded_of_raw"],
             r["recorded_ms_per_robot_second"],
             r["recorded_cost_vs_1"],
         )
@@ -295,7 +319,18 @@ def scaling(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     text = table(
         f"scaling: diff_drive + lidar + imu + joint_states + tf per robot, {seconds:g} s sim, "
         f"best of {args.repeat}",
-        ("robots", "raw × rt", "world × rt", "ms/robot-s", "vs 1", "recorded × rt", "ms/robot-s", "vs 1"),
+        (
+            "robots",
+            "raw × rt",
+            "floor × rt",
+            "world × rt",
+            "ms/robot-s",
+            "vs 1",
+            "recorded × rt",
+            "of raw",
+            "ms/robot-s",
+            "vs 1",
+        ),
         rows,
     )
     last = out[-1]
@@ -303,7 +338,8 @@ def scaling(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
         "sim_seconds": seconds,
         "rows": out,
         "targets": {
-            "16 robots recorded cost per robot-second <= 1.5x one robot": last["recorded_cost_vs_1"] <= 1.5
+            "16 robots recorded cost per robot-second <= 1.5x one robot": last["recorded_cost_vs_1"] <= 1.5,
+            "16 robots recorded >= 0.45 of raw": last["recorded_of_raw"] >= 0.45,
         },
     }
     return doc, text

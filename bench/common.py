@@ -131,6 +131,73 @@ def world_on_zenoh(plan: RunPlan) -> WorldStats:
             bus.undeclare_all()
 
 
+def world_floor(plan: RunPlan) -> WorldStats:
+    """The floor under `world_on_zenoh`: the same world, loop and boundaries, every hook at its rate, but a
+    hook does only MuJoCo's own work for its sensor (a lidar's ray casts, a camera's render and read-back)
+    and puts the messages it would publish, encoded beforehand (its first call's), on the same real Zenoh
+    session; nothing else is computed (no noise, no odometry, no encoding). No implementation of the
+    plugins, in any language, costs less than this: what lies above it is the plugins' own computing."""
+    with zenoh_session() as session:
+        bus = ZenohBus(session)
+        try:
+            world = World(plan, bus)
+            if world.remote_renders:
+                raise ValueError("world_floor measures worlds that render in their own process only")
+            for hook in [*world._after, *world._before, world._clock_hook]:
+                hook.fn = _floor_hook(world, hook.fn)
+            return world.run()
+        finally:
+            bus.undeclare_all()
+
+
+def _floor_hook(world: World, fn: Any) -> Any:
+    sent: list[tuple[Any, bytes, bytes]] = []
+    outs = list(world._out.values())
+    sends = [o.send for o in outs]
+    for out, send in zip(outs, sends, strict=True):
+        out.send = lambda payload, att, send=send: sent.append((send, bytes(payload), att))
+    try:
+        fn(world.now_ns)
+    finally:
+        for out, send in zip(outs, sends, strict=True):
+            out.send = send
+    engine = _engine_work(world, getattr(fn, "__self__", None))
+
+    def floor(now_ns: int) -> None:
+        if engine is not None:
+            engine()
+        for send, payload, att in sent:
+            send(payload, att)
+
+    return floor
+
+
+def _engine_work(world: World, plugin: Any) -> Any:
+    """What MuJoCo itself computes for a plugin's sensor, as the plugin calls it, or None."""
+    scan = getattr(plugin, "scan", None)
+    if callable(scan):
+        return scan  # a lidar: mj_multiRay over its beams
+    renderer = getattr(plugin, "renderer", None)
+    if renderer is None:
+        return None
+    data = world.data
+    color = getattr(plugin.params, "publish_color", True)
+    depth = type(plugin).__name__ == "DepthCamera"
+
+    def render() -> None:  # mjv_updateScene, mjr_render and mjr_readPixels, as the camera calls them
+        renderer.update(data)
+        if not depth:
+            renderer._render(depth_too=False)
+        elif color and renderer._depth_same_in_color_render():
+            renderer._render(depth_too=True)
+        else:
+            if color:
+                renderer._render(depth_too=False)
+            renderer._render_depth()
+
+    return render
+
+
 def gl_renderer() -> str:
     """The OpenGL renderer cameras render with (e.g. 'llvmpipe (LLVM 15.0.6, 256 bits)' on the CPU, the GPU's
     name on one), read from a context of the backend mujoco loaded; '' if unknown."""
