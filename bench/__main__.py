@@ -17,7 +17,8 @@ Sections (in order):
 - messages: encode cost by type, fixed layout (runner.wire.cdr) vs rosbags, µs per message.
 - cameras: the demo plus one 320x240 RGB camera per robot at 10 Hz, recorded; then the seeds' camera robots
   as declared (block_robot, harmonic_nav) against their limit, physics + one render per frame (and
-  mujoco.Renderer's calls), the world alone and the recorded run; the noise's cost per frame against its
+  mujoco.Renderer's calls), the world's floor (its loop, renders and puts, nothing else computed), the
+  world alone and the recorded run; the noise's cost per frame against its
   render; a frame's bytes on their way into the MCAP; the GL renderer used (bench/cameras.py).
 - realtime: `rate: realtime` for 60 s (10 s with --quick): the factor overall and over its worst second,
   and the delay from a `cmd_vel` put by another process to the controller acting on it.
@@ -442,9 +443,11 @@ def cameras(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
         plan = plan_from_file(REPO / "scenarios" / f"{name}.yaml", seconds=secs)
         steps = plan.duration_ns // plan.step_ns
         physics = max(raw_rate(plan, steps) for _ in range(args.repeat))
-        bounds, worlds, runs = [], [], []
+        bounds, floors, worlds, runs = [], [], [], []
         for i in range(args.repeat):  # alternating: the bound and the runs see the same machine
             bounds.append(bc.render_bound(plan, secs))
+            st = world_floor(plan)
+            floors.append(st.steps / st.wall_s)
             st = world_on_zenoh(plan)
             worlds.append(st.steps / st.wall_s)
             runs.append(_full_run(plan, tmp, f"{name}{i}")[0])
@@ -455,13 +458,14 @@ def cameras(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
         # the limit: physics + one render (read back) per frame, at the camera's size and settings
         limit = secs / (physics_wall + bound["one_pass_wall_s"])
         with_renderer = secs / (physics_wall + renderer_wall)  # mujoco.Renderer's calls instead
+        floor = max(floors) * dt_s  # the world's loop, its renders and its puts, nothing else computed
         world = max(worlds) * dt_s
         ours = max(runs) * dt_s
         specs = bc.camera_specs(plan)
         what = ", ".join(
             f"{s.width}x{s.height} {'RGB-D' if s.depth else 'RGB'} {s.rate:g} Hz" for s in specs[:1]
         ) + (f" (×{len(specs)})" if len(specs) > 1 else "")
-        row = (f"{name}: {what}", limit, world, world / limit, ours, ours / limit)
+        row = (f"{name}: {what}", limit, floor, floor / limit, world, world / limit, ours, ours / limit)
         scenario_rows.append((*row, with_renderer, ours / with_renderer))
         doc["scenarios"][name] = {
             "sim_seconds": secs,
@@ -469,10 +473,12 @@ def cameras(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
             "render_bound": bound,
             "limit_x_real_time": limit,
             "mujoco_renderer_limit_x_real_time": with_renderer,
+            "world_floor_x_real_time": floor,
             "world_x_real_time": world,
             "x_real_time": ours,
             "x_real_time_runs": [r * dt_s for r in runs],
             "ratio_to_limit": ours / limit,
+            "world_floor_ratio_to_limit": floor / limit,
             "world_ratio_to_limit": world / limit,
             "ratio_to_mujoco_renderer_limit": ours / with_renderer,
         }
@@ -489,8 +495,8 @@ def cameras(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     text += "\n\n" + table(
         f"cameras at declared sizes, {10 if not args.quick else 2} s sim, best of {args.repeat} alternating: "
         f"limit = physics + one render per frame (GL: {renderer or 'unknown'})",
-        ("scenario", "limit × rt", "world × rt", "of the limit", "scenario run × rt", "of the limit",
-         "mujoco.Renderer limit × rt", "run of it"),
+        ("scenario", "limit × rt", "world floor × rt", "of the limit", "world × rt", "of the limit",
+         "scenario run × rt", "of the limit", "mujoco.Renderer limit × rt", "run of it"),
         scenario_rows,
     )  # fmt: skip
     if noise_rows:
