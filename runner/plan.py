@@ -135,6 +135,7 @@ class RecordPlan(BaseModel):
     path: str
     include: list[str]  # full key expressions
     exclude: list[str]
+    compression: Literal["zstd", "none"] = "zstd"  # the chunks' (recordings of older plans: zstd)
 
 
 class RunPlan(BaseModel):

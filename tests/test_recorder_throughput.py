@@ -142,9 +142,10 @@ def test_mcap_layout_chunks_indexes_and_summary(tmp_path: Path):
     assert _check_chunks(path, min_chunks=10) == sum(map(len, expected.values()))
 
 
-def _check_chunks(path: Path, min_chunks: int) -> int:
-    """Each chunk's CRC-checked records decompress to its size, and each message index entry points at its
-    message; returns how many messages the indexes hold (= the statistics' count)."""
+def _check_chunks(path: Path, min_chunks: int, compression: str = "zstd") -> int:
+    """Each chunk's CRC-checked records decompress to its size (`compression`: the MCAP's name, "" for
+    none), and each message index entry points at its message; returns how many messages the indexes hold
+    (= the statistics' count)."""
     raw = path.read_bytes()
     with open(path, "rb") as f:
         s = make_reader(f).get_summary()
@@ -155,7 +156,9 @@ def _check_chunks(path: Path, min_chunks: int) -> int:
         start, end, size, _crc, clen = struct.unpack_from("<QQQII", body)
         (csize,) = struct.unpack_from("<Q", body, 32 + clen)
         assert (start, end) == (ci.message_start_time, ci.message_end_time)
-        records = zstandard.decompress(body[40 + clen : 40 + clen + csize], max_output_size=size)
+        assert body[32 : 32 + clen].decode() == ci.compression == compression
+        data = body[40 + clen : 40 + clen + csize]
+        records = zstandard.decompress(data, max_output_size=size) if compression else data
         assert len(records) == size == ci.uncompressed_size
         lengths = 0
         for cid, off in ci.message_index_offsets.items():
@@ -174,13 +177,15 @@ def _check_chunks(path: Path, min_chunks: int) -> int:
     return indexed
 
 
-def test_messages_larger_than_a_chunk_are_chunks_of_their_own(tmp_path: Path):
+@pytest.mark.parametrize("compression", ["zstd", "none"])
+def test_messages_larger_than_a_chunk_are_chunks_of_their_own(tmp_path: Path, compression: str):
     """A message as large as a chunk (a camera frame) is written as a chunk of its own straight from the
     received bytes (no copy into the chunk buffer): between small messages, first on its channel (the
     channel's record goes in its chunk), and larger than the gathered-write threshold; all read back whole,
-    in order, by every reader, CRCs checked."""
+    in order, by every reader, CRCs checked. So too with `record.compression: none` (chunks stored as they
+    are, the MCAP's empty compression)."""
     path = tmp_path / "large.mcap"
-    rec = Recorder(path, ["r/**"], chunk_size=4096)
+    rec = Recorder(path, ["r/**"], chunk_size=4096, compression=compression)
     twist = _twists(1)[0]
     image = "sensor_msgs/msg/Image"
     rng = np.random.default_rng(3)
@@ -222,7 +227,10 @@ def test_messages_larger_than_a_chunk_are_chunks_of_their_own(tmp_path: Path):
                 order.append(message.log_time)
             assert got == sent, reader_class
             assert order == sorted(order)
-    assert _check_chunks(path, min_chunks=12) == sum(map(len, sent.values()))
+    mcap_name = {"zstd": "zstd", "none": ""}[compression]
+    assert _check_chunks(path, min_chunks=12, compression=mcap_name) == sum(map(len, sent.values()))
+    if compression == "none":  # the frames' random bytes, stored as they are: the file is at least as large
+        assert path.stat().st_size > sum(len(p) for v in sent.values() for p in v)
 
 
 def _twists(n: int) -> list[bytes]:

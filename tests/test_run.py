@@ -423,3 +423,43 @@ def test_zenohs_rust_source_paths_stay_out_of_messages() -> None:
     assert r.returncode == 1, r.stderr
     assert f"cannot open the Zenoh network on tcp/127.0.0.1:{port}" in r.stderr, r.stderr
     assert ".rs:" not in r.stderr and "Traceback" not in r.stderr, r.stderr
+
+
+@pytest.mark.timeout(120)
+def test_a_recording_without_compression_holds_the_same_messages(write_scenario, tmp_path: Path):
+    """`record.compression: none` stores every chunk as it is (the MCAP's empty compression), a camera's
+    frames (larger than a chunk) too; an independent reader decodes the same messages as from a zstd run."""
+    from mcap.reader import make_reader
+
+    got = {}
+    for compression in ("zstd", "none"):
+        path = write_scenario(
+            f"""
+            name: packed
+            duration: 0.5
+            rate: max
+            robots:
+              - name: r1
+                description: "{{diffbot}}"
+                pose: {{xyz: [0, 0, 0.06]}}
+                plugins:
+                  - {{type: lidar, params: {{link: lidar_link, rate: 10}}}}
+                  - {{type: camera, params: {{width: 400, height: 300, rate: 10, noise_stddev: 0.01}}}}
+            record: {{compression: {compression}}}
+            """,
+            name=f"{compression}.yaml",
+        )
+        mcap = tmp_path / f"{compression}.mcap"
+        proc = run_cli("run", str(path), "--record", str(mcap), timeout=90)
+        assert proc.returncode == 0, proc.stderr
+        with open(mcap, "rb") as f:
+            summary = make_reader(f).get_summary()
+        assert summary is not None
+        assert {ci.compression for ci in summary.chunk_indexes} == {"zstd" if compression == "zstd" else ""}
+        got[compression] = [
+            (topic, t, bytes(m.data) if hasattr(m, "data") and topic.endswith("image_raw") else repr(m))
+            for topic, _type, t, m in read_mcap(mcap)
+            if not topic.endswith("/_plan")  # (the plan names its file and the compression)
+        ]
+    assert any(topic.endswith("camera/image_raw") for topic, _t, _m in got["none"])
+    assert got["none"] == got["zstd"]

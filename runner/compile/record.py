@@ -29,6 +29,7 @@ def record_plan(sc: Scenario, doc: Document, record_path: str | None) -> RecordP
         path=str(path),
         include=[full_expr(sc.name, e) for e in rec.include],
         exclude=[full_expr(sc.name, e) for e in rec.exclude],
+        compression=rec.compression,
     )
     _check_key_exprs(record, doc, rec)
     return record

@@ -195,6 +195,7 @@ class RecorderPart(Part):
                 types=types,
                 inbound=inbound,
                 guarded=True,
+                compression=plan.record.compression,
             )
         except OSError as e:
             raise RunError(f"cannot write the recording {plan.record.path}: {e.strerror or e}") from None

@@ -34,9 +34,12 @@ _MESSAGE_HEAD = struct.Struct("<BQHIQQ")
 _MESSAGE_FIXED = _MESSAGE_HEAD.size - 9  # the record's length minus the data's
 _MESSAGE_INDEX_HEAD = struct.Struct("<BQHI")
 # Chunk record up to its data: opcode, record length, start, end, uncompressed size and crc, compression
-# (a 4-byte string: "zstd"), compressed size.
-_CHUNK_HEAD = struct.Struct("<BQQQQII4sQ")
-_ZSTD = b"zstd"
+# (a string: "zstd", or "" for none), compressed size.
+_CHUNK_HEADS = {
+    "zstd": struct.Struct("<BQQQQII4sQ"),
+    "": struct.Struct("<BQQQQII0sQ"),
+}
+COMPRESSIONS = {"zstd": "zstd", "none": ""}  # the scenario's `record.compression` -> the MCAP's name
 _OP_MESSAGE = int(Opcode.MESSAGE)
 _OP_MESSAGE_INDEX = int(Opcode.MESSAGE_INDEX)
 
@@ -90,10 +93,15 @@ class McapFile:
         library: str,
         chunk_size: int = CHUNK_SIZE,
         guard: Guard | None = None,
+        compression: str = "zstd",
     ):
         self._stream = stream
         self.chunk_size = chunk_size
         self.chunk = bytearray()  # the uncompressed records of the chunk being built
+        if compression not in COMPRESSIONS:
+            raise ValueError(f"compression is one of {', '.join(COMPRESSIONS)}, not {compression!r}")
+        self.compression = COMPRESSIONS[compression]
+        self._head = _CHUNK_HEADS[self.compression]
         self._zstd = zstandard.ZstdCompressor(level=ZSTD_LEVEL)
         self._tail = Tail()  # the summary's records, as chunks are written
         self._by_id: dict[int, RecordedChannel] = {}
@@ -211,7 +219,12 @@ class McapFile:
     ) -> None:
         """Write a chunk whose records are `parts` (in order; compressed as one), then its indexes."""
         size = sum(len(part) for part in parts)
-        if len(parts) == 1:
+        if not self.compression:  # written as they are
+            compressed = list(parts)
+            crc = 0
+            for part in parts:
+                crc = zlib.crc32(part, crc)
+        elif len(parts) == 1:
             compressed = [self._zstd.compress(parts[0])]
             crc = zlib.crc32(parts[0])
         else:
@@ -223,15 +236,16 @@ class McapFile:
                 crc = zlib.crc32(part, crc)
         compressed_size = sum(len(c) for c in compressed)
         chunk_start = self._pos
-        head = _CHUNK_HEAD.pack(
+        name = self.compression.encode()
+        head = self._head.pack(
             int(Opcode.CHUNK),
-            _CHUNK_HEAD.size - 9 + compressed_size,
+            self._head.size - 9 + compressed_size,
             start,
             end,
             size,
             crc,
-            len(_ZSTD),
-            _ZSTD,
+            len(name),
+            name,
             compressed_size,
         )
         chunk_length = len(head) + compressed_size
@@ -249,7 +263,7 @@ class McapFile:
             chunk_length=chunk_length,
             message_index_offsets=offsets,
             message_index_length=len(out),
-            compression=_ZSTD.decode(),
+            compression=self.compression,
             compressed_size=compressed_size,
             uncompressed_size=size,
         )

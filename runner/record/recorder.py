@@ -72,6 +72,7 @@ class Recorder:
     inbound: set[str] = field(default_factory=set)  # keys the worlds take from others: checked to decode
     # a guard process finishes the file if this process dies before it does (kill -9): runner.record.finisher
     guarded: bool = False
+    compression: str = "zstd"  # the chunks': "zstd" or "none"
 
     def __post_init__(self) -> None:
         self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -88,6 +89,7 @@ class Recorder:
             library=self.library,
             chunk_size=self.chunk_size,
             guard=self._guard,
+            compression=self.compression,
         )
         self._lock = threading.Lock()
         self._schemas: dict[str, int] = {}
