@@ -27,7 +27,7 @@ from runner.plan import RunPlan  # noqa: E402
 from runner.scenario.loader import load_file, load_text  # noqa: E402
 from runner.scenario.validate import validate_scenario  # noqa: E402
 from runner.sim.world import World, WorldStats  # noqa: E402
-from runner.wire.transport import ZenohBus, free_port, make_config  # noqa: E402
+from runner.wire.transport import ATTACHMENT, ZenohBus, free_port, make_config  # noqa: E402
 
 
 def machine() -> dict[str, Any]:
@@ -134,9 +134,10 @@ def world_on_zenoh(plan: RunPlan) -> WorldStats:
 def world_floor(plan: RunPlan) -> WorldStats:
     """The floor under `world_on_zenoh`: the same world, loop and boundaries, every hook at its rate, but a
     hook does only MuJoCo's own work for its sensor (a lidar's ray casts, a camera's render and read-back)
-    and puts the messages it would publish, encoded beforehand (its first call's), on the same real Zenoh
-    session; nothing else is computed (no noise, no odometry, no encoding). No implementation of the
-    plugins, in any language, costs less than this: what lies above it is the plugins' own computing."""
+    and puts the messages it would publish, encoded beforehand (those of a call after its first, which may
+    publish once-only messages: static transforms), numbered and stamped, on the same real Zenoh session;
+    nothing else is computed (no noise, no odometry, no encoding). No implementation of the plugins, in any
+    language, costs less than this: what lies above it is the plugins' own computing."""
     with zenoh_session() as session:
         bus = ZenohBus(session)
         try:
@@ -151,23 +152,28 @@ def world_floor(plan: RunPlan) -> WorldStats:
 
 
 def _floor_hook(world: World, fn: Any) -> Any:
-    sent: list[tuple[Any, bytes, bytes]] = []
+    sent: list[tuple[Any, Any, bytes]] = []
     outs = list(world._out.values())
     sends = [o.send for o in outs]
     for out, send in zip(outs, sends, strict=True):
-        out.send = lambda payload, att, send=send: sent.append((send, bytes(payload), att))
+        out.send = lambda payload, att, out=out, send=send: sent.append((out, send, bytes(payload)))
     try:
+        fn(world.now_ns)
+        sent.clear()  # (the first call's once-only messages)
         fn(world.now_ns)
     finally:
         for out, send in zip(outs, sends, strict=True):
             out.send = send
+            out.seq = 0
     engine = _engine_work(world, getattr(fn, "__self__", None))
+    pack = ATTACHMENT.pack
 
     def floor(now_ns: int) -> None:
         if engine is not None:
             engine()
-        for send, payload, att in sent:
-            send(payload, att)
+        for out, send, payload in sent:
+            send(payload, pack(out.seq, now_ns))
+            out.seq += 1
 
     return floor
 

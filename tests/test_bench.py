@@ -127,3 +127,65 @@ def test_the_camera_bound_renders_each_declared_camera_at_its_size_and_rate() ->
     cost = bc.noise_cost(80, 60, 0.007, repeat=2)
     assert cost["noisy_ms"] > 0 and cost["plain_ms"] > 0
     assert gl_renderer()  # e.g. llvmpipe here, the GPU's name where EGL finds one
+
+
+@pytest.mark.timeout(120)
+def test_the_worlds_floor_puts_what_the_world_publishes() -> None:
+    """bench.common.world_floor, the floor the two_robots, scaling and cameras tables show: the same hooks
+    at the same times put the same keys, as many messages each (but for once-only ones), numbered from 0
+    and stamped with their sim time, as the world with every plugin computing; on a real Zenoh session,
+    taken by a subscriber in another session."""
+    import threading
+    import time
+
+    import zenoh
+
+    from bench.common import TWO_ROBOTS, World, ZenohBus, _floor_hook, plan_from_file
+    from runner.wire.transport import free_port, make_config, unpack_attachment
+
+    plan = plan_from_file(TWO_ROBOTS, seconds=1.0)
+    got: dict[str, list[tuple[int, int]]] = {}
+    lock = threading.Lock()
+
+    def on(sample: zenoh.Sample) -> None:
+        att = sample.attachment
+        if att is not None:
+            with lock:
+                got.setdefault(str(sample.key_expr), []).append(unpack_attachment(att.to_bytes()))
+
+    counts = {}
+    for floor in (False, True):
+        got.clear()
+        endpoint = f"tcp/127.0.0.1:{free_port()}"
+        with (
+            zenoh.open(make_config("router", listen=[endpoint])) as session,
+            zenoh.open(make_config("client", connect=[endpoint])) as other,
+        ):
+            sub = other.declare_subscriber(f"{plan.name}/**", on)
+            time.sleep(0.3)  # (the subscription reaches the router)
+            bus = ZenohBus(session)
+            world = World(plan, bus)
+            if floor:
+                for hook in [*world._after, *world._before, world._clock_hook]:
+                    hook.fn = _floor_hook(world, hook.fn)
+            stats = world.run()
+            deadline = time.monotonic() + 10
+            while time.monotonic() < deadline:
+                with lock:
+                    if all(len(got.get(k, ())) >= n for k, n in stats.published.items()):
+                        break
+                time.sleep(0.05)
+            sub.undeclare()
+            bus.undeclare_all()
+        with lock:
+            counts[floor] = {k: len(v) for k, v in got.items()}
+            for key, atts in got.items():
+                assert [seq for seq, _t in atts] == list(range(len(atts))), key
+                assert all(t % plan.step_ns == 0 and 0 <= t <= plan.duration_ns for _s, t in atts), key
+    world_counts, floor_counts = counts[False], counts[True]
+    assert {k for k, n in world_counts.items() if n > 2} <= set(floor_counts)
+    assert all(abs(floor_counts.get(k, 0) - n) <= 2 for k, n in world_counts.items()), (
+        world_counts,
+        floor_counts,
+    )
+    assert sum(floor_counts.values()) > 700  # the demo's 748 messages per sim second
