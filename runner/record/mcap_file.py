@@ -80,7 +80,8 @@ def _record_bytes(record: McapRecord) -> bytes:
 class McapFile:
     """A chunked, indexed MCAP writer (the layout of `mcap.writer.Writer` with its defaults: zstd chunks,
     message indexes, chunk indexes, statistics, repeated schemas and channels, summary offsets, summary
-    CRC), whose per-message work is two appends to the chunk and two to the channel's index.
+    CRC), whose per-message work is two appends to the chunk and two to the channel's index. With
+    `compression="none"` the chunks are stored as they are (the MCAP's empty compression name).
 
     Not thread-safe: the `Recorder` calls it under its lock.
     """
