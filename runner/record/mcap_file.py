@@ -220,21 +220,17 @@ class McapFile:
     ) -> None:
         """Write a chunk whose records are `parts` (in order; compressed as one), then its indexes."""
         size = sum(len(part) for part in parts)
+        crc = 0  # of the uncompressed records
+        for part in parts:
+            crc = zlib.crc32(part, crc)
         if not self.compression:  # written as they are
             compressed = list(parts)
-            crc = 0
-            for part in parts:
-                crc = zlib.crc32(part, crc)
         elif len(parts) == 1:
             compressed = [self._zstd.compress(parts[0])]
-            crc = zlib.crc32(parts[0])
         else:
             stream = self._zstd.compressobj(size=size)
             compressed = [stream.compress(part) for part in parts]
             compressed.append(stream.flush())
-            crc = 0
-            for part in parts:
-                crc = zlib.crc32(part, crc)
         compressed_size = sum(len(c) for c in compressed)
         chunk_start = self._pos
         name = self.compression.encode()
