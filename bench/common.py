@@ -141,14 +141,18 @@ def world_floor(plan: RunPlan) -> WorldStats:
     with zenoh_session() as session:
         bus = ZenohBus(session)
         try:
-            world = World(plan, bus)
-            if world.remote_renders:
-                raise ValueError("world_floor measures worlds that render in their own process only")
-            for hook in [*world._after, *world._before, world._clock_hook]:
-                hook.fn = _floor_hook(world, hook.fn)
-            return world.run()
+            return floor_of(World(plan, bus)).run()
         finally:
             bus.undeclare_all()
+
+
+def floor_of(world: World) -> World:
+    """`world` with every hook made its floor's (see `world_floor`), before it runs."""
+    if world.remote_renders:
+        raise ValueError("the floor is measured for worlds that render in their own process only")
+    for hook in [*world._after, *world._before, world._clock_hook]:
+        hook.fn = _floor_hook(world, hook.fn)
+    return world
 
 
 def _floor_hook(world: World, fn: Any) -> Any:

@@ -140,7 +140,7 @@ def test_the_worlds_floor_puts_what_the_world_publishes() -> None:
 
     import zenoh
 
-    from bench.common import TWO_ROBOTS, World, ZenohBus, _floor_hook, plan_from_file
+    from bench.common import TWO_ROBOTS, World, ZenohBus, floor_of, plan_from_file
     from runner.wire.transport import free_port, make_config, unpack_attachment
 
     plan = plan_from_file(TWO_ROBOTS, seconds=1.0)
@@ -165,10 +165,7 @@ def test_the_worlds_floor_puts_what_the_world_publishes() -> None:
             time.sleep(0.3)  # (the subscription reaches the router)
             bus = ZenohBus(session)
             world = World(plan, bus)
-            if floor:
-                for hook in [*world._after, *world._before, world._clock_hook]:
-                    hook.fn = _floor_hook(world, hook.fn)
-            stats = world.run()
+            stats = (floor_of(world) if floor else world).run()
             deadline = time.monotonic() + 10
             while time.monotonic() < deadline:
                 with lock:
