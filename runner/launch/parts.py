@@ -346,10 +346,10 @@ class LiveViewPart(Part):
 
     label = "live view"
 
-    def __init__(self, session: zenoh.Session, run: str, port: int):
+    def __init__(self, session: zenoh.Session, run: str, port: int, origins: tuple[str, ...] = ()):
         from runner.launch.live import LiveView
 
-        self.view = LiveView(session, run, port)
+        self.view = LiveView(session, run, port, origins=origins)
         print(f"Foxglove: connect to ws://127.0.0.1:{self.view.port}", file=sys.stderr, flush=True)
 
     def close(self, run: Run) -> None:
