@@ -91,25 +91,37 @@ def _full(plan, bus: MemoryBus) -> list:  # type: ignore[no-untyped-def]
 @pytest.mark.timeout(180)
 def test_a_recording_cut_by_a_kill_is_judged_up_to_its_cut(write_scenario, tmp_path: Path) -> None:
     """A real run's recording cut in the middle of a chunk (as a runner killed without its guard leaves
-    it): `scenario check` used to refuse it ("cannot judge it: EndOfFile"). Now it judges every whole
-    chunk: `near` (reached early) passes, `slow` fails, and `far`, `upright` are not decided, saying
-    where the recording stops."""
-    path = write_scenario(DRIVE.replace("duration: 6.0", "duration: 12.0").replace("by: 5", "by: 11"))
+    it), where it holds the run up to about t=3 s: `scenario check` used to refuse it ("cannot judge it:
+    EndOfFile"). Now it judges every whole chunk: `near` (reached early) passes, `slow` fails, and `far`
+    (reached near t=4.7 s), `upright` are not decided, saying where the recording stops."""
+    from mcap.reader import make_reader
+
+    path = write_scenario(DRIVE.replace("point: [1.5, 0]", "point: [2.5, 0]").replace("by: 5", "by: 5.8"))
     mcap = tmp_path / "run.mcap"
-    done = run_cli("run", str(path), "--record", str(mcap), "-q", timeout=150)
+    # at real time the recorder writes a chunk every second of the run (flush_stale): cuts in sim time
+    done = run_cli("run", str(path), "--record", str(mcap), "--rate", "realtime", "-q", timeout=150)
     assert done.returncode == 1 and "far" in done.stdout, done.stdout[-2000:] + done.stderr[-2000:]
-    data = mcap.read_bytes()
+    assert "pass" in _rows(done.stdout)["far"], done.stdout  # the full run passes `far` (near t=4.7 s)
+    with mcap.open("rb") as f:
+        chunks = sorted(make_reader(f).get_summary().chunk_indexes, key=lambda c: c.chunk_start_offset)  # type: ignore[union-attr]
+    cut_in = next(c for c in chunks if c.message_end_time > 3_000_000_000)
+    assert cut_in.message_start_time > 500_000_000  # (`near` is decided in the chunks before the cut)
     cut = tmp_path / "cut.mcap"
-    cut.write_bytes(data[: len(data) // 3])
+    cut.write_bytes(mcap.read_bytes()[: cut_in.chunk_start_offset + cut_in.chunk_length // 2])
 
     checked = run_cli("check", str(cut), "--scenario", str(path), timeout=120)
     out = checked.stdout
     assert "cannot judge" not in checked.stderr and "Traceback" not in checked.stderr, checked.stderr[-2000:]
     assert checked.returncode == 1, out
-    rows = {line.split("│")[1].strip(): line for line in out.splitlines() if line.count("│") > 3}
+    rows = _rows(out)
     assert "pass" in rows["near"] and "FAIL" in rows["slow"], out
     assert "not decided" in rows["far"] and "not decided" in rows["upright"], out
     assert "the recording stops at t=" in out and "the file is cut there, unfinished" in out, out
+
+
+def _rows(table: str) -> dict[str, str]:
+    """The rows of the Assertions table, by assertion name."""
+    return {line.split("│")[1].strip(): line for line in table.splitlines() if line.count("│") > 3}
 
 
 FSIZE_LIMIT = 1_000_000  # bytes: two_robots fills it near t=10 s of its 20 s

@@ -575,6 +575,10 @@ class Judge:
         for c in self.checks:
             if not c.decided:
                 cut = self._cut(c.key)
-                # its data stops before the run's end: it saw the run up to there only (data_stops)
-                c.finish(Span(cut[0], False, cut[1]) if cut is not None and cut[0] < end_ns else span)
+                if cut is None or cut[0] >= end_ns:
+                    c.finish(span)
+                    continue
+                # its data stops before the run's end: it saw the run up to there only (data_stops), and
+                # how the run ended (interrupted, stopped by an error) is said too
+                c.finish(Span(cut[0], False, cut[1] + (f" ({why})" if why and not complete else "")))
         return [c.result for c in self.checks if c.result is not None]
