@@ -79,6 +79,48 @@ def test_a_judge_whose_data_stops_decides_nothing_after_the_cut(write_scenario) 
     assert results["early_speed"].status == "pass"
 
 
+def test_a_live_judge_that_got_fewer_messages_than_published_knows_where_its_data_stops(
+    write_scenario,
+) -> None:
+    """The live judge's accounting (runner.launch.parts.JudgePart), on what a real world published: fed
+    (as its subscription or the recorder feeds it) the ground truth up to t=1.5 s only, while the world
+    says at its end that it published 6 s of it, the judge is told its data on that key stops at the last
+    message it got; `far` is not decided (it failed "not reached" before), with how many it got. A judge
+    that got every message is told nothing."""
+    from types import SimpleNamespace
+
+    from runner.launch.parts import JudgePart
+
+    plan = plan_of(write_scenario(DRIVE))
+    bus = MemoryBus()
+    World(plan, bus).run()
+    published: dict[str, int] = {}
+    for key, *_ in bus.sent:
+        published[key] = published.get(key, 0) + 1
+    run = SimpleNamespace(recorder=None, worlds=[SimpleNamespace(end_info={"published": published})])
+
+    def judged(until_ns: int) -> dict[str, object]:
+        judge = judge_for(plan)
+        assert judge is not None
+        part = JudgePart(judge)
+        feed = part.feeder(plan)
+        for key, _type_name, payload, att in bus.sent:
+            t = unpack_attachment(att)[1]  # type: ignore[index]
+            if t <= until_ns and key in judge.keys:
+                feed(key, t, payload)
+        part.close(run)  # type: ignore[arg-type]
+        return {r.name: r for r in judge.finish(plan.duration_ns)}
+
+    starved = judged(CUT_NS)
+    far = starved["far"]
+    assert far.status == "undecided" and far.t_ns is not None and far.t_ns <= CUT_NS, (far.message, far.value)
+    assert "the judge's data stops at t=1.500 s: it received 76 of the" in far.message, far.message
+    assert f"76 of the {published['cut/r1/_truth']} messages published on cut/r1/_truth" in far.message
+    assert starved["near"].status == "pass" and starved["slow"].status == "fail"
+    fed_all = judged(plan.duration_ns)
+    assert fed_all["far"].status == "pass" and fed_all["upright"].status == "pass"
+
+
 def _full(plan, bus: MemoryBus) -> list:  # type: ignore[no-untyped-def]
     judge = judge_for(plan)
     assert judge is not None

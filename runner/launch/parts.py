@@ -257,14 +257,12 @@ class JudgePart(Part):
         self.tapped: list[str] = []  # the keys it reads from the recorder
         self._lock = threading.Lock()
 
-    def start(self, run: Run) -> None:
+    def feeder(self, plan: RunPlan) -> Callable[[str, int, bytes], None]:
+        """What takes each message for the judge, `feed(key, sim ns, payload)`: decoded, counted (to know
+        later whether it got all the worlds published, `close`), judged."""
         from runner.checks.judge import judged_types
 
-        plan, judge = run.plan, self.judge
-        types = judged_types(plan)
-        lock = self._lock
-
-        fed = self.fed
+        judge, types, lock, fed = self.judge, judged_types(plan), self._lock, self.fed
 
         def feed(key: str, stamp_ns: int, payload: bytes) -> None:
             msg = msgs.decode(payload, types[key])
@@ -277,6 +275,11 @@ class JudgePart(Part):
                 ):
                     self.decided.set()
 
+        return feed
+
+    def start(self, run: Run) -> None:
+        judge, lock = self.judge, self._lock
+        feed = self.feeder(run.plan)
         keys = sorted(judge.keys)
         if run.recorder is not None:
             tapped = [k for k in keys if run.recorder.recorder.wanted(k)]
