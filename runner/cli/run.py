@@ -156,17 +156,9 @@ def run(
         plans = load_variants(file, record, variant)
     except ScenarioError as e:
         raise fail(e) from None
+    who = None if local else host
     options = RunOptions(
-        quiet,
-        listen,
-        connect,
-        no_judge,
-        None if local else host,
-        strict,
-        foxglove,
-        origins,
-        allow_undecided,
-        show_all,
+        quiet, listen, connect, no_judge, who, strict, foxglove, origins, allow_undecided, show_all
     )
     suites = []
     code = 0
