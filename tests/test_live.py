@@ -72,13 +72,13 @@ def _scans(ws: Any) -> list[tuple[int, Any]]:
 CLIENTS = Path(__file__).parent / "clients"
 
 
-def _serving(port: int, within: float = 60) -> subprocess.Popen[str]:
-    """two_robots at real time, served live on `port`; returns once the port takes connections (within
-    `within` s, or it fails)."""
+def _serving(port: int, within: float = 60, extra: tuple[str, ...] = ()) -> subprocess.Popen[str]:
+    """two_robots at real time, served live on `port` (`extra`: more options); returns once the port takes
+    connections (within `within` s, or it fails)."""
     run = subprocess.Popen(
         scenario_cmd(
             "run", str(SCENARIOS / "two_robots.yaml"), "--rate", "realtime", "--no-record", "--no-judge", "-q",
-            "--foxglove", str(port),
+            "--foxglove", str(port), *extra,
         ),
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,

@@ -14,7 +14,7 @@ gazebo_msgs/ContactsState, published by the world when a `no_collision` asks), a
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -105,6 +105,11 @@ ENDINGS = {
     "stopped": "stopped early",
     "failed": "stopped by an error",
 }
+
+
+def stops(what: str, t_ns: int, cause: str) -> str:
+    """Why the data stopped before the run's end: "the recording stops at t=12.300 s: disk full"."""
+    return f"{what} stops at t={t_ns / 1e9:.3f} s: {cause}"
 
 
 def ended_early(ending: str, sim_ns: int) -> str | None:
@@ -497,9 +502,28 @@ class Judge:
         for c in self.checks:
             self._by_key.setdefault(c.key, []).append(c)
 
+        # where the data stops before the run's end: key (None: every key) -> (sim ns, why)
+        self.cuts: dict[str | None, tuple[int, str]] = {}
+
     @property
     def keys(self) -> set[str]:
         return set(self._by_key) | self.events_keys
+
+    def data_stops(self, t_ns: int, why: str, keys: Iterable[str] | None = None) -> None:
+        """The data of `keys` (None: of every key) stops at sim time `t_ns`, before the run's end, for
+        `why` ("the recording stops at t=12.300 s: No space left on device"): the recording could not be
+        written, it was cut, or the judge's feed lost messages. Then `finish` decides nothing that needs
+        time after `t_ns`: a verdict reached before it stands, the rest is not decided, saying `why`.
+        The earliest cut of a key is kept."""
+        for key in [None] if keys is None else keys:
+            if key not in self.cuts or t_ns < self.cuts[key][0]:
+                self.cuts[key] = (t_ns, why)
+
+    def _cut(self, key: str) -> tuple[int, str] | None:
+        mine, every = self.cuts.get(key), self.cuts.get(None)
+        if mine is None or (every is not None and every[0] <= mine[0]):
+            return every
+        return mine
 
     def feed(self, key: str, t_ns: int, msg: Any) -> None:
         if key in self.events_keys:
@@ -545,9 +569,16 @@ class Judge:
     def finish(self, end_ns: int, *, complete: bool = True, why: str = "") -> list[Result]:
         """Decide what is left, at the run's end: sim time `end_ns`, reached as planned (`complete`) or
         not (`why`, e.g. "the run was interrupted at t=6.800 s"). A check whose window the run did not
-        show whole is not decided (UNDECIDED), never passed or failed by default."""
+        show whole is not decided (UNDECIDED), never passed or failed by default; one whose data stops
+        earlier (`data_stops`) is judged on the run up to there, with that reason."""
         span = Span(end_ns, complete, why)
         for c in self.checks:
             if not c.decided:
-                c.finish(span)
+                cut = self._cut(c.key)
+                if cut is None or cut[0] >= end_ns:
+                    c.finish(span)
+                    continue
+                # its data stops before the run's end: it saw the run up to there only (data_stops), and
+                # how the run ended (interrupted, stopped by an error) is said too
+                c.finish(Span(cut[0], False, cut[1] + (f" ({why})" if why and not complete else "")))
         return [c.result for c in self.checks if c.result is not None]

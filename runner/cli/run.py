@@ -86,6 +86,18 @@ _Foxglove = Annotated[
 ]
 
 
+_FoxgloveOrigin = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--foxglove-origin",
+        metavar="ORIGIN",
+        help="With --foxglove: also let web pages of this origin (scheme://host[:port]) connect; "
+        "repeatable. Allowed without it: the Foxglove app, pages on localhost, local files, and clients "
+        "that send no Origin (not browsers).",
+    ),
+]
+
+
 @dataclass
 class RunOptions:
     """What `run` was told that each variant's run needs."""
@@ -97,6 +109,7 @@ class RunOptions:
     host: str | None  # (None with --local)
     strict: bool
     foxglove: int | None
+    foxglove_origins: tuple[str, ...]
     allow_undecided: bool
     show_all: bool
 
@@ -118,6 +131,7 @@ def run(
     local: _Local = False,
     strict: _Strict = False,
     foxglove: _Foxglove = None,
+    foxglove_origin: _FoxgloveOrigin = None,
     allow_undecided: AllowUndecided = False,
     show_all: AllOpt = False,
 ) -> None:
@@ -129,6 +143,7 @@ def run(
       scenario run scenarios/two_robots.yaml
       scenario run scenarios/two_robots.yaml --rate realtime --listen tcp/127.0.0.1:7447
       scenario run scenarios/two_robots.yaml --rate realtime --foxglove 8765
+      scenario run scenarios/two_robots.yaml --foxglove 8765 --foxglove-origin https://viz.example.org
       scenario run fleet.yaml --host gpu_box
     """
     # Until a run starts its processes (loading, compiling), Ctrl-C and SIGTERM end the command at once:
@@ -136,12 +151,14 @@ def run(
     interrupts.exit_at_once()
     parsed_rate = _parse_rate(rate)
     _check_endpoints(listen, connect)
+    origins = _check_origins(foxglove_origin, foxglove)
     try:
         plans = load_variants(file, record, variant)
     except ScenarioError as e:
         raise fail(e) from None
+    who = None if local else host
     options = RunOptions(
-        quiet, listen, connect, no_judge, None if local else host, strict, foxglove, allow_undecided, show_all
+        quiet, listen, connect, no_judge, who, strict, foxglove, origins, allow_undecided, show_all
     )
     suites = []
     code = 0
@@ -198,6 +215,24 @@ def _check_endpoints(listen: list[str] | None, connect: list[str] | None) -> Non
                         f"protocol, e.g. tcp/{value.split('/')[-1] or '127.0.0.1:7447'}"
                     )
                 )
+
+
+def _check_origins(origins: list[str] | None, port: int | None) -> tuple[str, ...]:
+    """--foxglove-origin: web origins as browsers send them, and only with --foxglove."""
+    from runner.launch.live_gate import valid_origin
+
+    for origin in origins or []:
+        if not valid_origin(origin):
+            raise fail(
+                RunError(
+                    f"--foxglove-origin {origin!r}: not a web origin\n  expected: scheme://host[:port] "
+                    "(http, https or file), or null\n  hint:     as the browser's address bar shows the "
+                    "page, without its path, e.g. https://viz.example.org or http://192.168.1.7:8080"
+                )
+            )
+    if origins and port is None:
+        raise fail(RunError("--foxglove-origin is for the live view: give --foxglove PORT too"))
+    return tuple(origins or ())
 
 
 def _override(plan: Any, duration: float | None, rate: str | float | None, local: bool) -> None:
@@ -270,6 +305,7 @@ def _run_one(plan: Any, label: str, options: RunOptions) -> tuple[Any, int]:
                 judge=judge,
                 host=host,
                 foxglove_port=options.foxglove,
+                foxglove_origins=options.foxglove_origins,
             )
     except RunError as e:
         raise fail(e) from None

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from runner.compile.network import check_expr, full_expr, zenoh_settings
+from runner.compile.network import check_exposure, check_expr, full_expr, zenoh_settings
 from runner.compile.record import check_record_patterns
 from runner.compile.sanity import check_vacuous, window_edge
 from runner.compile.world import compile_world
@@ -129,6 +129,7 @@ def compile_plan(
             attach_bridges(plan, sc, doc, unchecked=unloaded)
     problems.raise_all()  # every mistake found, in the order of the file
     check_record_patterns(plan, sc, doc, notices)
+    check_exposure(sc, doc, notices)
     check_vacuous(plan, sc, doc, notices)
     plan.notices = [n.render() for n in notices]  # (with those of the checks over the whole run)
     own = doc.file.resolve() if doc.file is not None else None

@@ -3,9 +3,10 @@ and checked by Zenoh itself, and the `zenoh:` settings (config file, settings, l
 
 from __future__ import annotations
 
+import json
 from typing import Any
 
-from runner.errors import Problem, ScenarioError
+from runner.errors import Notices, Problem, ScenarioError
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import Scenario
 from runner.wire.transport import zenoh_reason
@@ -42,7 +43,6 @@ def check_expr(expr: str, doc: Document, where: PathKey, written: str | None = N
 
 def zenoh_settings(sc: Scenario, doc: Document) -> dict[str, Any]:
     """`zenoh:` checked against Zenoh itself (each setting inserted into a config), paths made absolute."""
-    import json
 
     import zenoh
 
@@ -98,3 +98,72 @@ def zenoh_settings(sc: Scenario, doc: Document) -> dict[str, Any]:
                 )
             )
     return {"file": file, "settings": settings}
+
+
+def exposed(endpoint: str) -> str | None:
+    """Where a Zenoh listen endpoint (`<protocol>/<address>[#config][?metadata]`) is reachable from
+    beyond this machine: None for loopback (127.0.0.0/8, ::1, `localhost`) and local sockets; else what
+    it reaches, in words ("every interface", "the address 192.168.1.5", "the interface eth0"...)."""
+    import ipaddress
+
+    proto, _, rest = endpoint.partition("/")
+    if proto.startswith("unixsock") or proto in ("vsock", "serial"):  # a local file, the VM's host, a line
+        return None
+    address, _, config = rest.split("?", 1)[0].partition("#")
+    iface = next((kv.split("=", 1)[1] for kv in config.split(";") if kv.startswith("iface=")), None)
+    if iface is not None and iface != "lo":
+        return f"the interface {iface}"
+    if address.startswith("["):  # [v6]:port
+        host = address[1:].partition("]")[0]
+    else:
+        host = address.rpartition(":")[0] if ":" in address else address
+    host, _, scope = host.partition("%")  # fe80::1%eth0: an address on an interface
+    if host == "localhost":
+        return None
+    try:
+        ip = ipaddress.ip_address(host)
+    except ValueError:
+        return f"the host name {host!r} (whatever it resolves to)"
+    if ip.is_loopback:
+        return None
+    if ip.is_unspecified:
+        return "every interface of this machine"
+    return f"the address {host}" + (f" on {scope}" if scope else "")
+
+
+def check_exposure(sc: Scenario, doc: Document, notices: Notices) -> None:
+    """A located warning for each `zenoh.listen` endpoint reachable beyond loopback, unless the run's
+    Zenoh configuration authenticates who joins (user/password, or TLS with client certificates):
+    whoever reaches that address reads every topic of the run and can publish on any (commands too)."""
+    import zenoh
+
+    if sc.zenoh is None or not sc.zenoh.listen:
+        return
+    probe = zenoh.Config()
+    try:
+        if sc.zenoh.config is not None:
+            probe = zenoh.Config.from_file(str(doc.base_dir / sc.zenoh.config))
+        for key, value in sc.zenoh.settings.items():
+            probe.insert_json5(key, json.dumps(value))
+    except Exception:  # (zenoh_settings reports it, located)
+        return
+    authenticated = probe.get_json("transport/auth/usrpwd/user") not in ("null", '""') or (
+        probe.get_json("transport/link/tls/enable_mtls") == "true"
+    )
+    if authenticated:
+        return
+    for i, endpoint in enumerate(sc.zenoh.listen):
+        reach = exposed(endpoint) if "/" in endpoint else None
+        if reach is None:
+            continue
+        where = doc.locate(("zenoh", "listen", i))
+        notices.add(
+            f"zenoh.listen[{i}] {endpoint!r} listens beyond loopback ({reach}), with no authentication: "
+            "anyone who can reach that address can read every topic of the run and publish on any",
+            where.file,
+            where.line,
+            hint="listen on tcp/127.0.0.1:PORT unless other machines must join; else authenticate them "
+            "with Zenoh's TLS (`tls/...` endpoints and `transport/link/tls` settings, with "
+            "`transport/link/tls/enable_mtls: true`) or user/password (`transport/auth/usrpwd`) in "
+            "`zenoh.settings`",
+        )

@@ -4,16 +4,19 @@ Every key of the run becomes a channel the first time it carries a message: ROS 
 their `ros2msg` schema, the scene as `protobuf`; each message is logged with its sim time. Open Foxglove,
 connect to `ws://127.0.0.1:PORT` and the 3D view, plots and images follow the run as it goes; the server
 advertises the `time` capability and sends the sim time, so the viewer's clock is the sim clock. The port
-takes both names of the protocol (`foxglove.websocket.v1`, `foxglove.sdk.v1`: runner.launch.live_gate). The
-server listens on loopback unless a host is given.
+takes both names of the protocol (`foxglove.websocket.v1`, `foxglove.sdk.v1`: runner.launch.live_gate) and
+refuses web pages of other sites (their `Origin`): the Foxglove app, local pages and files, and the origins
+given (`--foxglove-origin`) only. The server listens on loopback unless a host is given.
 """
 
 from __future__ import annotations
 
 import contextlib
+import sys
 import threading
 import time
 import warnings
+from collections.abc import Sequence
 from typing import Any
 
 import zenoh
@@ -25,8 +28,27 @@ from runner.wire.transport import type_from_encoding, unpack_attachment
 TIME_PERIOD_S = 0.02  # how often viewers are told the sim time, at most (wall)
 
 
+def _say_refused(origin: str) -> None:
+    """Said once per origin on the runner's console: a web page of another site tried to read the run."""
+    print(
+        f"Foxglove: refused a WebSocket from origin {origin}: not an allowed origin; "
+        f"allow it with --foxglove-origin {origin}",
+        file=sys.stderr,
+        flush=True,
+    )
+
+
 class LiveView:
-    def __init__(self, session: zenoh.Session, run: str, port: int, host: str = "127.0.0.1"):
+    def __init__(
+        self,
+        session: zenoh.Session,
+        run: str,
+        port: int,
+        host: str = "127.0.0.1",
+        origins: Sequence[str] = (),
+    ):
+        """`origins`: web page origins allowed besides the Foxglove app's and local ones
+        (runner.launch.live_gate.origin_allowed)."""
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DeprecationWarning)
             import foxglove
@@ -49,7 +71,9 @@ class LiveView:
         except Exception as e:
             raise RunError(f"cannot serve Foxglove: {e}") from None
         try:
-            self.gate = SubprotocolGate(self.server.port, host=host, port=port)
+            self.gate = SubprotocolGate(
+                self.server.port, host=host, port=port, origins=origins, on_refused=_say_refused
+            )
         except OSError as e:  # the port is taken, say
             self.server.stop()
             raise RunError(f"cannot serve Foxglove on {host}:{port}: {e.strerror or e}") from None

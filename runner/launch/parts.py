@@ -253,28 +253,38 @@ class JudgePart(Part):
         self.judge = judge
         self.decided = threading.Event()
         self.own: dict[str, int] = {}  # messages taken by its own subscriptions (keys not recorded), per key
+        self.fed: dict[str, tuple[int, int]] = {}  # key -> (messages fed to the judge, the last one's sim ns)
+        self.tapped: list[str] = []  # the keys it reads from the recorder
         self._lock = threading.Lock()
 
-    def start(self, run: Run) -> None:
+    def feeder(self, plan: RunPlan) -> Callable[[str, int, bytes], None]:
+        """What takes each message for the judge, `feed(key, sim ns, payload)`: decoded, counted (to know
+        later whether it got all the worlds published, `close`), judged."""
         from runner.checks.judge import judged_types
 
-        plan, judge = run.plan, self.judge
-        types = judged_types(plan)
-        lock = self._lock
+        judge, types, lock, fed = self.judge, judged_types(plan), self._lock, self.fed
 
         def feed(key: str, stamp_ns: int, payload: bytes) -> None:
             msg = msgs.decode(payload, types[key])
             with lock:
+                n, last = fed.get(key, (0, 0))
+                fed[key] = (n + 1, max(last, stamp_ns))
                 judge.feed(key, stamp_ns, msg)
                 if (plan.stop_on == "first_failure" and judge.failed()) or (
                     plan.stop_on == "all_decided" and judge.all_decided()
                 ):
                     self.decided.set()
 
+        return feed
+
+    def start(self, run: Run) -> None:
+        judge, lock = self.judge, self._lock
+        feed = self.feeder(run.plan)
         keys = sorted(judge.keys)
         if run.recorder is not None:
             tapped = [k for k in keys if run.recorder.recorder.wanted(k)]
             run.recorder.recorder.tap(tapped, feed)
+            self.tapped = tapped
             keys = [k for k in keys if k not in tapped]
         own = self.own
         for key in keys:
@@ -307,16 +317,42 @@ class JudgePart(Part):
         if self.decided.is_set() and run.reason == "completed":
             run.end("stopped")
 
+    def close(self, run: Run) -> None:
+        """Tell the judge where its data stopped short of what the worlds ran: the recording it reads
+        could not be written past a point (a full disk), or it got fewer messages on a key than the
+        worlds published (its subscription lost them, the drain timed out). The world ran on past
+        there, so what it did then is not decided on the data it had (which once failed a `reach` the
+        full run passes)."""
+        from runner.checks.judge import stops
+
+        judge, recorder = self.judge, run.recorder.recorder if run.recorder is not None else None
+        if recorder is not None and recorder.error is not None and recorder.stopped_ns is not None:
+            cause = recorder.error.strerror or str(recorder.error)
+            judge.data_stops(
+                recorder.stopped_ns, stops("the recording", recorder.stopped_ns, cause), self.tapped
+            )
+        published: dict[str, int] = {}
+        for world in run.worlds:
+            for key, n in world.end_info.get("published", {}).items():
+                published[key] = published.get(key, 0) + n
+        with self._lock:
+            fed = dict(self.fed)
+        for key in sorted(judge.keys - judge.events_keys):
+            n, (got, last) = published.get(key, 0), fed.get(key, (0, 0))
+            if got < n and key not in judge.cuts:
+                why = f"it received {got} of the {n} messages published on {key}"
+                judge.data_stops(last, stops("the judge's data", last, why), [key])
+
 
 class LiveViewPart(Part):
     """`--foxglove PORT`: the run, live, to Foxglove (runner.launch.live)."""
 
     label = "live view"
 
-    def __init__(self, session: zenoh.Session, run: str, port: int):
+    def __init__(self, session: zenoh.Session, run: str, port: int, origins: tuple[str, ...] = ()):
         from runner.launch.live import LiveView
 
-        self.view = LiveView(session, run, port)
+        self.view = LiveView(session, run, port, origins=origins)
         print(f"Foxglove: connect to ws://127.0.0.1:{self.view.port}", file=sys.stderr, flush=True)
 
     def close(self, run: Run) -> None:

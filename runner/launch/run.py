@@ -27,10 +27,12 @@ def run_plan(
     judge: Any = None,
     host: str | None = None,
     foxglove_port: int | None = None,
+    foxglove_origins: Sequence[str] = (),
 ) -> RunResult:
     """Run a plan (one world, or `plan.worlds`, each a process of its own behind one router and one
     recorder); with a `judge` (runner.checks.judge.Judge), feed it every message it asks for, live, and
-    stop the worlds early when the plan's `stop_on` says so.
+    stop the worlds early when the plan's `stop_on` says so. `foxglove_port`: serve the run live to
+    Foxglove there (runner.launch.live), to pages of the `foxglove_origins` besides the default ones.
 
     With `plan.hosts`, this runner plays `host` (None: the first, main host, which records and judges);
     the parts placed on other hosts are run by their own `scenario run FILE --host NAME`, and joined."""
@@ -45,7 +47,15 @@ def run_plan(
         listen = [plan.hosts[plan.main_host]]  # type: ignore[index]
     listen = list(listen) or [f"tcp/127.0.0.1:{free_port()}"]
     plan = _placed_renderers(plan)
-    run = Supervisor(plan, listen, connect, on_progress=on_progress, judge=judge, foxglove_port=foxglove_port)
+    run = Supervisor(
+        plan,
+        listen,
+        connect,
+        on_progress=on_progress,
+        judge=judge,
+        foxglove_port=foxglove_port,
+        foxglove_origins=tuple(foxglove_origins),
+    )
     run.run()
     return result_of(run)
 

@@ -75,6 +75,7 @@ class Supervisor:
         on_progress: Callable[[int, float], None] | None = None,
         judge: Any = None,
         foxglove_port: int | None = None,
+        foxglove_origins: tuple[str, ...] = (),
     ):
         self.plan = plan
         self.listen = list(listen)
@@ -82,6 +83,7 @@ class Supervisor:
         self.on_progress = on_progress
         self.judge = judge
         self.foxglove_port = foxglove_port
+        self.foxglove_origins = foxglove_origins
         self.state = State.STARTING
         self.reason = "completed"  # completed | stopped | interrupted | failed
         self.error: str | None = None
@@ -130,7 +132,9 @@ class Supervisor:
                 f"cannot open the Zenoh network on {', '.join(self.listen)}: {zenoh_reason(e)}"
             ) from None
         if self.foxglove_port is not None:
-            self.parts.append(LiveViewPart(self.session, plan.name, self.foxglove_port))
+            self.parts.append(
+                LiveViewPart(self.session, plan.name, self.foxglove_port, self.foxglove_origins)
+            )
         # `scenario echo/pub/topics` find the local run by it
         recording = plan.record.path if plan.record.enabled else None
         self._announced = announce(plan.name, self.listen, plan.zenoh, recording=recording)

@@ -58,7 +58,7 @@ def read_summary(path: Path) -> dict[str, Any]:
         }
 
 
-def _records(path: Path) -> Iterable[Any]:
+def read_records(path: Path) -> Iterable[Any]:
     """The records of an MCAP file in order (chunks opened), up to the first incomplete one."""
     from mcap.exceptions import McapError
     from mcap.stream_reader import StreamReader
@@ -77,7 +77,7 @@ def _scan(path: Path) -> dict[str, Any]:
     channels: dict[int, tuple[str, str]] = {}
     counts: dict[int, int] = {}
     start, end = None, 0
-    for record in _records(path):
+    for record in read_records(path):
         if isinstance(record, Schema):
             schemas[record.id] = record.name
         elif isinstance(record, Channel):
@@ -109,7 +109,7 @@ def recover(path: Path, out: Path) -> dict[str, Any]:
     with open(out, "wb") as f:
         writer = Writer(f, compression=CompressionType.ZSTD)
         writer.start(profile="ros2", library="scenario-runner (recovered)")
-        for record in _records(path):
+        for record in read_records(path):
             if isinstance(record, Schema) and record.id not in schema_ids:
                 schema_ids[record.id] = writer.register_schema(record.name, record.encoding, record.data)
             elif isinstance(record, Channel) and record.id not in channel_ids:

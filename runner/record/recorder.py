@@ -101,6 +101,7 @@ class Recorder:
         self.unknown: dict[str, int] = {}  # keys whose samples had no ROS type in their encoding
         self.closed = False
         self.error: OSError | None = None  # what stopped the drain thread's recording, if anything
+        self.stopped_ns: int | None = None  # the sim time it stopped at (the judge's data stops there too)
         self.rejected = 0  # samples the drain thread could not record (an exception each)
         self.mistyped: dict[str, dict[str, int]] = {}  # key -> why -> samples of another type, not recorded
         self._subscriber: Any = None
@@ -162,7 +163,7 @@ class Recorder:
             except zenoh.ZError:
                 return
             except OSError as e:  # the disk is full...: stop recording, say it once, keep the queue moving
-                self.error = e
+                self.error, self.stopped_ns = e, self.latest_ns
                 with contextlib.suppress(OSError):
                     self._mcap.cut_back()  # the file ends with whole chunks: `close` adds the summary
                 print(f"recorder: recording stopped: {e}", file=sys.stderr, flush=True)
@@ -301,7 +302,7 @@ class Recorder:
                 try:
                     self._mcap.flush_chunk()
                 except OSError as e:  # the disk is full: as in the drain thread
-                    self.error = e
+                    self.error, self.stopped_ns = e, self.latest_ns
                     with contextlib.suppress(OSError):
                         self._mcap.cut_back()
                     print(f"recorder: recording stopped: {e}", file=sys.stderr, flush=True)

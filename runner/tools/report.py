@@ -2,12 +2,23 @@
 
 from __future__ import annotations
 
+import struct
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from runner.checks.judge import FAIL, PASS, UNDECIDED, Judge, Result, ended_early, events_key, judged_types
+from runner.checks.judge import (
+    FAIL,
+    PASS,
+    UNDECIDED,
+    Judge,
+    Result,
+    ended_early,
+    events_key,
+    judged_types,
+    stops,
+)
 
 
 def judge_for(plan: Any) -> Judge | None:
@@ -67,40 +78,72 @@ def rejudge(plan: Any, mcap: Path) -> Judged:
     """Re-judge a recording with the scenario's assertions (the same Judge the live run used), reading its
     events' firings too. How it ended is read from the recording's `scenario` metadata (written by the
     run); a recording without it (cut, or older) counts as complete only if it reaches the planned
-    duration."""
-    from mcap.reader import make_reader
-
-    from runner.wire import msgs
-
+    duration. A cut file (its runner killed before it was finished) is read up to its last whole chunk.
+    Where the recording stops early, what needs the time after its end is not decided (`Judge.finish`)."""
     judge = judge_for(plan)
     if judge is None:
         return Judged([], 0, None, [])
-    types = judged_types(plan)
-    end_ns = 0
-    meta: dict[str, str] = {}
-    with open(mcap, "rb") as f:
-        reader = make_reader(f)
-        wanted = judge.keys
-        for _schema, channel, message in reader.iter_messages(log_time_order=True):
-            end_ns = max(end_ns, message.log_time)
-            if channel.topic in wanted:
-                judge.feed(channel.topic, message.log_time, msgs.decode(message.data, types[channel.topic]))
-        try:
-            meta = next((dict(m.metadata) for m in reader.iter_metadata() if m.name == "scenario"), {})
-        except Exception:  # no summary (a cut file): no metadata to go by
-            meta = {}
-    at = f" at t={end_ns / 1e9:.3f} s"
+    end_ns, meta, cut = _feed_recording(judge, judged_types(plan), mcap)
     ended = meta.get("ended")
     if "stopped" in meta:  # the recording itself stopped early (a full disk, a killed runner)
-        why: str | None = f"the recording stopped early{at} ({meta['stopped']})"
+        cause = meta["stopped"] + (f" ({meta['error']})" if meta.get("error") else "")
+        why: str | None = stops("the recording", end_ns, cause)
+    elif cut:
+        why = stops("the recording", end_ns, "the file is cut there, unfinished")
     elif ended is not None:
         why = ended_early(ended, end_ns)
     elif end_ns + 20_000_000 >= plan.duration_ns:  # (20 ms: the last clock before the planned end)
         why = None
     else:
-        why = f"the recording ends{at}, before the run's planned end ({plan.duration_ns / 1e9:g} s)"
+        why = stops("the recording", end_ns, f"before the run's planned end ({plan.duration_ns / 1e9:g} s)")
     results = judge.finish(end_ns, complete=why is None, why=why or "")
     return Judged(results, end_ns, why, firings(judge.fired))
+
+
+def _feed_recording(judge: Judge, types: dict[str, str], mcap: Path) -> tuple[int, dict[str, str], bool]:
+    """Feed `judge` the messages of the recording it asks for: the last sim time the recording holds, its
+    `scenario` metadata, and whether the file is cut (no summary: read record by record up to its last
+    whole chunk, as `scenario info` does)."""
+    from mcap.exceptions import McapError
+    from mcap.reader import make_reader
+    from mcap.records import Channel, Message, Metadata
+
+    from runner.record.readback import read_records
+    from runner.wire import msgs
+
+    end_ns = 0
+    wanted = judge.keys
+    with open(mcap, "rb") as f:
+        try:
+            summary = make_reader(f).get_summary()
+        except (McapError, struct.error, ValueError, EOFError):
+            summary = None
+        if summary is not None:
+            f.seek(0)
+            reader = make_reader(f)
+            for _schema, channel, message in reader.iter_messages(log_time_order=True):
+                end_ns = max(end_ns, message.log_time)
+                topic = channel.topic
+                if topic in wanted:
+                    judge.feed(topic, message.log_time, msgs.decode(message.data, types[topic]))
+            try:
+                meta = next((dict(m.metadata) for m in reader.iter_metadata() if m.name == "scenario"), {})
+            except Exception:  # a summary without a usable metadata index: nothing to go by
+                meta = {}
+            return end_ns, meta, False
+    topics: dict[int, str] = {}
+    meta = {}
+    for record in read_records(mcap):  # in the order recorded (each key's messages in sim order)
+        if isinstance(record, Channel):
+            topics[record.id] = record.topic
+        elif isinstance(record, Message):
+            end_ns = max(end_ns, record.log_time)
+            topic = topics.get(record.channel_id)
+            if topic in wanted:
+                judge.feed(topic, record.log_time, msgs.decode(record.data, types[topic]))
+        elif isinstance(record, Metadata) and record.name == "scenario":
+            meta = dict(record.metadata)
+    return end_ns, meta, True
 
 
 def _now() -> str:
