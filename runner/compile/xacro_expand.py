@@ -192,8 +192,9 @@ def _xacro_error(e: Exception, path: Path) -> XacroError:
     if message.startswith("Undefined parameters") and name:
         # the call that lacks them: `<xacro:wheel .../>` (not the definition, `<xacro:macro ...>`)
         message = f"the call of macro {name!r} does not give {message.removeprefix('Undefined ')}"
+        missing = re.findall(r"[^\s,\[\]]+", message.partition("[")[2].partition("]")[0])
         for candidate in dict.fromkeys([file, *sources]):
-            line = _line_of(candidate, f"<xacro:{name}")
+            line = _call_lacking(candidate, name, missing)
             if line is not None:
                 return XacroError(
                     message,
@@ -286,6 +287,21 @@ def _line_of(file: Path, needle: str, also: str = "") -> int | None:
                 return i + 1
     except OSError:
         pass
+    return None
+
+
+def _call_lacking(file: Path, macro: str, missing: list[str]) -> int | None:
+    """The line of the first call of `macro` in `file` that gives none of the `missing` parameters: xacro
+    expands in document order, so an earlier call that lacked them would have failed first (the first
+    call of all, which we used to point at, may well give them)."""
+    try:
+        text = file.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return None
+    for m in re.finditer(rf"<xacro:(?:[\w.]+\.)?{re.escape(macro)}(?=[\s/>])([^>]*)>", text):
+        given = set(re.findall(r"([\w:.-]+)\s*=", m.group(1)))
+        if not given & set(missing):
+            return text.count("\n", 0, m.start()) + 1
     return None
 
 
