@@ -23,11 +23,13 @@ from __future__ import annotations
 import ast
 import math
 import re
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable
 from typing import Any
 
 import xacro
 import xacro.substitution_args as _sa
+
+from runner.compile.xacro_eval import BINOPS, Bound, Interpreter
 
 # xacro's own helpers (message, warning, error, print_location, fatal, arg), taken before any expansion
 # replaces its global symbols by ours
@@ -51,96 +53,8 @@ HINT = (
     "reaches Python itself"
 )
 
-# Names whose absence the user should read as "refused", not "a typo" (when no property has the name).
-_DANGEROUS_NAMES = frozenset(
-    {
-        "eval",
-        "exec",
-        "compile",
-        "open",
-        "getattr",
-        "setattr",
-        "delattr",
-        "hasattr",
-        "vars",
-        "type",
-        "globals",
-        "dir",
-        "__import__",
-        "breakpoint",
-        "help",
-        "exit",
-        "quit",
-        "input",
-        "print",
-        "object",
-        "super",
-        "memoryview",
-        "bytearray",
-        "classmethod",
-        "staticmethod",
-        "property",
-        "id",
-        "format",
-        "iter",
-        "next",
-        "callable",
-        "chr",
-    }
-)
-
-_WHAT = {
-    ast.Lambda: "a lambda",
-    ast.NamedExpr: "an assignment expression (:=)",
-    ast.Await: "await",
-    ast.Yield: "yield",
-    ast.YieldFrom: "yield",
-}
-
-_STR_METHODS = frozenset(
-    {
-        "split",
-        "rsplit",
-        "join",
-        "replace",
-        "strip",
-        "lstrip",
-        "rstrip",
-        "lower",
-        "upper",
-        "title",
-        "capitalize",
-        "swapcase",
-        "casefold",
-        "startswith",
-        "endswith",
-        "find",
-        "rfind",
-        "index",
-        "rindex",
-        "count",
-        "isdigit",
-        "isnumeric",
-        "isdecimal",
-        "isalpha",
-        "isalnum",
-        "isspace",
-        "islower",
-        "isupper",
-        "istitle",
-        "splitlines",
-        "partition",
-        "rpartition",
-        "removeprefix",
-        "removesuffix",
-    }
-)
-_DICT_METHODS = frozenset({"get", "keys", "values", "items"})
-_SEQ_METHODS = frozenset({"index", "count"})
-
 # printf-style `%` formatting: a width or precision past 3 digits, or taken from the arguments (`*`)
 _WIDE_FORMAT = re.compile(r"%[^a-zA-Z%]*(?:\*|\d{4,})")
-_FORMAT_SPEC = re.compile(r"^[<>^=]?[+\- ]?#?0?\d{0,3}[,_]?(?:\.\d{1,3})?[bcdeEfFgGnosxX%]?$")
 
 
 class SandboxError(Exception):
@@ -152,23 +66,6 @@ class SandboxError(Exception):
         self.expr = expr
         self.opener = opener  # how the expression starts in the file: "${" or "$(eval "
         self.hint = hint
-
-
-class _Bound:
-    """A whitelisted method of a string, list or dict (`s.split`): callable, nothing else reachable."""
-
-    __slots__ = ("name", "obj", "sandbox")
-
-    def __init__(self, obj: Any, name: str, sandbox: Sandbox):
-        self.obj = obj
-        self.name = name
-        self.sandbox = sandbox
-
-    def __call__(self, *args: Any, **kwargs: Any) -> Any:
-        return self.sandbox.method(self.obj, self.name, args, kwargs)
-
-    def __repr__(self) -> str:
-        return f"<method {self.name}>"
 
 
 class Sandbox:
@@ -288,7 +185,7 @@ class Sandbox:
             except (RecursionError, MemoryError, ValueError):
                 raise self.refuse("an expression nested too deeply") from None
             self._check_depth(tree)
-            return self._checked(_Eval(self, lookup).eval(tree.body))
+            return self.checked(Interpreter(self, lookup).eval(tree.body))
         finally:
             self.expr, self.opener = outer
 
@@ -338,7 +235,7 @@ class Sandbox:
         self.spend(total)
         return total
 
-    def _checked(self, value: Any) -> Any:
+    def checked(self, value: Any) -> Any:
         if isinstance(value, int) and value.bit_length() > MAX_INT_BITS:
             raise self.refuse(f"an integer of more than {MAX_INT_BITS} bits")
         if isinstance(value, str | bytes | list | tuple | dict | set | frozenset) and (
@@ -347,7 +244,7 @@ class Sandbox:
             raise self.refuse(f"a value of more than {MAX_WEIGHT} characters or items")
         return value
 
-    def _bounded_list(self, items: Iterable[Any]) -> list[Any]:
+    def bounded_list(self, items: Iterable[Any]) -> list[Any]:
         out: list[Any] = []
         weight = 0
         for item in items:
@@ -358,7 +255,7 @@ class Sandbox:
         return out
 
     def check_callable(self, f: Any) -> None:
-        if isinstance(f, _Bound) or id(f) in self.allowed:
+        if isinstance(f, Bound) or id(f) in self.allowed:
             return
         raise self.refuse(f"calling {_describe(f)}")
 
@@ -405,8 +302,8 @@ class Sandbox:
 
     def _prod(self, iterable: Iterable[Any], *, start: Any = 1) -> Any:
         out = start
-        for x in self._bounded_list(iterable):
-            out = self._checked(self.binop(ast.Mult(), out, x))
+        for x in self.bounded_list(iterable):
+            out = self.checked(self.binop(ast.Mult(), out, x))
         return out
 
     def _lcm(self, *ints: int) -> int:
@@ -420,21 +317,21 @@ class Sandbox:
     def _map(self, f: Any, *iterables: Iterable[Any]) -> list[Any]:
         # a list, not a lazy map: every value an expression holds is one we could weigh
         self.check_callable(f)
-        return self._bounded_list(map(f, *iterables))
+        return self.bounded_list(map(f, *iterables))
 
     def _filter(self, f: Any, iterable: Iterable[Any]) -> list[Any]:
         if f is not None:
             self.check_callable(f)
-        return self._bounded_list(filter(f, iterable))
+        return self.bounded_list(filter(f, iterable))
 
     def _zip(self, *iterables: Iterable[Any]) -> list[Any]:
-        return self._bounded_list(zip(*iterables, strict=False))
+        return self.bounded_list(zip(*iterables, strict=False))
 
     def _enumerate(self, iterable: Iterable[Any], start: int = 0) -> list[Any]:
-        return self._bounded_list(enumerate(iterable, start))
+        return self.bounded_list(enumerate(iterable, start))
 
     def _reversed(self, seq: Any) -> list[Any]:
-        return self._bounded_list(reversed(seq))
+        return self.bounded_list(reversed(seq))
 
     # --- operators and methods with a size that the operands do not bound ----------------------------
 
@@ -462,7 +359,7 @@ class Sandbox:
                 raise self.refuse("a %-format with a width or precision above 999")
         elif isinstance(op, ast.MatMult):
             raise self.refuse("the @ operator")
-        return _BINOPS[type(op)](a, b)
+        return BINOPS[type(op)](a, b)
 
     def _check_repeat(self, seq: Any, n: Any) -> None:
         if (
@@ -479,7 +376,7 @@ class Sandbox:
                 self.check_callable(a)
         if isinstance(obj, str) and name == "join":
             (items,) = args
-            parts = self._bounded_list(items)
+            parts = self.bounded_list(items)
             if sum(len(p) for p in parts if isinstance(p, str)) + len(obj) * len(parts) > MAX_WEIGHT:
                 raise self.refuse(f"a string of more than {MAX_WEIGHT} characters")
             return obj.join(parts)
@@ -491,8 +388,8 @@ class Sandbox:
                     raise self.refuse(f"a string of more than {MAX_WEIGHT} characters")
         result = getattr(obj, name)(*args, **kwargs)
         if name in ("keys", "values", "items"):
-            result = self._bounded_list(result)
-        return self._checked(result)
+            result = self.bounded_list(result)
+        return self.checked(result)
 
 
 def _tokenize(s: str, sep: str = ",; ", skip_empty: bool = True) -> list[str]:
@@ -509,261 +406,3 @@ def _is_int(x: Any) -> bool:
 def _describe(f: Any) -> str:
     name = getattr(type(f), "__name__", "?")
     return f"a {name} that is not one of the functions a description may call"
-
-
-_BINOPS: dict[type[ast.operator], Callable[[Any, Any], Any]] = {
-    ast.Add: lambda a, b: a + b,
-    ast.Sub: lambda a, b: a - b,
-    ast.Mult: lambda a, b: a * b,
-    ast.Div: lambda a, b: a / b,
-    ast.FloorDiv: lambda a, b: a // b,
-    ast.Mod: lambda a, b: a % b,
-    ast.Pow: lambda a, b: a**b,
-    ast.LShift: lambda a, b: a << b,
-    ast.RShift: lambda a, b: a >> b,
-    ast.BitOr: lambda a, b: a | b,
-    ast.BitXor: lambda a, b: a ^ b,
-    ast.BitAnd: lambda a, b: a & b,
-}
-_CMPOPS: dict[type[ast.cmpop], Callable[[Any, Any], bool]] = {
-    ast.Eq: lambda a, b: a == b,
-    ast.NotEq: lambda a, b: a != b,
-    ast.Lt: lambda a, b: a < b,
-    ast.LtE: lambda a, b: a <= b,
-    ast.Gt: lambda a, b: a > b,
-    ast.GtE: lambda a, b: a >= b,
-    ast.Is: lambda a, b: a is b,
-    ast.IsNot: lambda a, b: a is not b,
-    ast.In: lambda a, b: a in b,
-    ast.NotIn: lambda a, b: a not in b,
-}
-
-
-class _Eval:
-    """The interpreter of one expression's tree: every node kind not handled here is refused."""
-
-    def __init__(self, sandbox: Sandbox, lookup: Callable[[str], Any]):
-        self.s = sandbox
-        self.lookup = lookup
-        self.scopes: list[dict[str, Any]] = []  # the loop variables of the comprehensions being evaluated
-
-    def eval(self, node: ast.AST) -> Any:
-        self.s.spend(1)
-        handler = getattr(self, "_" + type(node).__name__, None)
-        if handler is None:
-            what = _WHAT.get(type(node), f"a {type(node).__name__} expression")
-            raise self.s.refuse(what)
-        return handler(node)
-
-    def _Constant(self, node: ast.Constant) -> Any:
-        return node.value
-
-    def _Name(self, node: ast.Name) -> Any:
-        name = node.id
-        if name.startswith("__"):
-            raise self.s.refuse(f"the name {name!r}")
-        for scope in reversed(self.scopes):
-            if name in scope:
-                return scope[name]
-        try:
-            return self.lookup(name)
-        except KeyError:
-            if name in _DANGEROUS_NAMES:
-                raise self.s.refuse(f"{name}()") from None
-            raise NameError(f"name '{name}' is not defined") from None
-
-    def _BinOp(self, node: ast.BinOp) -> Any:
-        a = self.eval(node.left)
-        b = self.eval(node.right)
-        return self.s._checked(self.s.binop(node.op, a, b))
-
-    def _UnaryOp(self, node: ast.UnaryOp) -> Any:
-        v = self.eval(node.operand)
-        if isinstance(node.op, ast.Not):
-            return not v
-        if isinstance(node.op, ast.USub):
-            return -v
-        if isinstance(node.op, ast.UAdd):
-            return +v
-        return ~v
-
-    def _BoolOp(self, node: ast.BoolOp) -> Any:
-        value: Any = None
-        for operand in node.values:
-            value = self.eval(operand)
-            if isinstance(node.op, ast.And) and not value:
-                return value
-            if isinstance(node.op, ast.Or) and value:
-                return value
-        return value
-
-    def _Compare(self, node: ast.Compare) -> Any:
-        left = self.eval(node.left)
-        for op, right_node in zip(node.ops, node.comparators, strict=True):
-            right = self.eval(right_node)
-            if not _CMPOPS[type(op)](left, right):
-                return False
-            left = right
-        return True
-
-    def _IfExp(self, node: ast.IfExp) -> Any:
-        return self.eval(node.body) if self.eval(node.test) else self.eval(node.orelse)
-
-    def _Subscript(self, node: ast.Subscript) -> Any:
-        value = self.eval(node.value)
-        key = self.eval(node.slice)
-        if isinstance(key, str) and key.startswith("_") and isinstance(value, xacro.Table):
-            raise self.s.refuse(f"the name {key!r}")
-        return value[key]
-
-    def _Slice(self, node: ast.Slice) -> slice:
-        part = [None if n is None else self.eval(n) for n in (node.lower, node.upper, node.step)]
-        return slice(*part)
-
-    def _items(self, elts: list[ast.expr]) -> list[Any]:
-        out: list[Any] = []
-        for e in elts:
-            if isinstance(e, ast.Starred):
-                out.extend(self.s._bounded_list(self.eval(e.value)))
-            else:
-                out.append(self.eval(e))
-        return out
-
-    def _List(self, node: ast.List) -> Any:
-        return self.s._checked(self._items(node.elts))
-
-    def _Tuple(self, node: ast.Tuple) -> Any:
-        return self.s._checked(tuple(self._items(node.elts)))
-
-    def _Set(self, node: ast.Set) -> Any:
-        return self.s._checked(set(self._items(node.elts)))
-
-    def _Dict(self, node: ast.Dict) -> Any:
-        out: dict[Any, Any] = {}
-        for k, v in zip(node.keys, node.values, strict=True):
-            if k is None:
-                out.update(self.eval(v))
-            else:
-                out[self.eval(k)] = self.eval(v)
-        return self.s._checked(out)
-
-    # Comprehensions (xacro's own tests use them: `[2*item.val.x for item in xacro.load_yaml(...)]`) are
-    # loops of this interpreter, not code objects: what they iterate is a value we weighed, what they
-    # build is weighed as it grows, and each step is spent from the expansion's work.
-
-    def _ListComp(self, node: ast.ListComp) -> Any:
-        return self.s._bounded_list(self._generate(node.generators, lambda: self.eval(node.elt)))
-
-    def _GeneratorExp(self, node: ast.GeneratorExp) -> Any:
-        return self.s._bounded_list(self._generate(node.generators, lambda: self.eval(node.elt)))
-
-    def _SetComp(self, node: ast.SetComp) -> Any:
-        return self.s._checked(set(self._ListComp(node)))  # type: ignore[arg-type]
-
-    def _DictComp(self, node: ast.DictComp) -> Any:
-        pairs = self._generate(node.generators, lambda: (self.eval(node.key), self.eval(node.value)))
-        return self.s._checked(dict(self.s._bounded_list(pairs)))
-
-    def _generate(self, generators: list[ast.comprehension], element: Callable[[], Any]) -> Iterator[Any]:
-        first, rest = generators[0], generators[1:]
-        if first.is_async:
-            raise self.s.refuse("async")
-        scope: dict[str, Any] = {}
-        self.scopes.append(scope)
-        try:
-            for item in self.eval(first.iter):  # evaluated outside the new variables, as Python does
-                self.s.spend(1)
-                self._bind(first.target, item, scope)
-                if all(self.eval(test) for test in first.ifs):
-                    if rest:
-                        yield from self._generate(rest, element)
-                    else:
-                        yield element()
-        finally:
-            del self.scopes[next(i for i, x in enumerate(self.scopes) if x is scope)]
-
-    def _bind(self, target: ast.expr, value: Any, scope: dict[str, Any]) -> None:
-        if isinstance(target, ast.Name) and not target.id.startswith("__"):
-            scope[target.id] = value
-        elif isinstance(target, ast.Tuple | ast.List) and not any(
-            isinstance(e, ast.Starred) for e in target.elts
-        ):
-            values = list(value)
-            if len(values) != len(target.elts):
-                raise ValueError(f"cannot unpack {len(values)} values into {len(target.elts)} names")
-            for t, v in zip(target.elts, values, strict=True):
-                self._bind(t, v, scope)
-        else:
-            raise self.s.refuse("a loop variable that is not a plain name")
-
-    def _Attribute(self, node: ast.Attribute) -> Any:
-        name = node.attr
-        if name.startswith("_"):
-            raise self.s.refuse(f"the attribute {name!r}")
-        obj = self.eval(node.value)
-        if isinstance(obj, xacro.Table):  # xacro's namespaces: python, math, xacro, include ns=
-            try:
-                return obj[name]
-            except KeyError:
-                if name in _DANGEROUS_NAMES or name in ("type", "vars"):
-                    raise self.s.refuse(f"{name}()") from None
-                raise NameError(f"name '{name}' is not defined") from None
-        if isinstance(obj, dict) and name in _DICT_METHODS:
-            return _Bound(obj, name, self.s)
-        if isinstance(obj, xacro.YamlDictWrapper):  # dotted access to a YAML key
-            return obj[name]
-        if isinstance(obj, str) and name in _STR_METHODS:
-            return _Bound(obj, name, self.s)
-        if isinstance(obj, list | tuple) and name in _SEQ_METHODS:
-            return _Bound(obj, name, self.s)
-        raise self.s.refuse(f"the attribute {name!r} of {_article(obj)}")
-
-    def _Call(self, node: ast.Call) -> Any:
-        f = self.eval(node.func)
-        self.s.check_callable(f)
-        args = self._items(node.args)
-        kwargs: dict[str, Any] = {}
-        for kw in node.keywords:
-            if kw.arg is None:
-                kwargs.update(self.eval(kw.value))
-            else:
-                kwargs[kw.arg] = self.eval(kw.value)
-        for a in (*args, *kwargs.values()):
-            if callable(a):  # map(f, ...), sorted(key=f): f runs too
-                self.s.check_callable(a)
-        return self.s._checked(f(*args, **kwargs))
-
-    def _JoinedStr(self, node: ast.JoinedStr) -> Any:
-        out = []
-        for part in node.values:
-            if isinstance(part, ast.Constant):
-                out.append(str(part.value))
-            else:
-                out.append(self.eval(part))
-        return self.s._checked("".join(out))
-
-    def _FormattedValue(self, node: ast.FormattedValue) -> str:
-        value = self.eval(node.value)
-        spec = ""
-        if node.format_spec is not None:
-            parts = node.format_spec.values if isinstance(node.format_spec, ast.JoinedStr) else []
-            if not all(isinstance(p, ast.Constant) for p in parts):
-                raise self.s.refuse("an f-string format computed from an expression")
-            spec = "".join(str(p.value) for p in parts if isinstance(p, ast.Constant))
-            if not _FORMAT_SPEC.match(spec):
-                raise self.s.refuse(f"the f-string format {spec!r}")
-        value = self.s._checked(value)
-        if node.conversion == ord("r"):
-            value = repr(value)
-        elif node.conversion == ord("a"):
-            value = ascii(value)
-        elif node.conversion == ord("s"):
-            value = str(value)
-        if not isinstance(value, str | int | float | complex | bool) and value is not None:
-            value = str(value)
-        return format(value, spec)
-
-
-def _article(obj: Any) -> str:
-    name = type(obj).__name__
-    return f"an {name}" if name[:1] in "aeiou" else f"a {name}"
