@@ -34,7 +34,7 @@ ROBOT = """<?xml version="1.0"?>
   </link>
 </robot>
 """
-REFUSED = "is not allowed in a robot description"
+REFUSED = "not allowed in a robot description"
 TOUCH = "touch CANARY"
 
 # (id, expression, what the error says). `${rp}` is ")": the text of `$(eval ...)` cannot hold one, and
@@ -106,6 +106,9 @@ ESCAPES: list[tuple[str, str, str]] = [
     ("replace-bomb", "${('-'*10**5).replace('-', '-'*10**5)}", REFUSED),
     ("comprehension-bomb", "${[[0]*999999 for i in python.range(100)]}", REFUSED),
     ("deep-expression", "${" + "-" * 5000 + "1}", REFUSED),
+    ("sort-key-bomb", "${python.sorted([python.range(10**6)]*300000, key=list)}", REFUSED),
+    ("scan-bomb", "${len([1 for i in python.range(30000) if [0]*300000 == [0]*300000])}", REFUSED),
+    ("method-scan-bomb", "${python.sum([('a'*400000).count('a') for i in python.range(3000)])}", REFUSED),
 ]
 
 

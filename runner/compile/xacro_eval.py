@@ -20,6 +20,8 @@ class Host(Protocol):
     def checked(self, value: Any) -> Any: ...
     def bounded_list(self, items: Iterable[Any]) -> list[Any]: ...
     def check_callable(self, f: Any) -> None: ...
+    def weigh(self, value: Any) -> int: ...
+    def metered(self, f: Callable[..., Any]) -> Callable[..., Any]: ...
     def binop(self, op: ast.operator, a: Any, b: Any) -> Any: ...
     def method(self, obj: Any, name: str, args: tuple[Any, ...], kwargs: dict[str, Any]) -> Any: ...
 
@@ -221,6 +223,7 @@ class Interpreter:
         left = self.eval(node.left)
         for op, right_node in zip(node.ops, node.comparators, strict=True):
             right = self.eval(right_node)
+            self.s.weigh(right)  # `x in big`, `big == other` scan: spent from the expansion's work
             if not _CMPOPS[type(op)](left, right):
                 return False
             left = right
@@ -234,7 +237,7 @@ class Interpreter:
         key = self.eval(node.slice)
         if isinstance(key, str) and key.startswith("_") and isinstance(value, xacro.Table):
             raise self.s.refuse(f"the name {key!r}")
-        return value[key]
+        return self.s.checked(value[key]) if isinstance(key, slice) else value[key]
 
     def _Slice(self, node: ast.Slice) -> slice:
         part = [None if n is None else self.eval(n) for n in (node.lower, node.upper, node.step)]
@@ -351,6 +354,9 @@ class Interpreter:
         for a in (*args, *kwargs.values()):
             if callable(a):  # map(f, ...), sorted(key=f): f runs too
                 self.s.check_callable(a)
+            self.s.weigh(a)  # a call costs what it reads (max(x) scans x): spent from the expansion's work
+        if callable(kwargs.get("key")):  # sorted(x, key=list): each key it makes is weighed and spent
+            kwargs["key"] = self.s.metered(kwargs["key"])
         return self.s.checked(f(*args, **kwargs))
 
     def _JoinedStr(self, node: ast.JoinedStr) -> Any:

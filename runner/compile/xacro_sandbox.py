@@ -317,12 +317,12 @@ class Sandbox:
     def _map(self, f: Any, *iterables: Iterable[Any]) -> list[Any]:
         # a list, not a lazy map: every value an expression holds is one we could weigh
         self.check_callable(f)
-        return self.bounded_list(map(f, *iterables))
+        return self.bounded_list(map(self.metered(f), *iterables))
 
     def _filter(self, f: Any, iterable: Iterable[Any]) -> list[Any]:
         if f is not None:
             self.check_callable(f)
-        return self.bounded_list(filter(f, iterable))
+        return self.bounded_list(filter(None if f is None else self.metered(f), iterable))
 
     def _zip(self, *iterables: Iterable[Any]) -> list[Any]:
         return self.bounded_list(zip(*iterables, strict=False))
@@ -370,7 +370,17 @@ class Sandbox:
         ):
             raise self.refuse(f"a value of more than {MAX_WEIGHT} characters or items")
 
+    def metered(self, f: Callable[..., Any]) -> Callable[..., Any]:
+        """`f` as a builtin calls it (map, filter, sorted's key): each call spent, its result weighed."""
+
+        def call(*args: Any) -> Any:
+            self.spend(1)
+            return self.checked(f(*args))
+
+        return call
+
     def method(self, obj: Any, name: str, args: tuple[Any, ...], kwargs: dict[str, Any]) -> Any:
+        self.weigh(obj)  # s.count(x) scans s
         for a in (*args, *kwargs.values()):
             if callable(a):
                 self.check_callable(a)
