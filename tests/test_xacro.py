@@ -107,3 +107,35 @@ def test_a_macro_call_without_its_parameters_and_a_macro_without_end_are_located
         expand(loop, {}, PackageMap(roots=[tmp_path]))
     assert err.value.line == 3 and "macro 'again' calls itself without end" in str(err.value)
     assert "<xacro:if>" in (err.value.hint or "")
+
+
+@pytest.mark.parametrize("ns", ["", "p."])
+def test_a_macro_call_without_its_parameters_is_located_at_that_call(tmp_path: Path, ns: str):
+    """The error pointed at the first call of the macro (`<xacro:wheel`), the call before the one that
+    lacks a parameter; calls spread over lines and namespaced calls count too."""
+    from runner.compile.xacro_expand import XacroError
+
+    parts = tmp_path / "parts.xacro"
+    parts.write_text(
+        '<?xml version="1.0"?>\n<robot xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+        '  <xacro:macro name="wheel" params="name radius">\n    <link name="${name}"/>\n'
+        "  </xacro:macro>\n</robot>\n"
+    )
+    main = tmp_path / "robot.urdf.xacro"
+    include = (
+        '<xacro:include filename="parts.xacro" ns="p"/>' if ns else '<xacro:include filename="parts.xacro"/>'
+    )
+    main.write_text(
+        '<?xml version="1.0"?>\n<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+        f"  {include}\n"
+        '  <link name="base"/>\n'
+        f'  <xacro:{ns}wheel name="w1" radius="0.1"/>\n'
+        f'  <xacro:{ns}wheel\n      name="w2"\n      radius="0.1"/>\n'
+        f'  <xacro:{ns}wheel name="w3"/>\n'
+        f'  <xacro:{ns}wheel name="w4"/>\n'
+        "</robot>\n"
+    )
+    with pytest.raises(XacroError) as err:
+        expand(main, {}, PackageMap(roots=[tmp_path]))
+    assert err.value.file == main and err.value.line == 9, (err.value.file, err.value.line)
+    assert "the call of macro 'wheel' does not give parameters [radius]" in str(err.value)

@@ -1,8 +1,11 @@
 """xacro -> URDF text, with `$(find pkg)` resolved through our package map (no ROS install).
 
 The xacro package resolves `$(find)` through ament_index_python, which is not on PyPI; we replace its
-resolver. That is a private API of xacro (`xacro.substitution_args._eval_find`): this module is the only
-place that touches it, and tests/compile/test_xacro.py pins the behaviour.
+resolver. It evaluates `${...}` and `$(eval ...)` with Python's `eval`, which a description can escape
+from; we replace its evaluator with ours (xacro_sandbox.py), and its global symbols with ours. Those are
+private APIs of xacro (`substitution_args._eval_find`, `_eval`, `safe_eval`, `_global_symbols`): this
+module is the only place that touches them, under a lock and restored after, and tests/test_xacro.py and
+tests/test_xacro_sandbox.py pin the behaviour.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ import xacro
 import xacro.substitution_args as _sa
 
 from runner.compile.packages import PackageMap
+from runner.compile.xacro_sandbox import Sandbox, SandboxError
 from runner.errors import SourceError
 
 
@@ -55,9 +59,14 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
     real_parse = xacro.parse
     with _lock:
         saved = _sa._eval_find, _sa._eval_dict.get("find")
+        saved_eval = xacro.safe_eval, xacro._global_symbols, _sa._eval
+        sandbox = Sandbox(_trusted_load_yaml(xacro.load_yaml, path, packages))
         _sa._eval_find = find
         _sa._eval_dict["find"] = find
-        xacro.parse = _cycle_guard(real_parse)
+        xacro.safe_eval = sandbox.safe_eval
+        xacro._global_symbols = sandbox.root
+        _sa._eval = sandbox.substitution_eval
+        xacro.parse = _cycle_guard(real_parse, path, packages)
         stderr = io.StringIO()
         xacro.all_includes = []
         try:
@@ -79,6 +88,7 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
             raise _xacro_error(e, path) from None
         finally:
             xacro.parse = real_parse
+            xacro.safe_eval, xacro._global_symbols, _sa._eval = saved_eval
             _sa._eval_find, found = saved
             if found is not None:
                 _sa._eval_dict["find"] = found
@@ -105,14 +115,17 @@ def _package_finder(path: Path, packages: PackageMap) -> Callable[[str], str]:
     return find
 
 
-def _cycle_guard(real_parse: Callable[..., Any]) -> Callable[..., Any]:
-    """xacro's `parse`, stopping an include cycle (a includes b includes a) at the first file that is
-    already being read: xacro itself recurses without end."""
+def _cycle_guard(real_parse: Callable[..., Any], path: Path, packages: PackageMap) -> Callable[..., Any]:
+    """xacro's `parse`, refusing an included file outside what the scenario trusts before it is read, and
+    stopping an include cycle (a includes b includes a) at the first file that is already being read:
+    xacro itself recurses without end."""
 
     def parse(inp, filename=None):  # type: ignore[no-untyped-def]
         # xacro has pushed `filename` on its stack before parsing it.
         stack = list(getattr(xacro, "filestack", None) or [])
         if inp is None and filename and len(stack) > 1:
+            if not packages.readable(Path(filename), path):
+                raise _outside(Path(filename), Path(stack[-2]))
             again = _same_file_index(stack[:-1], filename)
             if again is not None:
                 chain = [Path(f).name for f in stack[again:-1]] + [Path(filename).name]
@@ -129,29 +142,45 @@ def _cycle_guard(real_parse: Callable[..., Any]) -> Callable[..., Any]:
     return parse
 
 
+def _trusted_load_yaml(real: Callable[[str], Any], path: Path, packages: PackageMap) -> Callable[[str], Any]:
+    """xacro's `load_yaml`, refusing a file outside what the scenario trusts before it is opened."""
+
+    def load_yaml(filename: str) -> Any:
+        full = Path(xacro.abs_filename_spec(str(filename)))
+        if not packages.readable(full, path):
+            raise _outside(full, _current_file(path))
+        return real(filename)
+
+    return load_yaml
+
+
 def _check_readable(sources: list[Path], path: Path, packages: PackageMap) -> None:
-    """Every file the expansion read (`<xacro:include>`, `xacro.load_yaml`) is one the scenario trusts."""
+    """Every file the expansion read (`<xacro:include>`, `xacro.load_yaml`) is one the scenario trusts
+    (checked again after the expansion, whatever way a file was read)."""
     for read in sources[1:]:
         if not packages.readable(read, path):
-            holder = next((f for f in sources if _line_of(f, read.name)), path)
-            raise OutsidePackages(
-                f"{read} is outside the scenario's folder and packages",
-                holder,
-                _line_of(holder, read.name),
-                hint="a robot description may read files of the scenario's folder, its own folder "
-                "and the packages (`packages:`, SCENARIO_PACKAGE_PATH); list other folders the "
-                "scenario trusts under `allow_paths:`",
-            )
+            raise _outside(read, next((f for f in sources if _line_of(f, read.name)), path))
+
+
+def _outside(read: Path, holder: Path) -> OutsidePackages:
+    return OutsidePackages(
+        f"{read} is outside the scenario's folder and packages",
+        holder,
+        _line_of(holder, read.name),
+        hint="a robot description may read files of the scenario's folder, its own folder "
+        "and the packages (`packages:`, SCENARIO_PACKAGE_PATH); list other folders the "
+        "scenario trusts under `allow_paths:`",
+    )
 
 
 def _xacro_error(e: Exception, path: Path) -> XacroError:
     """What xacro raised, as an error at the file and line it is about (called while xacro's file stack
     still says which file it was reading)."""
-    cause = e.__cause__ or e.__context__
-    if isinstance(cause, MissingPackage):
-        return cause
-    if isinstance(cause, IncludeCycle):
-        return cause
+    for cause in _causes(e):
+        if isinstance(cause, SourceError):  # ours, raised inside xacro: already located
+            return cause
+        if isinstance(cause, SandboxError):
+            return _refused(cause, path)
     message = " ".join(str(e).split())
     missing = getattr(e, "exc", None)
     if isinstance(missing, FileNotFoundError) and missing.filename:
@@ -163,8 +192,9 @@ def _xacro_error(e: Exception, path: Path) -> XacroError:
     if message.startswith("Undefined parameters") and name:
         # the call that lacks them: `<xacro:wheel .../>` (not the definition, `<xacro:macro ...>`)
         message = f"the call of macro {name!r} does not give {message.removeprefix('Undefined ')}"
+        missing = re.findall(r"[^\s,\[\]]+", message.partition("[")[2].partition("]")[0])
         for candidate in dict.fromkeys([file, *sources]):
-            line = _line_of(candidate, f"<xacro:{name}")
+            line = _call_lacking(candidate, name, missing)
             if line is not None:
                 return XacroError(
                     message,
@@ -184,6 +214,71 @@ def _xacro_error(e: Exception, path: Path) -> XacroError:
     return XacroError(message, file, line, hint=_hint(message))
 
 
+def _causes(e: BaseException) -> list[BaseException]:
+    """`e` and what it wraps (xacro's `XacroException.exc`, Python's cause and context), outermost first."""
+    out: list[BaseException] = []
+    todo: list[BaseException | None] = [e]
+    while todo:
+        x = todo.pop(0)
+        if x is None or any(x is seen for seen in out):
+            continue
+        out.append(x)
+        todo += [getattr(x, "exc", None), x.__cause__, x.__context__]
+    return out
+
+
+def _refused(e: SandboxError, path: Path) -> XacroError:
+    """An expression the sandbox refused, at the line where the expression is written."""
+    sources = [_current_file(path), path, *map(Path, xacro.all_includes)]
+    shown = e.expr if len(e.expr) <= 120 else e.expr[:117] + "..."
+    where, line = _expression_line(e.expr, e.opener, sources)
+    closer = "}" if e.opener == "${" else ")"
+    return XacroError(f"{e.why}: {e.opener}{shown}{closer}", where, line, hint=e.hint)
+
+
+def _expression_line(expr: str, opener: str, sources: list[Path]) -> tuple[Path, int | None]:
+    """Where `expr` is written: xacro gives the expression as parsed (entities decoded, an attribute's
+    newlines turned to spaces, `${...}` inside `$(eval ...)` already expanded), so we match it loosely,
+    whole then by a shrinking prefix."""
+    for length in dict.fromkeys([len(expr), 60, 30, 15, 6]):
+        if length > len(expr):
+            continue
+        for lead in dict.fromkeys([opener, "${", "$(eval", ""]):
+            pattern = re.compile(_loose(lead) + r"\s*" + _loose(expr[:length].strip()))
+            for file in dict.fromkeys(sources):
+                try:
+                    text = file.read_text(encoding="utf-8", errors="replace")
+                except OSError:
+                    continue
+                m = pattern.search(text)
+                if m:
+                    return file, text.count("\n", 0, m.start()) + 1
+    return sources[0], None
+
+
+_ENTITIES = {
+    "<": ("&lt;", "&#60;"),
+    ">": ("&gt;", "&#62;"),
+    "&": ("&amp;", "&#38;"),
+    '"': ("&quot;", "&#34;"),
+    "'": ("&apos;", "&#39;"),
+}
+
+
+def _loose(text: str) -> str:
+    """A regular expression for `text` as written in XML: any whitespace for whitespace, an entity for
+    a character it may stand for."""
+    out = []
+    for c in text:
+        if c.isspace():
+            out.append(r"\s+")
+        elif c in _ENTITIES:
+            out.append("(?:" + "|".join(map(re.escape, (c, *_ENTITIES[c]))) + ")")
+        else:
+            out.append(re.escape(c))
+    return "".join(out)
+
+
 def _line_of(file: Path, needle: str, also: str = "") -> int | None:
     """The first line of `file` holding `needle` (and `also`, when given)."""
     try:
@@ -192,6 +287,21 @@ def _line_of(file: Path, needle: str, also: str = "") -> int | None:
                 return i + 1
     except OSError:
         pass
+    return None
+
+
+def _call_lacking(file: Path, macro: str, missing: list[str]) -> int | None:
+    """The line of the first call of `macro` in `file` that gives none of the `missing` parameters: xacro
+    expands in document order, so an earlier call that lacked them would have failed first (the first
+    call of all, which we used to point at, may well give them)."""
+    try:
+        text = file.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return None
+    for m in re.finditer(rf"<xacro:(?:[\w.]+\.)?{re.escape(macro)}(?=[\s/>])([^>]*)>", text):
+        given = set(re.findall(r"([\w:.-]+)\s*=", m.group(1)))
+        if not given & set(missing):
+            return text.count("\n", 0, m.start()) + 1
     return None
 
 
