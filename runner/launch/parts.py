@@ -8,6 +8,7 @@ step inherits the no-op. The worlds are parts too (runner.launch.worlds), with t
 
 from __future__ import annotations
 
+import json
 import sys
 import threading
 import time
@@ -238,7 +239,14 @@ class RecorderPart(Part):
 
     def close(self, run: Run) -> None:
         # how the run ended, for judging the recording by itself later (`scenario check`)
-        self.recorder.end_note(ended=run.ending(), sim_ns=str(run.reached()))
+        from runner.launch.result import outside_of, rejected_of
+
+        rejected = rejected_of(run)
+        outside, outsiders = outside_of(run)
+        said = {"rejected": json.dumps(rejected)} if rejected else {}  # (key -> why -> how many)
+        if outside:  # (key -> how many, and who: the sessions outside the run)
+            said["outside"] = json.dumps({"messages": outside, "from": outsiders})
+        self.recorder.end_note(ended=run.ending(), sim_ns=str(run.reached()), **said)
         self.recorder.close()
 
 

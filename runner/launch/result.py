@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 from runner.record import TopicStats
 
 if TYPE_CHECKING:
+    from runner.launch.parts import Run
     from runner.launch.supervisor import Supervisor
 
 
@@ -25,6 +26,8 @@ class RunResult:
     error: str | None = None
     endpoints: list[str] = field(default_factory=list)
     rejected: dict[str, dict[str, int]] = field(default_factory=dict)  # inbound samples dropped: key, why
+    outside: dict[str, int] = field(default_factory=dict)  # messages from publishers outside the run, per key
+    outsiders: list[str] = field(default_factory=list)  # those publishers' sessions, named
 
     @property
     def exit_code(self) -> int:
@@ -37,14 +40,11 @@ class RunResult:
         return {k: n - got[k] for k, n in self.published.items() if k in got and n > got[k]}
 
 
-def result_of(run: Supervisor) -> RunResult:
-    """What a finished supervisor tells: how the run ended, its times, what was published and recorded."""
-    infos = [w.end_info for w in run.worlds]
-    walls = [float(i["wall_s"]) for i in infos if "wall_s" in i]
-    published: dict[str, int] = {}
+def rejected_of(run: Supervisor | Run) -> dict[str, dict[str, int]]:
+    """The inbound messages dropped, per key and why: by the worlds (NaN or Inf values, another type) and
+    by the recorder (not recorded)."""
     rejected: dict[str, dict[str, int]] = {}
-    for i in infos:
-        published.update(i.get("published", {}))
+    for i in (w.end_info for w in run.worlds):
         for key, whys in i.get("rejected", {}).items():
             for why, n in whys.items():
                 rejected.setdefault(key, {})[why] = rejected.get(key, {}).get(why, 0) + n
@@ -53,6 +53,26 @@ def result_of(run: Supervisor) -> RunResult:
         for key, whys in recorder.mistyped.items():
             for why, n in whys.items():
                 rejected.setdefault(key, {}).setdefault(f"not recorded: {why}", n)
+    return rejected
+
+
+def outside_of(run: Supervisor | Run) -> tuple[dict[str, int], list[str]]:
+    """The messages put on the run's keys by publishers outside the run (per key), and who they are."""
+    recorder = run.recorder.recorder if run.recorder is not None else None
+    counts = dict(recorder.outside) if recorder is not None else {}
+    part = getattr(run, "outside", None)
+    return counts, part.seen.foreign() if part is not None and counts else []
+
+
+def result_of(run: Supervisor) -> RunResult:
+    """What a finished supervisor tells: how the run ended, its times, what was published and recorded."""
+    infos = [w.end_info for w in run.worlds]
+    walls = [float(i["wall_s"]) for i in infos if "wall_s" in i]
+    published: dict[str, int] = {}
+    for i in infos:
+        published.update(i.get("published", {}))
+    recorder = run.recorder.recorder if run.recorder is not None else None
+    outside, outsiders = outside_of(run)
     return RunResult(
         reason="interrupted" if run.signalled.is_set() else run.reason,  # (one that came while closing too)
         sim_ns=run.reached(),
@@ -62,5 +82,7 @@ def result_of(run: Supervisor) -> RunResult:
         published=published,
         error=run.error,
         endpoints=run.listen,
-        rejected=rejected,
+        rejected=rejected_of(run),
+        outside=outside,
+        outsiders=outsiders,
     )
