@@ -8,10 +8,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from runner.launch.parts import outside_of, rejected_of
 from runner.record import TopicStats
 
 if TYPE_CHECKING:
-    from runner.launch.parts import Run
     from runner.launch.supervisor import Supervisor
 
 
@@ -38,30 +38,6 @@ class RunResult:
         """Messages published but not recorded, per topic (only topics that were recorded)."""
         got = {t.key: t.count for t in self.topics}
         return {k: n - got[k] for k, n in self.published.items() if k in got and n > got[k]}
-
-
-def rejected_of(run: Supervisor | Run) -> dict[str, dict[str, int]]:
-    """The inbound messages dropped, per key and why: by the worlds (NaN or Inf values, another type) and
-    by the recorder (not recorded)."""
-    rejected: dict[str, dict[str, int]] = {}
-    for i in (w.end_info for w in run.worlds):
-        for key, whys in i.get("rejected", {}).items():
-            for why, n in whys.items():
-                rejected.setdefault(key, {})[why] = rejected.get(key, {}).get(why, 0) + n
-    recorder = run.recorder.recorder if run.recorder is not None else None
-    if recorder is not None:
-        for key, whys in recorder.mistyped.items():
-            for why, n in whys.items():
-                rejected.setdefault(key, {}).setdefault(f"not recorded: {why}", n)
-    return rejected
-
-
-def outside_of(run: Supervisor | Run) -> tuple[dict[str, int], list[str]]:
-    """The messages put on the run's keys by publishers outside the run (per key), and who they are."""
-    recorder = run.recorder.recorder if run.recorder is not None else None
-    counts = dict(recorder.outside) if recorder is not None else {}
-    part = getattr(run, "outside", None)
-    return counts, part.seen.foreign() if part is not None and counts else []
 
 
 def result_of(run: Supervisor) -> RunResult:

@@ -333,10 +333,8 @@ class World(PubSub):
         while True:
             self._boundary()
             # what the hooks wrote to the controls, checked before physics takes it (a NaN fails `<=` too)
-            if not (np.abs(ctrl, out=abs_ctrl) <= CTRL_MAX).all():
-                error = self._bad_controls()
-                if error is not None:
-                    break
+            if not (np.abs(ctrl, out=abs_ctrl) <= CTRL_MAX).all() and (error := self._bad_controls()):
+                break
             if self.now_ns >= end_ns or self._ended is not None:
                 break
             target = self._next_boundary(end_ns)
@@ -349,11 +347,8 @@ class World(PubSub):
             else:
                 mujoco.mj_step(m, d, nstep=n)
             steps += n
-            if warnings[0].number or warnings[1].number or warnings[2].number:
+            if warnings[0].number or warnings[1].number or warnings[2].number or badctrl.number:
                 error = self._instability(self.now_ns, self.now_ns + n * self.step_ns)
-                break
-            if badctrl.number:  # (the check above keeps controls good: something else wrote them)
-                error = self._bad_control(int(badctrl.lastinfo), "NaN, Inf or huge", self.now_ns)
                 break
             self.now_ns += n * self.step_ns
             wall = time.perf_counter()
@@ -430,6 +425,8 @@ class World(PubSub):
     def _instability(self, t0_ns: int, t1_ns: int) -> str:
         """What went unstable, where (the joint of the degree of freedom MuJoCo names, and its robot)."""
         m, d = self.model, self.data
+        if d.warning[_BADCTRL].number:  # (the check before each step keeps controls good: not a hook's)
+            return self._bad_control(int(d.warning[_BADCTRL].lastinfo), "NaN, Inf or huge", t0_ns)
         kinds = zip(("positions", "velocities", "accelerations"), _UNSTABLE, strict=True)
         kind, i = next((k, i) for k, i in kinds if d.warning[i].number)
         dof = int(d.warning[i].lastinfo)
