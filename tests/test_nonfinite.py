@@ -204,7 +204,8 @@ def test_a_nan_put_by_another_session_in_a_real_run_is_dropped_reported_and_fail
     """The issue's case, in a real run: a stray Zenoh client puts one Twist with linear.x = NaN on
     <run>/r1/cmd_vel, then a good one (and a burst of 2000 more of those). The robot drives as the good
     command says (read back from the MCAP); the end table and the recording's metadata count 1 rejected
-    message on that topic and name the stray session by its Zenoh id with its count; --strict exits 1."""
+    message on that topic and name the stray session (its Zenoh id, and the ROS node its liveliness token
+    says) with its count; --strict exits 1."""
     from mcap.reader import make_reader
 
     from runner.wire.transport import free_port
@@ -220,12 +221,16 @@ def test_a_nan_put_by_another_session_in_a_real_run_is_dropped_reported_and_fail
         session = _join(port, "stray")
         try:
             zid = str(session.zid())
+            # what an rmw_zenoh node declares for itself (rmw_zenoh_cpp liveliness_utils.cpp: domain, zid,
+            # node id, entity id, NN, enclave, namespace, name; "/" written "%")
+            node = session.liveliness().declare_token(f"@ros2_lv/0/{zid}/0/0/NN/%/%robots/teleop_stray")
             pub = session.declare_publisher("stray/r1/cmd_vel", encoding=encoding_for(TWIST))
             pub.put(twist(math.nan))
             pub.put(twist(0.3))
             for _ in range(2000):
                 pub.put(twist(0.3))
             pub.undeclare()
+            node.undeclare()
         finally:
             session.close()
         out, err = proc.communicate(timeout=120)
@@ -235,9 +240,9 @@ def test_a_nan_put_by_another_session_in_a_real_run_is_dropped_reported_and_fail
     text = " ".join(out.split())
     assert "rejected: 1 message(s) on stray/r1/cmd_vel: NaN or Inf values" in text, out
     assert (
-        f"recorded 2002 message(s) on stray/r1/cmd_vel, 2002 from a publisher outside the run (zid {zid}"
-        in text
-    )
+        "recorded 2002 message(s) on stray/r1/cmd_vel, 2002 from a publisher outside the run "
+        f"(ROS node /robots/teleop_stray, zid {zid} from tcp/127.0.0.1:"
+    ) in text, out
     assert text.count("outside:") == 1, out  # (the world's own topics carry the run's attachment)
     assert "--strict: 1 message(s) rejected, on stray/r1/cmd_vel" in " ".join(err.split())
     assert "stray/r1/cmd_vel at t = " in err and "linear.x is nan" in err

@@ -327,13 +327,13 @@ class World(PubSub):
         steps = 0
         warnings = [d.warning[i] for i in _UNSTABLE]
         badctrl = d.warning[_BADCTRL]
-        ctrl, abs_ctrl = d.ctrl, np.empty(m.nu)
+        ctrl, abs_ctrl, nu = d.ctrl, np.empty(m.nu), m.nu
         self._clamped: set[int] = set()
         error = None
         while True:
             self._boundary()
-            # what the hooks wrote to the controls, checked before physics takes it (a NaN fails `<=` too)
-            if not (np.abs(ctrl, out=abs_ctrl) <= CTRL_MAX).all() and (error := self._bad_controls()):
+            # the hooks' controls, checked before physics takes them (a NaN fails `<=` too), in ~1 µs
+            if nu and not np.abs(ctrl, out=abs_ctrl).max() <= CTRL_MAX and (error := self._bad_controls()):
                 break
             if self.now_ns >= end_ns or self._ended is not None:
                 break
