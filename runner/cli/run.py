@@ -334,6 +334,7 @@ def _run_one(plan: Any, label: str, options: RunOptions) -> tuple[Any, int]:
         interrupted=ended,
         label=label,
         events=events,
+        properties=_run_properties(result),
     )
     if results and not suite.passed and result.mcap is not None:
         plot_failure(plan, result.mcap, results)
@@ -384,12 +385,17 @@ def _progress_line(plan: Any, shown: bool) -> Iterator[Callable[[int, float], No
 
 
 def _run_error(result: Any, strict: bool) -> str | None:
-    """The run's error; with --strict, messages published but not recorded are one."""
+    """The run's error; with --strict, messages published but not recorded are one, and so are messages
+    dropped on their way in (a NaN in a command, another type: what was sent was not obeyed)."""
     error: str | None = result.error
     lost = sum(result.lost.values()) + sum(t.lost for t in result.topics)
     if strict and lost and error is None:
         where = sorted({k for k, n in result.lost.items() if n} | {t.key for t in result.topics if t.lost})
         error = f"--strict: {lost} message(s) published but not recorded, on {', '.join(where)}"
+    rejected = getattr(result, "rejected", {})
+    if strict and rejected and error is None:
+        n = sum(sum(whys.values()) for whys in rejected.values())
+        error = f"--strict: {n} message(s) rejected, on {', '.join(sorted(rejected))} (the table says why)"
     return error
 
 
@@ -431,7 +437,44 @@ def _print_summary(result: Any, show_all: bool = False) -> None:
     for key, whys in sorted(getattr(result, "rejected", {}).items()):
         for why, n in whys.items():
             out.print(f"rejected: {n} message(s) on {key}: {why}", markup=False, style="yellow")
+    _print_outside(result)
     sim = result.sim_ns / 1e9
     rtf = sim / result.wall_s if result.wall_s > 0 else 0.0
     where = f" -> {result.mcap}" if result.mcap else ""
     out.print(f"{result.reason}: {sim:.2f} s sim in {result.wall_s:.2f} s wall ({rtf:.1f}× real time){where}")
+
+
+def _run_properties(result: Any) -> dict[str, str]:
+    """What the results (JSON, JUnit <properties>) say of messages dropped or put from outside the run:
+    `rejected.<key>` = `1 NaN or Inf values`, `outside.<key>` = how many, `outside.from` = who."""
+    said = {
+        f"rejected.{key}": "; ".join(f"{n} {why}" for why, n in whys.items())
+        for key, whys in sorted(getattr(result, "rejected", {}).items())
+    }
+    outside = getattr(result, "outside", {})
+    said.update({f"outside.{key}": str(n) for key, n in sorted(outside.items())})
+    if outside and getattr(result, "outsiders", None):
+        said["outside.from"] = "; ".join(result.outsiders)
+    return said
+
+
+def _print_outside(result: Any) -> None:
+    """Messages put on the run's keys by publishers outside the run (a stray client, a flood), and who."""
+    outside: dict[str, int] = getattr(result, "outside", {})
+    if not outside:
+        return
+    who = getattr(result, "outsiders", [])
+    named = (
+        f"a publisher outside the run ({who[0]})"
+        if len(who) == 1
+        else f"publishers outside the run ({'; '.join(who)})"
+        if who
+        else "a publisher outside the run (gone before it could be named)"
+    )
+    recorded = {t.key: t.count for t in result.topics}
+    for key, n in sorted(outside.items()):
+        total = recorded.get(key)
+        head = (
+            f"recorded {total} message(s) on {key}, {n}" if total is not None else f"{n} message(s) on {key}"
+        )
+        out.print(f"outside: {head} from {named}", markup=False, style="yellow")

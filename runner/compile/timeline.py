@@ -47,10 +47,29 @@ def message_of(type_text: str, data: dict[str, Any], doc: Document, here: PathKe
     `publish`), its data checked against the type's fields: each mistake located."""
     type_name = message_type(type_text, doc, (*here, "type"))
     try:
-        msgs.from_data(type_name, data)
+        msg = msgs.from_data(type_name, data)
     except msgs.MessageDataError as e:
         where: PathKey = (*here, "data", *e.path)
         raise ScenarioError(Problem(str(e), doc.locate(where), where, hint=e.hint)) from None
+    bad = msgs.nonfinite(msg, type_name)
+    if bad is not None:
+        # (YAML's .nan, .inf, -.inf: the plan's JSON would carry them as null, a silent 0.0 in the world,
+        # and the world drops such a message from any other publisher)
+        where = (*here, "data", *bad)
+        value = data
+        for part in bad:
+            value = value[part]
+        raise ScenarioError(
+            Problem(
+                "a message field must be a finite number",
+                doc.locate(where),
+                where,
+                expected="a finite number (within its type's range)",
+                found=str(value),
+                hint="a command of NaN or Inf cannot be obeyed: write the number meant (a large speed is "
+                "limited by the robot's drive anyway)",
+            )
+        )
     return type_name
 
 

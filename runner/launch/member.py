@@ -18,6 +18,7 @@ from runner.launch.nodes import NodeError, Nodes
 from runner.launch.result import RunResult
 from runner.launch.worlds import connectable, world_parts
 from runner.plan import RunPlan
+from runner.wire.graph import member_key
 from runner.wire.transport import make_config, meta_key, zenoh_reason
 
 
@@ -36,6 +37,7 @@ def run_member(
         raise RunError(f"cannot open the Zenoh network on {', '.join(listen)}: {zenoh_reason(e)}") from None
     parts = world_parts(plan, host)
     subs = [session.declare_subscriber(meta_key(p.plan.name, "**"), p.on_meta) for p in parts]
+    subs.append(session.liveliness().declare_token(member_key(plan.name, str(session.zid()))))  # (the run's)
     nodes = (
         Nodes(plan, connectable(listen[0]), host=host) if any(n.host == host for n in plan.nodes) else None
     )

@@ -8,6 +8,7 @@ step inherits the no-op. The worlds are parts too (runner.launch.worlds), with t
 
 from __future__ import annotations
 
+import json
 import sys
 import threading
 import time
@@ -74,6 +75,30 @@ def wait_for_published(run: Run, counts: Callable[[], dict[str, int]], wanted: C
             if all(got.get(k, 0) >= n for k, n in published.items() if wanted(k)):
                 break
             run.hurry.wait(0.01)
+
+
+def rejected_of(run: Run) -> dict[str, dict[str, int]]:
+    """The inbound messages dropped, per key and why: by the worlds (NaN or Inf values, another type) and
+    by the recorder (not recorded)."""
+    rejected: dict[str, dict[str, int]] = {}
+    for i in (w.end_info for w in run.worlds):
+        for key, whys in i.get("rejected", {}).items():
+            for why, n in whys.items():
+                rejected.setdefault(key, {})[why] = rejected.get(key, {}).get(why, 0) + n
+    recorder = run.recorder.recorder if run.recorder is not None else None
+    if recorder is not None:
+        for key, whys in recorder.mistyped.items():
+            for why, n in whys.items():
+                rejected.setdefault(key, {}).setdefault(f"not recorded: {why}", n)
+    return rejected
+
+
+def outside_of(run: Run) -> tuple[dict[str, int], list[str]]:
+    """The messages put on the run's keys by publishers outside the run (per key), and who they are."""
+    recorder = run.recorder.recorder if run.recorder is not None else None
+    counts = dict(recorder.outside) if recorder is not None else {}
+    part = getattr(run, "outside", None)
+    return counts, part.seen.foreign() if part is not None and counts else []
 
 
 class Part:
@@ -238,7 +263,12 @@ class RecorderPart(Part):
 
     def close(self, run: Run) -> None:
         # how the run ended, for judging the recording by itself later (`scenario check`)
-        self.recorder.end_note(ended=run.ending(), sim_ns=str(run.reached()))
+        rejected = rejected_of(run)
+        outside, outsiders = outside_of(run)
+        said = {"rejected": json.dumps(rejected)} if rejected else {}  # (key -> why -> how many)
+        if outside:  # (key -> how many, and who: the sessions outside the run)
+            said["outside"] = json.dumps({"messages": outside, "from": outsiders})
+        self.recorder.end_note(ended=run.ending(), sim_ns=str(run.reached()), **said)
         self.recorder.close()
 
 

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from runner.launch.parts import outside_of, rejected_of
 from runner.record import TopicStats
 
 if TYPE_CHECKING:
@@ -25,6 +26,8 @@ class RunResult:
     error: str | None = None
     endpoints: list[str] = field(default_factory=list)
     rejected: dict[str, dict[str, int]] = field(default_factory=dict)  # inbound samples dropped: key, why
+    outside: dict[str, int] = field(default_factory=dict)  # messages from publishers outside the run, per key
+    outsiders: list[str] = field(default_factory=list)  # those publishers' sessions, named
 
     @property
     def exit_code(self) -> int:
@@ -42,17 +45,10 @@ def result_of(run: Supervisor) -> RunResult:
     infos = [w.end_info for w in run.worlds]
     walls = [float(i["wall_s"]) for i in infos if "wall_s" in i]
     published: dict[str, int] = {}
-    rejected: dict[str, dict[str, int]] = {}
     for i in infos:
         published.update(i.get("published", {}))
-        for key, whys in i.get("rejected", {}).items():
-            for why, n in whys.items():
-                rejected.setdefault(key, {})[why] = rejected.get(key, {}).get(why, 0) + n
     recorder = run.recorder.recorder if run.recorder is not None else None
-    if recorder is not None:
-        for key, whys in recorder.mistyped.items():
-            for why, n in whys.items():
-                rejected.setdefault(key, {}).setdefault(f"not recorded: {why}", n)
+    outside, outsiders = outside_of(run)
     return RunResult(
         reason="interrupted" if run.signalled.is_set() else run.reason,  # (one that came while closing too)
         sim_ns=run.reached(),
@@ -62,5 +58,7 @@ def result_of(run: Supervisor) -> RunResult:
         published=published,
         error=run.error,
         endpoints=run.listen,
-        rejected=rejected,
+        rejected=rejected_of(run),
+        outside=outside,
+        outsiders=outsiders,
     )

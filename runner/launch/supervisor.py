@@ -38,6 +38,7 @@ import zenoh
 from runner import interrupts
 from runner.errors import RunError
 from runner.launch.announce import announce, update_announcement, withdraw
+from runner.launch.outside import OutsidePart
 from runner.launch.parts import (
     BridgePart,
     JudgePart,
@@ -92,6 +93,7 @@ class Supervisor:
         self.worlds = world_parts(plan, None)
         self.parts: list[Part] = []
         self.recorder: RecorderPart | None = None
+        self.outside: OutsidePart | None = None
         self.subs: list[Any] = []
         self.session: Any = None
         self.endpoint = connectable(self.listen[0])
@@ -131,6 +133,8 @@ class Supervisor:
             raise RunError(
                 f"cannot open the Zenoh network on {', '.join(self.listen)}: {zenoh_reason(e)}"
             ) from None
+        self.outside = OutsidePart()  # (first: it hears of every session that joins)
+        self.parts.append(self.outside)
         if self.foxglove_port is not None:
             self.parts.append(
                 LiveViewPart(self.session, plan.name, self.foxglove_port, self.foxglove_origins)

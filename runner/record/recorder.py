@@ -104,6 +104,9 @@ class Recorder:
         self.stopped_ns: int | None = None  # the sim time it stopped at (the judge's data stops there too)
         self.rejected = 0  # samples the drain thread could not record (an exception each)
         self.mistyped: dict[str, dict[str, int]] = {}  # key -> why -> samples of another type, not recorded
+        # samples without the run's (sequence, stamp) attachment, per key: every process of the run (worlds,
+        # nodes, bridges, the tools) attaches one, so these come from a publisher outside the run
+        self.outside: dict[str, int] = {}
         self._subscriber: Any = None
         self._drainer: threading.Thread | None = None
         self._taps: dict[str, Callable[[str, int, bytes], None]] = {}
@@ -178,6 +181,9 @@ class Recorder:
             return
         key = str(sample.key_expr)
         att = sample.attachment
+        raw = att.to_bytes() if att is not None else b""
+        if len(raw) != _ATT_SIZE:
+            self.outside[key] = self.outside.get(key, 0) + 1
         ch = self._channels.get(key)
         if self.types and key in self.types:
             given = type_from_encoding(sample.encoding)
@@ -191,16 +197,14 @@ class Recorder:
                 except Exception:
                     self._mistyped(key, f"payloads that do not decode as {self.types[key]}")
                     return
-        if ch is not None and att is not None:
-            raw = att.to_bytes()
-            if len(raw) == _ATT_SIZE:
-                seq, stamp = _unpack_att(raw)
-                if stamp > self.latest_ns:
-                    self.latest_ns = stamp
-                self._add(ch, seq, stamp, sample.payload.to_bytes())
-                return
+        if ch is not None and len(raw) == _ATT_SIZE:
+            seq, stamp = _unpack_att(raw)
+            if stamp > self.latest_ns:
+                self.latest_ns = stamp
+            self._add(ch, seq, stamp, sample.payload.to_bytes())
+            return
         # first sample of a key, a key not recorded, or no attachment
-        parsed = unpack_attachment(att.to_bytes()) if att is not None else None
+        parsed = unpack_attachment(raw) if att is not None else None
         if ch is None and not self.wanted(key):
             if parsed is not None:
                 self.latest_ns = max(self.latest_ns, parsed[1])

@@ -6,6 +6,7 @@ inbox of messages from other processes, delivered at the next boundary (`PubSub`
 from __future__ import annotations
 
 import queue
+import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -18,6 +19,9 @@ from runner.wire.transport import Bus, topic_key
 if TYPE_CHECKING:
     from runner.sim.links import Lockstep
 
+
+# Why an inbound message was dropped, as the end-of-run table and the recording's metadata count it
+NONFINITE = "NaN or Inf values"
 
 # A subscriber in this process: (type, callback, peek): `peek(payload)` gives what the callback reads of
 # each message this process publishes (runner.wire.cdr.Peek), or None for the whole decoded message
@@ -91,6 +95,11 @@ class PubSub:
         self._remote_subscribed: set[str] = set()
         self._inbox: queue.SimpleQueue[tuple[str, bytes, bytes | None]] = queue.SimpleQueue()
         self._received: dict[str, int] = {}  # messages from other processes, per key
+        # keys a plugin takes from other processes: a message there with a NaN or Inf anywhere is dropped
+        # before any subscriber sees it (one NaN in a command would reach MuJoCo's controls, or stay in a
+        # controller's state for good: a diff drive's integral never forgets it)
+        self._checked: set[str] = set()
+        self._nonfinite_said: set[str] = set()
 
     def make_publisher(self, key: str, type_name: str) -> Outgoing:
         out = self._out.get(key)
@@ -116,9 +125,17 @@ class PubSub:
 
         return make
 
-    def _subscriber_factory(self, namespace: str) -> Callable[[str, str, Callable[[Any, int], None]], None]:
+    def _subscriber_factory(
+        self, namespace: str, checked: bool = True
+    ) -> Callable[[str, str, Callable[[Any, int], None]], None]:
+        """`subscribe(topic, type, callback)` for a robot's plugins; `checked`: messages from other
+        processes holding a NaN or Inf are dropped (plugins), or delivered as they are (what an event
+        watches: a node's LaserScan says "no return" with +inf, REP 117)."""
+
         def subscribe(topic: str, type_name: str, callback: Callable[[Any, int], None]) -> None:
             key = topic_key(self.plan.name, namespace, topic)
+            if checked:
+                self._checked.add(key)
             # the same list as the publisher's `local`, if this process also publishes the key
             self._local.setdefault(key, []).append((msgs.normalize_type(type_name), callback, None))
             if key not in self._remote_subscribed:
@@ -137,21 +154,52 @@ class PubSub:
             lockstep.poke()
 
     def _drain_inbox(self) -> None:
+        checked = self._checked
         while True:
             try:
                 key, payload, _att = self._inbox.get_nowait()
             except queue.Empty:
                 return
+            decoded: dict[str, Any] = {}  # type -> the message, decoded once (None: dropped)
             for type_name, cb, _peek in self._local.get(key, ()):
-                try:
-                    msg = msgs.decode(payload, type_name)
-                except Exception:
-                    # not a message of the subscribed type: a foreign publisher's mistake, dropped and counted
-                    reject = getattr(self.bus, "reject", None)
-                    if reject is not None:
-                        reject(key, f"{len(payload)} bytes that do not decode as {type_name}")
-                    continue
-                cb(msg, self.now_ns)
+                if type_name in decoded:
+                    msg = decoded[type_name]
+                else:
+                    msg = decoded[type_name] = self._inbound(key, payload, type_name, key in checked)
+                if msg is not None:
+                    cb(msg, self.now_ns)
+
+    def _inbound(self, key: str, payload: bytes, type_name: str, checked: bool) -> Any:
+        """A message from another process, decoded; None (dropped, and counted by the bus) when it is not
+        of the type, or, on a key a plugin takes (`checked`), when it holds a NaN or Inf: the plugin keeps
+        its last good command."""
+        try:
+            msg = msgs.decode(payload, type_name)
+        except Exception:
+            # not a message of the subscribed type: a foreign publisher's mistake, dropped and counted
+            self._reject(key, f"{len(payload)} bytes that do not decode as {type_name}")
+            return None
+        if checked:
+            where = msgs.nonfinite(msg, type_name)
+            if where is not None:
+                if key not in self._nonfinite_said:
+                    self._nonfinite_said.add(key)
+                    value = msg
+                    for part in where:
+                        value = value[part] if isinstance(part, int) else getattr(value, part)
+                    print(
+                        f"world: {key} at t = {self.now_ns / 1e9:.3f} s: {msgs.path_text(where)} is {value}; "
+                        "the message is dropped (its subscriber keeps the last good one)",
+                        file=sys.stderr,
+                    )
+                self._reject(key, NONFINITE)
+                return None
+        return msg
+
+    def _reject(self, key: str, why: str) -> None:
+        reject = getattr(self.bus, "reject", None)
+        if reject is not None:
+            reject(key, why)
 
     def published(self) -> dict[str, int]:
         return {k: o.seq for k, o in self._out.items()}

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import gc
 import math
+import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -69,6 +70,13 @@ _UNSTABLE = (
     int(mujoco.mjtWarning.mjWARN_BADQVEL),
     int(mujoco.mjtWarning.mjWARN_BADQACC),
 )
+
+
+# MuJoCo treats a control beyond this as "huge" (mjMAXVAL, engine_util_misc.h: mju_isBad): it warns,
+# zeroes every control of the world for that step, and goes on. A finite control beyond it is clamped here
+# (an actuator with a ctrlrange is clamped by MuJoCo anyway); a NaN or Inf stops the run, naming it.
+CTRL_MAX = 1e10
+_BADCTRL = int(mujoco.mjtWarning.mjWARN_BADCTRL)
 
 
 class World(PubSub):
@@ -268,7 +276,7 @@ class World(PubSub):
             peek = Peek(type_name, fields).peek if fields else None
             self._local.setdefault(key, []).append((type_name, callback, peek))
         else:
-            self._subscriber_factory("")("/" + key.split("/", 1)[1], type_name, callback)
+            self._subscriber_factory("", checked=False)("/" + key.split("/", 1)[1], type_name, callback)
 
     def plugin_at(self, index: int) -> Plugin | None:
         return self._plugin_index.get(index)
@@ -318,9 +326,15 @@ class World(PubSub):
         next_check = wall0
         steps = 0
         warnings = [d.warning[i] for i in _UNSTABLE]
+        badctrl = d.warning[_BADCTRL]
+        ctrl, abs_ctrl, nu = d.ctrl, np.empty(m.nu), m.nu
+        self._clamped: set[int] = set()
         error = None
         while True:
             self._boundary()
+            # the hooks' controls, checked before physics takes them (a NaN fails `<=` too), in ~1 µs
+            if nu and not np.abs(ctrl, out=abs_ctrl).max() <= CTRL_MAX and (error := self._bad_controls()):
+                break
             if self.now_ns >= end_ns or self._ended is not None:
                 break
             target = self._next_boundary(end_ns)
@@ -333,7 +347,7 @@ class World(PubSub):
             else:
                 mujoco.mj_step(m, d, nstep=n)
             steps += n
-            if warnings[0].number or warnings[1].number or warnings[2].number:
+            if warnings[0].number or warnings[1].number or warnings[2].number or badctrl.number:
                 error = self._instability(self.now_ns, self.now_ns + n * self.step_ns)
                 break
             self.now_ns += n * self.step_ns
@@ -374,9 +388,45 @@ class World(PubSub):
             ended=self._ended,
         )
 
+    def _bad_controls(self) -> str | None:
+        """Controls beyond CTRL_MAX: a NaN or Inf stops the run (the error, naming the actuator, its robot
+        and the sim time), a finite one is clamped to ±CTRL_MAX (said once per actuator)."""
+        ctrl = self.data.ctrl
+        for i in np.flatnonzero(~(np.abs(ctrl) <= CTRL_MAX)).tolist():
+            value = float(ctrl[i])
+            if not math.isfinite(value):
+                return self._bad_control(i, str(value), self.now_ns)
+            ctrl[i] = math.copysign(CTRL_MAX, value)
+            if i not in self._clamped:
+                self._clamped.add(i)
+                name, robot = self._actuator(i)
+                print(
+                    f"world: actuator {name}{robot} was given a control of {value:g} at t = "
+                    f"{self.now_ns / 1e9:.3f} s: clamped to ±{CTRL_MAX:g} (MuJoCo would zero every control)",
+                    file=sys.stderr,
+                )
+        return None
+
+    def _actuator(self, i: int) -> tuple[str, str]:
+        """An actuator's name and ` of robot <name>` (empty when no robot's)."""
+        name = mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, i) or f"#{i}"
+        robot = next((r.name for r in self.plan.robots if name.startswith(r.prefix)), None)
+        return repr(name), f" of robot {robot}" if robot else ""
+
+    def _bad_control(self, i: int, value: str, now_ns: int) -> str:
+        name, robot = self._actuator(i)
+        return (
+            f"actuator {name}{robot} was given a control of {value} at t = {now_ns / 1e9:.3f} s (sim): the "
+            "physics never takes a NaN or Inf (MuJoCo would zero every control, or reset the world), so the "
+            "run stops here (the recording keeps everything before). Hint: one of the robot's plugins "
+            "computed it: check its parameters and the commands it was given"
+        )
+
     def _instability(self, t0_ns: int, t1_ns: int) -> str:
         """What went unstable, where (the joint of the degree of freedom MuJoCo names, and its robot)."""
         m, d = self.model, self.data
+        if d.warning[_BADCTRL].number:  # (the check before each step keeps controls good: not a hook's)
+            return self._bad_control(int(d.warning[_BADCTRL].lastinfo), "NaN, Inf or huge", t0_ns)
         kinds = zip(("positions", "velocities", "accelerations"), _UNSTABLE, strict=True)
         kind, i = next((k, i) for k, i in kinds if d.warning[i].number)
         dof = int(d.warning[i].lastinfo)

@@ -89,6 +89,12 @@ def intersects(a: str, b: str) -> bool:
         return False
 
 
+def member_key(run: str, zid: str) -> str:
+    """The liveliness token by which a Zenoh session says it is part of the run (its Zenoh id): the runner
+    tells a publisher outside the run by its absence."""
+    return meta_key(run, "member", zid)
+
+
 class GraphTokens:
     """The tokens of one process. Declare endpoints as they are made; `close()` (or the process's end)
     withdraws them all."""
@@ -98,6 +104,8 @@ class GraphTokens:
         self.base = f"{meta_key(run, 'graph')}/{_q(process)}/{_q(role)}"
         self._tokens: dict[str, Any] = {}
         self._declare(self.base)
+        # this session is the run's (runner.launch.outside)
+        self._declare(member_key(run, str(session.zid())))
 
     def _declare(self, key: str) -> None:
         if key not in self._tokens:

@@ -6,6 +6,7 @@ and in a ROS 2 node are the same.
 
 from __future__ import annotations
 
+import math
 from functools import cache
 from typing import Any
 
@@ -204,3 +205,60 @@ def to_data(msg: Any) -> Any:
     if isinstance(msg, list):
         return [to_data(x) for x in msg]
     return msg
+
+
+# ------------------------------------------------------------------------------------ non-finite values
+@cache
+def _float_fields(type_name: str) -> tuple[tuple[str, str, str | None], ...]:
+    """Where a type holds floating-point numbers: (field, how, nested type) for each field that is a
+    float ("f"), a message holding floats ("m"), a float array ("a") or an array of such messages ("l").
+    Empty for a type without any (a String, an Image): nothing to check."""
+    out: list[tuple[str, str, str | None]] = []
+    for name, (node, detail) in TYPESTORE.fielddefs[type_name][1]:
+        if node == Nodetype.BASE:
+            if detail[0].startswith("float"):
+                out.append((name, "f", None))
+        elif node == Nodetype.NAME:
+            if _float_fields(detail):
+                out.append((name, "m", detail))
+        else:
+            (inner_node, inner_detail), _length = detail
+            if inner_node == Nodetype.BASE:
+                if inner_detail[0].startswith("float"):
+                    out.append((name, "a", None))
+            elif inner_node == Nodetype.NAME and _float_fields(inner_detail):
+                out.append((name, "l", inner_detail))
+    return tuple(out)
+
+
+def nonfinite(msg: Any, type_name: str) -> tuple[str | int, ...] | None:
+    """The path (`("linear", "x")`, `("ranges", 3)`) of the first NaN or ±Inf in a message of `type_name`,
+    or None when every float in it is finite. Only the float fields are visited (the per-type plan is
+    cached), and a float array is one `np.isfinite`: a Twist costs ~2 µs, a String nothing."""
+    for name, how, sub in _float_fields(type_name):
+        value = getattr(msg, name)
+        if how == "f":
+            if not math.isfinite(value):
+                return (name,)
+        elif how == "m":
+            inner = nonfinite(value, sub)  # type: ignore[arg-type]
+            if inner is not None:
+                return (name, *inner)
+        elif how == "a":
+            ok = np.isfinite(value)
+            if not ok.all():
+                return (name, int(np.flatnonzero(~ok)[0]))
+        else:
+            for i, item in enumerate(value):
+                inner = nonfinite(item, sub)  # type: ignore[arg-type]
+                if inner is not None:
+                    return (name, i, *inner)
+    return None
+
+
+def path_text(path: tuple[str | int, ...]) -> str:
+    """`("ranges", 3)` -> `ranges[3]`, `("linear", "x")` -> `linear.x`."""
+    text = ""
+    for part in path:
+        text += f"[{part}]" if isinstance(part, int) else (f".{part}" if text else part)
+    return text
