@@ -250,3 +250,52 @@ def test_the_next_run_clears_stale_locks_and_empty_recordings(tmp_path: Path) ->
     finally:
         holder.communicate(input="", timeout=30)
     assert left == [".live.mcap.lock", "cut.mcap", "new.mcap"], left
+
+
+LONG = """
+name: long
+duration: 600
+rate: realtime
+robots:
+  - name: r1
+    description: {file: "{diffbot}"}
+    pose: {xyz: [0, 0, 0.06]}
+    plugins:
+      - {type: diff_drive}
+"""
+
+
+@pytest.mark.timeout(150)
+def test_a_suite_killed_outright_takes_its_runs_along(write_scenario, tmp_path: Path) -> None:
+    """kill -9 of `scenario test`: its run (a `scenario run` of its own, and that run's world, keeper and
+    guard) is stopped as Ctrl-C stops it, its recording finished; it used to run on to its end."""
+    path = write_scenario(LONG, "long.yaml")
+    out = tmp_path / "runs"
+    proc = subprocess.Popen(
+        scenario_cmd("test", str(path), "--out", str(out)),
+        cwd=tmp_path,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
+    try:
+        assert wait_recorded(out / "long.mcap", "long/clock", 5, time.monotonic() + 90), "the run did not run"
+        runs = processes_of(proc.pid, r"runner\.cli run", direct=True)
+        assert len(runs) == 1, "the suite runs its scenario"
+        procs = {p: t for p in processes_of(proc.pid, ".") if (t := _start_time(p)) is not None}
+        os.kill(proc.pid, signal.SIGKILL)
+        killed = time.monotonic()
+        left = _alive(procs)
+        while left and time.monotonic() - killed < 10.0:
+            time.sleep(0.05)
+            left = _alive(procs)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=30)
+        for pid in _alive(procs if "procs" in locals() else {}):
+            os.kill(pid, signal.SIGKILL)
+    assert not left, "alive after the suite was killed: " + "; ".join(left.values())
+    with (out / "long.mcap").open("rb") as f:  # stopped in order: its summary written by the run itself
+        summary = make_reader(f).get_summary()
+        assert summary is not None and summary.statistics.message_count > 0
