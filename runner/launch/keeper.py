@@ -29,6 +29,12 @@ left behind is ended before `scenario run` returns. Not covered: a process that 
 (`env -i`) and leaves its session (`setsid`), and the runner and the keeper both killed (then the kernel
 still ends the runner's children, but their own children are left).
 
+Why a token and not a subreaper (PR_SET_CHILD_SUBREAPER): a subreaper adopts the orphans of its own
+descendants only, so the keeper would have to be the parent of every child, taking their Popen objects
+(output pipes, exit codes, signals) away from the runner; and the runner as the subreaper loses what it
+adopted to PID 1 the moment it dies. The token reaches the same processes (an orphan keeps its
+environment) with the runner still the parent of its children.
+
 Kept to the standard library: the keeper runs this file as a script, isolated (`python -I -S`), so it
 starts in milliseconds and nothing of the package is imported there.
 """
