@@ -278,6 +278,7 @@ def test_a_suite_killed_outright_takes_its_runs_along(write_scenario, tmp_path: 
         stderr=subprocess.DEVNULL,
         start_new_session=True,
     )
+    procs: dict[int, str] = {}
     try:
         assert wait_recorded(out / "long.mcap", "long/clock", 5, time.monotonic() + 90), "the run did not run"
         runs = processes_of(proc.pid, r"runner\.cli run", direct=True)
@@ -293,7 +294,7 @@ def test_a_suite_killed_outright_takes_its_runs_along(write_scenario, tmp_path: 
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
         proc.wait(timeout=30)
-        for pid in _alive(procs if "procs" in locals() else {}):
+        for pid in _alive(procs):
             os.kill(pid, signal.SIGKILL)
     assert not left, "alive after the suite was killed: " + "; ".join(left.values())
     with (out / "long.mcap").open("rb") as f:  # stopped in order: its summary written by the run itself
