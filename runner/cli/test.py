@@ -218,7 +218,12 @@ def _run_here(
     from runner.tools.suite import run_variant
 
     record = None if no_record else out_dir / f"{variant.stem}.mcap"
-    return run_variant(variant, record, allow_undecided=allow_undecided, timeout_s=timeout)
+    # `scenario test` killed outright (kill -9, the OOM killer) stops its runs as Ctrl-C does: they would
+    # live on (each run's own processes end with it, runner.launch.keeper). The pool's threads, which
+    # start the runs, live until every run is over: the signal is tied to the thread that started a run.
+    return run_variant(
+        variant, record, allow_undecided=allow_undecided, timeout_s=timeout, die_with_parent=True
+    )
 
 
 def _write_reports(suites: list[Any]) -> dict[str, str]:

@@ -14,6 +14,7 @@ from collections.abc import Sequence
 import zenoh
 
 from runner.errors import RunError
+from runner.launch.keeper import Keeper
 from runner.launch.nodes import NodeError, Nodes
 from runner.launch.result import RunResult
 from runner.launch.worlds import connectable, world_parts
@@ -35,6 +36,7 @@ def run_member(
         session = zenoh.open(make_config("router", listen=listen, connect=connect))
     except zenoh.ZError as e:
         raise RunError(f"cannot open the Zenoh network on {', '.join(listen)}: {zenoh_reason(e)}") from None
+    keeper = Keeper()  # every process started here ends with this runner, however it ends
     parts = world_parts(plan, host)
     subs = [session.declare_subscriber(meta_key(p.plan.name, "**"), p.on_meta) for p in parts]
     subs.append(session.liveliness().declare_token(member_key(plan.name, str(session.zid()))))  # (the run's)
@@ -88,6 +90,7 @@ def run_member(
             with contextlib.suppress(Exception):
                 sub.undeclare()
         session.close()
+        keeper.close()
     infos = [p.end_info for p in parts]
     return RunResult(
         reason=reason if error is None or reason != "completed" else "failed",

@@ -18,6 +18,7 @@ import threading
 import time
 from typing import Any
 
+from runner.launch import keeper
 from runner.plan import NodePlan, RunPlan
 
 STOP_GRACE_S = 3.0
@@ -83,10 +84,13 @@ class NodeProcess:
                 stdout=subprocess.PIPE,
                 stderr=subprocess.STDOUT,
                 start_new_session=True,  # Ctrl-C reaches the runner only; it stops the nodes in order
+                # ...and a runner killed outright takes them along (runner.launch.keeper)
+                preexec_fn=keeper.dies_with_runner(signal.SIGTERM),
             )
         except OSError as e:
             what = f"node {self.plan.name!r} cannot start {self.plan.argv[0]!r}"
             raise NodeError(f"{what}: {e.strerror}") from None
+        keeper.watch(self.proc.pid)
         self.output = OutputTail(self.proc.stdout, f"[{self.plan.name}] ")
         self.output.start()
 

@@ -19,9 +19,11 @@ from typing import TYPE_CHECKING, Any, Protocol
 import zenoh
 
 from runner.errors import RunError
+from runner.launch import keeper
 from runner.launch.nodes import NodeError, Nodes
 from runner.plan import NodePlan, RunPlan
 from runner.record import Recorder
+from runner.record.claim import lock_of
 from runner.wire import msgs
 from runner.wire.graph import GraphTokens
 from runner.wire.transport import meta_key, unpack_attachment
@@ -224,6 +226,10 @@ class RecorderPart(Part):
             )
         except OSError as e:
             raise RunError(f"cannot write the recording {plan.record.path}: {e.strerror or e}") from None
+        if self.recorder.guard_pid is not None:
+            # the one process left to end by itself (it finishes the file of a runner killed outright);
+            # then its lock, if the guard was killed too
+            keeper.wait_for(self.recorder.guard_pid, lock_of(self.recorder.path))
 
     def start(self, run: Run) -> None:
         plan, recorder = run.plan, self.recorder

@@ -13,7 +13,12 @@
 - STOPPING: the worlds (and their renderers) stop; how each ended is collected -> DRAINING.
 - DRAINING: the recorder waits for every message the worlds say they published -> DONE.
 - DONE: the nodes stop, subscribers and the session close, the recording is finished with a note of how
-  the run ended. Always reached, whatever happened before (an error escaping a step included).
+  the run ended. Always reached, whatever happened before (an error escaping a step included). Last, the
+  run's keeper (runner.launch.keeper) ends whatever the parts left behind (a node's own children).
+
+Every process the run starts ends with the runner however the runner ends (kill -9, the OOM killer, a CI
+job's timeout killing its process group): the kernel signals each child when the runner dies, and the
+keeper, a process started first in a session of its own, ends their children (runner.launch.keeper).
 
 Signals never raise inside the supervisor: SIGINT/SIGTERM set a flag the loop reads at its next tick (any
 state), so nothing is cut half-way (a recording being closed, a process being started). A second signal
@@ -38,6 +43,7 @@ import zenoh
 from runner import interrupts
 from runner.errors import RunError
 from runner.launch.announce import announce, update_announcement, withdraw
+from runner.launch.keeper import Keeper
 from runner.launch.outside import OutsidePart
 from runner.launch.parts import (
     BridgePart,
@@ -111,6 +117,8 @@ class Supervisor:
         """Start, run, stop, drain, finish; a RunError of a step is raised after everything is closed."""
         with self._signals():
             self.trace(self.state)
+            # first: every process started after it ends with the run, however the runner ends
+            keeper = Keeper()
             try:
                 self._start()
                 self._supervise()
@@ -123,7 +131,10 @@ class Supervisor:
                 self._stop_quietly()
                 raise
             finally:
-                self._close()
+                try:
+                    self._close()
+                finally:
+                    keeper.close()  # (last: what the parts left behind, a node's own children, ends)
 
     def _start(self) -> None:
         plan = self.plan

@@ -22,6 +22,7 @@ from typing import Any
 import zenoh
 
 from runner.errors import RunError
+from runner.launch import keeper
 from runner.launch.nodes import OutputTail
 from runner.plan import RunPlan
 from runner.wire.transport import meta_key
@@ -82,14 +83,27 @@ class WorldPart:
             # cameras render in a process of their own, fed the world's state (runner/sim/render.py)
             rcmd = [sys.executable, "-m", "runner.sim.render", self.plan_file, "--connect", endpoint]
             self.renderer = subprocess.Popen(
-                rcmd, stderr=subprocess.PIPE, start_new_session=True, env=world_env(plan)
+                rcmd,
+                stderr=subprocess.PIPE,
+                start_new_session=True,
+                env=world_env(plan),
+                preexec_fn=keeper.dies_with_runner(signal.SIGKILL),
             )
+            keeper.watch(self.renderer.pid)
             self.rtail = OutputTail(self.renderer.stderr, f"[{self.label.replace('world', 'render')}] ")
             self.rtail.start()
         env = dict(os.environ) if renders_apart else world_env(plan)
         cmd = [sys.executable, "-m", "runner.sim", self.plan_file, "--connect", endpoint]
-        # A session of its own: a terminal's Ctrl-C reaches only us, and we stop the world in order.
-        self.child = subprocess.Popen(cmd, stderr=subprocess.PIPE, start_new_session=True, env=env)
+        # A session of its own: a terminal's Ctrl-C reaches only us, and we stop the world in order. Killed
+        # outright, we take it along (runner.launch.keeper): what it would publish could not be recorded.
+        self.child = subprocess.Popen(
+            cmd,
+            stderr=subprocess.PIPE,
+            start_new_session=True,
+            env=env,
+            preexec_fn=keeper.dies_with_runner(signal.SIGKILL),
+        )
+        keeper.watch(self.child.pid)
         self.tail = OutputTail(self.child.stderr, f"[{self.label}] ")
         self.tail.start()
 

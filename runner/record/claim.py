@@ -1,11 +1,27 @@
 """Who records where: a recording's claim is a lock on a hidden `.<name>.lock` beside it, held by the
 run recording it (and then by its guard, `runner.record.finisher`) until the file is complete.
+
+The lock is a `flock`, which the kernel drops when its holders are gone, however they ended; the file it
+is on stays behind when the run and its guard were both killed. Such stale lock files are removed by the
+run's keeper (runner.launch.keeper) or, failing that, by the next run that records in the same folder,
+together with a recording beside one that holds nothing (a run that could not write its first bytes: a
+full disk). A lock file is only ever removed by whoever holds its lock, and `claim` checks, once it holds
+one, that the name is still its file, so a claim never rests on a removed file.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 from pathlib import Path
+
+# a recording shorter than the MCAP magic and one record's head holds nothing (runner.launch.keeper too)
+EMPTY_BELOW = 8 + 9
+
+
+def lock_of(path: Path) -> Path:
+    """The lock file of the recording `path`."""
+    return path.with_name(f".{path.name}.lock")
 
 
 def recording_live(path: Path) -> bool:
@@ -13,7 +29,7 @@ def recording_live(path: Path) -> bool:
     import fcntl
 
     try:
-        fd = os.open(path.with_name(f".{path.name}.lock"), os.O_RDONLY)
+        fd = os.open(lock_of(path), os.O_RDONLY)
     except OSError:
         return False
     try:
@@ -28,17 +44,64 @@ def recording_live(path: Path) -> bool:
 def claim(path: Path) -> tuple[Path, int]:
     """The recording path this run may write, and the descriptor that holds it: a lock on a hidden
     `.<name>.lock` beside it (released when the process ends, however it ends). A path another live run
-    is recording to is not touched: the next free `<stem>-2.mcap`, `-3`... is taken instead."""
+    is recording to is not touched: the next free `<stem>-2.mcap`, `-3`... is taken instead. Stale lock
+    files in the folder (their runs gone) are removed first (see `clear_stale`)."""
     import fcntl
 
-    for n in range(1, 1000):
+    clear_stale(path.parent)
+    n = 1
+    while n < 1000:
         candidate = path if n == 1 else path.with_name(f"{path.stem}-{n}{path.suffix}")
-        lock = candidate.with_name(f".{candidate.name}.lock")
+        lock = lock_of(candidate)
         fd = os.open(lock, os.O_WRONLY | os.O_CREAT, 0o600)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
             os.close(fd)
+            n += 1
+            continue
+        if not _still_named(lock, fd):  # removed (stale) between our open and our lock: open it again
+            os.close(fd)
             continue
         return candidate, fd
     raise OSError(f"a thousand runs are recording beside {path}")
+
+
+def clear_stale(folder: Path) -> list[Path]:
+    """Remove the lock files in `folder` nobody holds (their runs and guards gone), and the recording
+    beside each if it holds nothing; what was removed."""
+    import fcntl
+
+    removed: list[Path] = []
+    try:
+        locks = [p for p in folder.iterdir() if p.name.startswith(".") and p.name.endswith(".lock")]
+    except OSError:  # (no folder yet: nothing stale in it)
+        return removed
+    for lock in locks:
+        try:
+            fd = os.open(lock, os.O_RDONLY)
+        except OSError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            if not _still_named(lock, fd):
+                continue
+            recording = lock.with_name(lock.name[1 : -len(".lock")])
+            with contextlib.suppress(OSError):
+                if recording.stat().st_size < EMPTY_BELOW:
+                    recording.unlink()
+                    removed.append(recording)
+            lock.unlink()
+            removed.append(lock)
+        except OSError:  # held: a live run's (or gone meanwhile)
+            continue
+        finally:
+            os.close(fd)
+    return removed
+
+
+def _still_named(lock: Path, fd: int) -> bool:
+    try:
+        return os.stat(lock).st_ino == os.fstat(fd).st_ino
+    except OSError:
+        return False

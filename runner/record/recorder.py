@@ -30,7 +30,7 @@ from typing import IO, Any
 
 import zenoh
 
-from runner.record.claim import claim
+from runner.record.claim import claim, lock_of
 from runner.record.finisher import Guard
 from runner.record.mcap_file import CHUNK_SIZE, McapFile, RecordedChannel, TopicStats
 from runner.wire import msgs
@@ -79,18 +79,23 @@ class Recorder:
         # the path the plan gave; `path` is the one recorded to (see `runner.record.claim`)
         self.asked = self.path
         self.path, self._claim_fd = claim(self.path)
-        # unbuffered: whole chunks are written at once, and a failed write (a full disk) leaves no buffer
-        # behind that a later flush would write past the point the file is cut back to
-        self._file: IO[bytes] = open(self.path, "wb", buffering=0)  # noqa: SIM115 - closed in close()
-        self._guard = Guard(self.path, self._claim_fd) if self.guarded else None
-        self._mcap = McapFile(
-            self._file,
-            profile="ros2",
-            library=self.library,
-            chunk_size=self.chunk_size,
-            guard=self._guard,
-            compression=self.compression,
-        )
+        self._guard: Guard | None = None
+        try:
+            # unbuffered: whole chunks are written at once, and a failed write (a full disk) leaves no
+            # buffer behind that a later flush would write past the point the file is cut back to
+            self._file: IO[bytes] = open(self.path, "wb", buffering=0)  # noqa: SIM115 - closed in close()
+            self._guard = Guard(self.path, self._claim_fd) if self.guarded else None
+            self._mcap = McapFile(
+                self._file,
+                profile="ros2",
+                library=self.library,
+                chunk_size=self.chunk_size,
+                guard=self._guard,
+                compression=self.compression,
+            )
+        except BaseException:
+            self._give_up()
+            raise
         self._lock = threading.Lock()
         self._schemas: dict[str, int] = {}
         self._channels: dict[str, RecordedChannel] = {}
@@ -350,8 +355,29 @@ class Recorder:
                 if self._guard is not None:
                     self._guard.done()
                 with contextlib.suppress(OSError):  # the path is free for the next run
-                    self.path.with_name(f".{self.path.name}.lock").unlink()
+                    lock_of(self.path).unlink()
                     os.close(self._claim_fd)
+
+    def _give_up(self) -> None:
+        """The recording could not even begin (a full disk): nothing of it is left, neither the file (it
+        holds nothing) nor its lock."""
+        if hasattr(self, "_file"):  # (only a file this run created is removed)
+            with contextlib.suppress(OSError):
+                self._file.close()
+            with contextlib.suppress(OSError):
+                self.path.unlink()
+        if self._guard is not None:
+            self._guard.done()
+        with contextlib.suppress(OSError):  # removed while held, then given up (runner.record.claim)
+            lock_of(self.path).unlink()
+        with contextlib.suppress(OSError):
+            os.close(self._claim_fd)
+
+    @property
+    def guard_pid(self) -> int | None:
+        """The pid of the recording's guard process (None: unguarded)."""
+        proc = self._guard.proc if self._guard is not None else None
+        return proc.pid if proc is not None else None
 
 
 def foxglove_schema(type_name: str) -> Any:
