@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from tests.conftest import processes_of, run_cli, scenario_cmd
+from tests.conftest import processes_of, run_cli, scenario_cmd, wait_recorded
 
 SCENE = """
 name: cams
@@ -90,7 +90,8 @@ def test_a_renderer_that_dies_fails_the_run_and_keeps_the_recording(write_scenar
             pids = processes_of(proc.pid, "runner.sim.render")  # this run's, not another suite's
             renderer = pids[0] if pids else None
         assert renderer is not None, "no renderer process"
-        time.sleep(1.5)  # some frames first
+        # some frames recorded first (waited for, not slept: under load 1.5 s once gave none)
+        assert wait_recorded(mcap, "cams/r1/camera/image_raw", 1, time.monotonic() + 60), "no frame recorded"
         os.kill(renderer, signal.SIGKILL)
         _out, err = proc.communicate(timeout=30)
     finally:

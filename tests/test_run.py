@@ -250,7 +250,9 @@ def test_a_dead_world_process_fails_the_run_and_keeps_the_recording(tmp_path: Pa
             proc.kill()
     assert proc.returncode == 1
     assert "world process exited with code -9" in err
-    assert ended - killed < 1.0, ended - killed  # noticed, reported, recording finished: within a second
+    # noticed, reported, recording finished and the interpreter gone: ~0.6-0.9 s on a quiet 2-core machine,
+    # up to 1.6 s beside other suites; a runner that waited on a timeout instead of the exit takes 5 s+
+    assert ended - killed < 3.0, ended - killed
     assert "Traceback" not in err
     assert "failed" in out
     assert any(topic == "two_robots/r1/scan" for topic, _, _, _ in read_mcap(mcap))
