@@ -17,7 +17,7 @@ import mujoco
 
 from runner.compile.nodes import declared_topics
 from runner.compile.timeline import message_of
-from runner.errors import Problem, Problems, ScenarioError
+from runner.errors import Problem, Problems, ScenarioError, closest, did_you_mean
 from runner.geometry import rpy_to_quat
 from runner.plan import ActorPlan, EventPlan, RobotPlan
 from runner.plugin.registry import load
@@ -81,7 +81,8 @@ class _World:
             where,
             expected=_choices(self.bodies(), "robots, actors or models"),
             found=name,
-            hint="a name of `robots:`, `world.actors` or `world.models` (or a body of the world file)",
+            hint=(f"did you mean {near!r}? " if (near := closest(name, self.bodies())) else "")
+            + "a name of `robots:`, `world.actors` or `world.models` (or a body of the world file)",
         )
 
     def problem(self, message: str, where: PathKey, **kw: Any) -> ScenarioError:
@@ -94,7 +95,8 @@ class _World:
                     f"no region named {value!r}",
                     where,
                     expected=_choices(set(self.sc.regions), "regions (`regions:`)"),
-                    hint="name it under `regions:` or give it here: {min: [x, y], max: [x, y]}",
+                    hint=(f"did you mean {near!r}? " if (near := closest(value, self.sc.regions)) else "")
+                    + "name it under `regions:` or give it here: {min: [x, y], max: [x, y]}",
                 )
             value = self.sc.regions[value]
         return value.model_dump(exclude_none=True)  # type: ignore[no-any-return]
@@ -114,6 +116,8 @@ class _World:
         )
         if published and key in self.heard:
             hint = "a node publishes it: the world can put a fault only on what it publishes itself"
+        elif (near := closest(topic.strip("/"), names)) is not None:
+            hint = f"did you mean {near!r}?"
         raise self.problem(
             f"no topic {topic!r} that {what}",
             where,
@@ -215,6 +219,7 @@ def _when(w: _World, ev: Event, here: PathKey, names: list[str]) -> dict[str, An
                 f"no event named {when.after.event!r}",
                 (*at, "event"),
                 expected=_choices([n for n in names if n != ev.name], "other events"),
+                hint=did_you_mean(when.after.event, [n for n in names if n != ev.name], "other events"),
             )
         if when.after.event == ev.name:
             raise w.problem("an event cannot follow itself", (*at, "event"), hint="use `repeat: true`")
@@ -223,7 +228,10 @@ def _when(w: _World, ev: Event, here: PathKey, names: list[str]) -> dict[str, An
     name = when.assertion.assertion
     if name not in w.assertions:
         raise w.problem(
-            f"no assertion named {name!r}", (*at, "assertion"), expected=_choices(w.assertions, "assertions")
+            f"no assertion named {name!r}",
+            (*at, "assertion"),
+            expected=_choices(w.assertions, "assertions"),
+            hint=did_you_mean(name, w.assertions, "assertions"),
         )
     return {
         "kind": "assertion",
@@ -268,7 +276,10 @@ def _action(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
         names = [a.name for a in w.actors]
         if name not in names:
             raise w.problem(
-                f"no actor named {name!r}", at, expected=_choices(names, "actors (`world.actors`)")
+                f"no actor named {name!r}",
+                at,
+                expected=_choices(names, "actors (`world.actors`)"),
+                hint=did_you_mean(name, names, "actors (`world.actors`)"),
             )
         return {"kind": kind, "actor": names.index(name), "name": name}
     if act.teleport is not None:
@@ -336,7 +347,12 @@ def _set_param(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
     assert s is not None
     robots = [r.name for r in w.robots]
     if s.robot not in robots:
-        raise w.problem(f"no robot named {s.robot!r}", (*at, "robot"), expected=_choices(robots, "robots"))
+        raise w.problem(
+            f"no robot named {s.robot!r}",
+            (*at, "robot"),
+            expected=_choices(robots, "robots"),
+            hint=did_you_mean(s.robot, robots, "robots"),
+        )
     index = sum(len(r.plugins) for r in w.robots[: robots.index(s.robot)])
     robot = w.robots[robots.index(s.robot)]
     plugins = [p.name for p in robot.plugins]
@@ -345,6 +361,7 @@ def _set_param(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
             f"robot {s.robot!r} has no plugin named {s.plugin!r}",
             (*at, "plugin"),
             expected=_choices(plugins, "plugins"),
+            hint=did_you_mean(s.plugin, plugins, f"plugins of {s.robot!r}"),
         )
     pp = robot.plugins[plugins.index(s.plugin)]
     cls = load(pp.type)
@@ -363,7 +380,12 @@ def _set_param(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
         cls.Params.model_validate({**pp.params, s.param: s.value})
     except ValidationError as e:
         first = e.errors()[0]
-        raise w.problem(f"{s.param}: {first['msg']}", (*at, "value"), found=repr(s.value)) from None
+        raise w.problem(
+            f"{s.param}: {first['msg']}",
+            (*at, "value"),
+            found=repr(s.value),
+            hint=f"give a value the {pp.type} plugin's `{s.param}` takes, as in its `params:`",
+        ) from None
     return {
         "kind": "set",
         "plugin": index + plugins.index(s.plugin),
@@ -381,7 +403,9 @@ def _check_noise_fields(w: _World, fields: list[str], type_name: str, where: Pat
             check_fields(compile_expr(f"{name} == {name}"), type_name)
         except ExprError as e:
             raise w.problem(
-                f"{type_name} has no field {name!r}: {getattr(e, 'message', e)}", (*where, k)
+                f"{type_name} has no field {name!r}: {getattr(e, 'message', e)}",
+                (*where, k),
+                hint=e.hint or "a field path of the message, such as pose.pose.position.x",
             ) from None
 
 
@@ -392,13 +416,17 @@ def _joint(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
     robot = robots.get(ref.robot)
     if robot is None:
         raise w.problem(
-            f"no robot named {ref.robot!r}", (*at, "robot"), expected=_choices(set(robots), "robots")
+            f"no robot named {ref.robot!r}",
+            (*at, "robot"),
+            expected=_choices(set(robots), "robots"),
+            hint=did_you_mean(ref.robot, robots, "robots"),
         )
     if ref.joint not in robot.joints:
         raise w.problem(
             f"robot {ref.robot!r} has no joint {ref.joint!r}",
             (*at, "joint"),
             expected=_choices(robot.joints, "joints"),
+            hint=did_you_mean(ref.joint, robot.joints, f"joints of {ref.robot!r}"),
         )
     name = f"{robot.prefix}{ref.joint}"
     jid = mujoco.mj_name2id(w.model, mujoco.mjtObj.mjOBJ_JOINT, name)

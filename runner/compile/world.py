@@ -20,7 +20,7 @@ from runner.compile.sanity import check_start_overlaps
 from runner.compile.sdf import load_sdf_world
 from runner.compile.timeline import compile_timeline
 from runner.compile.wheels import check_geometry
-from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError
+from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError, missing_file_hint
 from runner.geometry import rpy_to_quat
 from runner.plan import NodePlan, RecordPlan, RobotPlan, RunPlan
 from runner.scenario.loader import Document, PathKey
@@ -275,6 +275,9 @@ def _load_sdf(
                 ("world", "sdf"),
                 expected="an SDF or .world file (relative to the scenario's folder)",
                 found=str(path),
+                hint=missing_file_hint(path)
+                if not path.is_dir()
+                else "name the .sdf or .world file in it: world: {sdf: <folder>/<file>.world}",
             )
         )
     try:

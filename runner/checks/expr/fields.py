@@ -137,7 +137,12 @@ def check_fields(expr: Expr, type_name: str, condition: bool = True) -> None:
 
     type_name = normalize_type(type_name)
     if type_name not in TYPESTORE.fielddefs:
-        raise ExprError(f"unknown message type {type_name!r}", None, None, expr.text)
+        raise ExprError(
+            f"unknown message type {type_name!r}",
+            None,
+            "give a ROS 2 type such as nav_msgs/msg/Odometry",
+            expr.text,
+        )
 
     def fail(message: str, column: int | None, hint: str | None = None) -> None:
         raise ExprError(message, column, hint, expr.text)
@@ -158,7 +163,7 @@ def check_fields(expr: Expr, type_name: str, condition: bool = True) -> None:
                             f"'{shown + '.' if shown else ''}{seg}': {where} has no field {seg!r}; "
                             f"fields: {', '.join(names)}",
                             col,
-                            did_you_mean(seg, names),
+                            did_you_mean(seg, names) or "use one of the fields listed",
                         )
                     cur = dict(fields)[seg]
                 elif node in (Nodetype.ARRAY, Nodetype.SEQUENCE):
@@ -168,32 +173,53 @@ def check_fields(expr: Expr, type_name: str, condition: bool = True) -> None:
                         f"index it ({shown}[0]) or reduce it ({shown}.min())",
                     )
                 else:
-                    fail(f"'{shown}' is {_describe_type(cur)}; it has no field {seg!r}", col)
+                    fail(
+                        f"'{shown}' is {_describe_type(cur)}; it has no field {seg!r}",
+                        col,
+                        f"compare '{shown}' itself",
+                    )
                 shown = f"{shown}.{seg}" if shown else seg
             else:
                 if node in (Nodetype.ARRAY, Nodetype.SEQUENCE):
                     inner, length = detail
                     if node == Nodetype.ARRAY and not -length <= seg < length:
-                        fail(f"index {seg} is out of range: '{shown}' is {_describe_type(cur)}", col)
+                        fail(
+                            f"index {seg} is out of range: '{shown}' is {_describe_type(cur)}",
+                            col,
+                            f"indexes go from 0 to {length - 1} (or -1 for the last)",
+                        )
                     cur = inner
                 elif node == Nodetype.BASE and detail[0] in ("string", "wstring"):
                     pass  # a character of a string
                 else:
-                    fail(f"'{shown}' cannot be indexed; it is {_describe_type(cur)}", col)
+                    fail(
+                        f"'{shown}' cannot be indexed; it is {_describe_type(cur)}",
+                        col,
+                        "only arrays, sequences and strings take [i]",
+                    )
                 shown = f"{shown}[{seg}]"
         node, detail = cur
         kind = _kind_of_type(cur)
         if p.use == "len":
             if kind not in ("numseq", "seq", "str"):
-                fail(f"len() needs a sequence or a string; '{shown}' is {_describe_type(cur)}", p.column)
+                fail(
+                    f"len() needs a sequence or a string; '{shown}' is {_describe_type(cur)}",
+                    p.column,
+                    "len() counts the items of a sequence field, such as ranges",
+                )
         elif p.use in REDUCERS:
             if kind != "numseq":
-                fail(f"{p.use}() needs a sequence of numbers; '{shown}' is {_describe_type(cur)}", p.column)
+                fail(
+                    f"{p.use}() needs a sequence of numbers; '{shown}' is {_describe_type(cur)}",
+                    p.column,
+                    f"{p.use}() reduces a sequence field of numbers, such as ranges.{p.use}()",
+                )
         elif kind == "msg":
             names = [f[0] for f in TYPESTORE.fielddefs[detail][1]]
             fail(
                 f"'{shown}' is {_describe_type(cur)}, not a value; use one of its fields: {', '.join(names)}",
                 p.column,
+                f"e.g. {shown}.{names[0]}" if names else None,
             )
         kinds[id(p.node)] = kind
     kind = _infer(expr, expr._tree.body, kinds)

@@ -272,14 +272,21 @@ class Reader:
         path = path.resolve()
         if not path.is_file():
             if asked_by:
-                raise self.error(f"SDF file {str(path)!r} not found", asked_by[0], asked_by[1])
+                raise self.error(
+                    f"SDF file {str(path)!r} not found",
+                    asked_by[0],
+                    asked_by[1],
+                    hint="relative paths are resolved from the file that names it",
+                )
             raise SdfError(
                 f"SDF file {str(path)!r} not found", path, hint="paths are relative to the scenario"
             )
         try:
             data = _xml_bytes(path)
         except OSError as e:
-            raise SdfError(f"cannot read {str(path)!r}: {e.strerror or e}", path) from None
+            raise SdfError(
+                f"cannot read {str(path)!r}: {e.strerror or e}", path, hint="check the file's permissions"
+            ) from None
         parser = etree.XMLParser(
             remove_comments=True, remove_pis=True, resolve_entities=False, no_network=True
         )
