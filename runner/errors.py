@@ -47,7 +47,10 @@ def missing_file_hint(path: Path, relative_to: str = "the scenario's folder") ->
         missing = folder
         while not missing.parent.is_dir() and missing != missing.parent:
             missing = missing.parent
-        return f"the folder {str(missing)!r} does not exist; paths are relative to {relative_to}"
+        return (
+            f"paths are relative to {relative_to}, and it has no folder {missing.name!r} "
+            f"(in {str(missing.parent)!r})"
+        )
     try:
         entries = [p.name for _, p in zip(range(5000), folder.iterdir(), strict=False)]
     except OSError:
@@ -55,7 +58,7 @@ def missing_file_hint(path: Path, relative_to: str = "the scenario's folder") ->
     near = closest(path.name, entries)
     if near is not None:
         return f"did you mean {near!r}? (in {str(folder)!r})"
-    return f"no such file in {str(folder)!r}; paths are relative to {relative_to}"
+    return f"paths are relative to {relative_to}; {str(folder)!r} has no file of a name close to it"
 
 
 @dataclass(frozen=True)

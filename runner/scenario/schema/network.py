@@ -41,8 +41,12 @@ def endpoint_error(value: str, listen: bool) -> str | None:
         return None
     address = re.split(r"[?#]", rest, maxsplit=1)[0]
     host, colon, port = address.rpartition(":")
+    if address.endswith("]"):  # an IPv6 address without its port
+        host, colon, port = address, "", ""
     if not colon or not host or host == "[":
-        return f"no address and port: write {proto}/<address>:<port>, e.g. {proto}/127.0.0.1:7447"
+        if not colon:
+            return f"no port: write {proto}/<address>:<port>, e.g. {proto}/{address or '127.0.0.1'}:7447"
+        return f"no address: write {proto}/<address>:<port>, e.g. {proto}/127.0.0.1:{port or 7447}"
     if not port.isdigit():
         return f"the port {port!r} is not a number: write a port from 1 to 65535, e.g. {proto}/{host}:7447"
     low = 0 if listen else 1
@@ -155,7 +159,10 @@ class Resources(Strict):
     def _not_builtin(cls, v: dict[str, float]) -> dict[str, float]:
         for name in v:
             if name in ("CPU", "GPU", "memory", "object_store_memory"):
-                raise ValueError(f"custom.{name}: say it with num_cpus / num_gpus, not as a custom resource")
+                fix = {"GPU": "`num_gpus: 1`", "CPU": "`num_cpus: 2`"}.get(name, "num_cpus / num_gpus only")
+                raise ValueError(
+                    f"custom.{name}: say it with num_cpus / num_gpus, not as a custom resource: write {fix}"
+                )
         return v
 
 
@@ -262,7 +269,10 @@ class Bridge(Strict):
     @model_validator(mode="after")
     def _one_source(self) -> Bridge:
         if (self.topic is None) == (self.file is None):
-            raise ValueError("a bridge has either `topic:` (one mapping) or `file:` (a ros_gz_bridge file)")
+            raise ValueError(
+                "a bridge has either `topic:` (one mapping) or `file:` (a ros_gz_bridge file): "
+                "write one of them, in a bridge of its own"
+            )
         if self.file is not None:
             extra = [f for f in ("key", "ros_topic", "type") if getattr(self, f) is not None]
             if extra:
