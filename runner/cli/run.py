@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -137,7 +138,8 @@ def run(
     parsed_rate = _parse_rate(rate)
     _check_endpoints(listen, connect)
     try:
-        plans = load_variants(file, record, variant)
+        # (with --no-record, the scenario's record.path is not checked: nothing is written there)
+        plans = load_variants(file, os.devnull if no_record else record, variant)
     except ScenarioError as e:
         raise fail(e) from None
     options = RunOptions(

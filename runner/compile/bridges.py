@@ -282,14 +282,8 @@ def _one(
         return []
     if type_name is None:
         at = (*where, "type")
-        problems.append(
-            Problem(
-                "the topic's type is not known here; give it",
-                doc.locate(at),
-                at,
-                hint="add `type:` with the topic's ROS 2 type, e.g. geometry_msgs/msg/Twist",
-            )
-        )
+        hint = "add `type:` with the topic's ROS 2 type, e.g. geometry_msgs/msg/Twist"
+        problems.append(Problem("the topic's type is not known here; give it", doc.locate(at), at, hint=hint))
         return []
     rel = key[len(topics.run) + 1 :]
     common = {"where": _where(doc, where), "sim_key": key, "type": type_name, "direction": b.direction}
@@ -297,16 +291,11 @@ def _one(
     if ros2 is not None:
         if b.encoding != "cdr":
             at = (*where, "encoding")
-            problems.append(
-                Problem(
-                    "ROS 2 speaks CDR",
-                    doc.locate(at),
-                    at,
-                    expected="cdr",
-                    found=b.encoding,
-                    hint="remove `encoding:` (or set it to cdr) on a bridge to ROS 2",
-                )
+            hint = "remove `encoding:` (or set it to cdr) on a bridge to ROS 2"
+            problem = Problem(
+                "ROS 2 speaks CDR", doc.locate(at), at, expected="cdr", found=b.encoding, hint=hint
             )
+            problems.append(problem)
             return []
         return [BridgePlan(**common, ros_topic=_qualify(b.ros_topic or rel, None), ros2=ros2)]
     other = (b.key or rel).strip("/")
@@ -323,13 +312,9 @@ def _key_ok(
     try:
         expr = zenoh.KeyExpr(other)
     except Exception as e:
+        hint = "chunks separated by '/', no empty chunk, no leading or trailing '/'"
         problems.append(
-            Problem(
-                f"{other!r} is not a Zenoh key expression: {e}",
-                doc.locate(at),
-                at,
-                hint="chunks separated by '/', no empty chunk, no leading or trailing '/'",
-            )
+            Problem(f"{other!r} is not a Zenoh key expression: {e}", doc.locate(at), at, hint=hint)
         )
         return False
     if expr.intersects(zenoh.KeyExpr(f"{run}/**")) or other == run:
@@ -414,6 +399,18 @@ class _FileEntry(NamedTuple):
     lazy: bool
 
 
+# What to do, for the mistakes of a ros_gz_bridge file entry that are always said the same way
+_FILE_HINTS = {
+    "an entry is a mapping": "give the entry's keys under its `- `, one per line",
+    "services are not bridged (topics only)": "remove the entry; a node of the scenario can serve it instead",
+    "topic_name names both sides": "drop ros_topic_name/gz_topic_name, or topic_name",
+    "an entry names its topic": "add `topic_name:` when both sides use the same name",
+    "ros_type_name is missing": "add `ros_type_name:`",
+    "gz_type_name is missing": "add `gz_type_name:`",
+    "lazy is true or false": "write `lazy: true` or `lazy: false`",
+    "a Gazebo type is gz.msgs.<Name>": "write gz.msgs.<Name>, e.g. gz.msgs.LaserScan",
+}
+_DIRECTIONS_TEXT = "GZ_TO_ROS, ROS_TO_GZ or BIDIRECTIONAL"
 _Report = Callable[..., None]  # problem(message, key=None, **Problem's keywords) at an entry (and key)
 
 
@@ -431,6 +428,7 @@ def _file_entry(
 
     def problem(message: str, key: str | None = None, **kw: Any) -> None:
         at: PathKey = (j, key) if key else (j,)
+        kw.setdefault("hint", _FILE_HINTS.get(message, "see ros_gz_bridge's configuration file format"))
         problems.append(Problem(message, fdoc.locate(at), at, **kw))
 
     fields = _entry_fields(entry, problem, problems)
@@ -469,18 +467,10 @@ def _entry_fields(entry: Any, problem: _Report, problems: list[Problem]) -> _Fil
     """An entry's keys known, its topic named (`topic_name`, or both sides'), both types, its direction and
     `lazy` of the right form; None when any is not (each reported)."""
     if not isinstance(entry, dict):
-        problem(
-            "an entry is a mapping",
-            expected="ros_topic_name, gz_topic_name, ros_type_name, ...",
-            hint="give the entry's keys under its `- `, one per line",
-        )
+        problem("an entry is a mapping", expected="ros_topic_name, gz_topic_name, ros_type_name, ...")
         return None
     if "service_name" in entry:
-        problem(
-            "services are not bridged (topics only)",
-            "service_name",
-            hint="remove the entry; a node of the scenario can serve it instead",
-        )
+        problem("services are not bridged (topics only)", "service_name")
         return None
     n = len(problems)
     for k in entry:
@@ -498,47 +488,31 @@ def _entry_fields(entry: Any, problem: _Report, problems: list[Problem]) -> _Fil
     ros_name = entry.get("ros_topic_name")
     if "topic_name" in entry:
         if ros_name is not None or gz_name is not None:
-            problem(
-                "topic_name names both sides",
-                "topic_name",
-                hint="drop ros_topic_name/gz_topic_name, or topic_name",
-            )
+            problem("topic_name names both sides", "topic_name")
         gz_name = ros_name = entry["topic_name"]
     elif gz_name is None or ros_name is None:
         problem(
             "an entry names its topic",
             expected="topic_name (both sides), or ros_topic_name and gz_topic_name",
-            hint="add `topic_name:` when both sides use the same name",
         )
     ros_type = entry.get("ros_type_name")
     gz_type = entry.get("gz_type_name", entry.get("ign_type_name"))
     if ros_type is None:
-        problem(
-            "ros_type_name is missing",
-            expected="a ROS 2 type, e.g. sensor_msgs/msg/LaserScan",
-            hint="add `ros_type_name:`",
-        )
+        problem("ros_type_name is missing", expected="a ROS 2 type, e.g. sensor_msgs/msg/LaserScan")
     if gz_type is None:
-        problem(
-            "gz_type_name is missing",
-            expected="a Gazebo type, e.g. gz.msgs.LaserScan",
-            hint="add `gz_type_name:`",
-        )
+        problem("gz_type_name is missing", expected="a Gazebo type, e.g. gz.msgs.LaserScan")
     direction = entry.get("direction", "BIDIRECTIONAL")
     if not isinstance(direction, str) or direction not in _GZ_DIRECTIONS:
-        problem(
-            f"unknown direction {direction!r}",
-            "direction",
-            expected="GZ_TO_ROS, ROS_TO_GZ or BIDIRECTIONAL",
-            hint=(
-                f"did you mean {near!r}?"
-                if isinstance(direction, str) and (near := closest(direction, _GZ_DIRECTIONS))
-                else "one word, not a list: GZ_TO_ROS, ROS_TO_GZ or BIDIRECTIONAL"
-            ),
+        near = closest(direction, _GZ_DIRECTIONS) if isinstance(direction, str) else None
+        hint = (
+            f"did you mean {near!r}?"
+            if near
+            else "one word, not a list: GZ_TO_ROS, ROS_TO_GZ or BIDIRECTIONAL"
         )
+        problem(f"unknown direction {direction!r}", "direction", expected=_DIRECTIONS_TEXT, hint=hint)
     lazy = entry.get("lazy", False)
     if not isinstance(lazy, bool):
-        problem("lazy is true or false", "lazy", found=repr(lazy), hint="write `lazy: true` or `lazy: false`")
+        problem("lazy is true or false", "lazy", found=repr(lazy))
     if len(problems) > n:
         return None
     return _FileEntry(gz_name, ros_name, ros_type, gz_type, direction, lazy)
@@ -551,22 +525,12 @@ def _entry_type(fields: _FileEntry, problem: _Report) -> str | None:
     full = msgs.normalize_type(str(ros_type))
     if not msgs.is_known(full):
         near = msgs.similar_types(full)
-        problem(
-            f"unknown message type {ros_type!r}",
-            "ros_type_name",
-            hint=f"did you mean {', '.join(near)}?"
-            if near
-            else "a ROS 2 type, e.g. sensor_msgs/msg/LaserScan",
-        )
+        hint = f"did you mean {', '.join(near)}?" if near else "a ROS 2 type, e.g. sensor_msgs/msg/LaserScan"
+        problem(f"unknown message type {ros_type!r}", "ros_type_name", hint=hint)
         return None
     gz_short = str(gz_type).removeprefix("gz.msgs.").removeprefix("ignition.msgs.")
     if gz_short == str(gz_type):
-        problem(
-            "a Gazebo type is gz.msgs.<Name>",
-            "gz_type_name",
-            found=str(gz_type),
-            hint=f"write gz.msgs.{gz_type}",
-        )
+        problem("a Gazebo type is gz.msgs.<Name>", "gz_type_name", found=str(gz_type))
         return None
     allowed = _GZ_TYPES.get(full)
     if allowed is not None and gz_short not in allowed:

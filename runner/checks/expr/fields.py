@@ -125,6 +125,22 @@ def _infer(expr: Expr, node: ast.AST, kinds: dict[int, str]) -> str:
     raise AssertionError(f"unchecked node {ast.dump(node)}")  # pragma: no cover
 
 
+# What to do, by what check_fields found (its messages say what is wrong; these, what to write instead)
+_HINTS = {
+    " is not a known type": "give a ROS 2 type such as nav_msgs/msg/Odometry",
+    "; it has no field ": "only a message has fields: compare this value itself",
+    " is out of range: ": "an index counts from 0 (or from -1 back from the end) within the array's length",
+    " cannot be indexed; ": "only arrays, sequences and strings take an index [i]",
+    "len() needs ": "len() counts the items of a sequence field, such as len(ranges)",
+    "() needs a sequence of numbers": "a reducer takes a sequence of numbers: ranges.min(), ranges.mean()",
+    ", not a value; ": "read one of its fields, e.g. pose.position.x rather than pose.position",
+}
+
+
+def _hint(message: str) -> str | None:
+    return next((hint for part, hint in _HINTS.items() if part in message), None)
+
+
 def check_fields(expr: Expr, type_name: str, condition: bool = True) -> None:
     """Check `expr` against the message type `type_name` (e.g. `nav_msgs/msg/Odometry`) without a message:
     every field must exist, indexes must follow a sequence (and fit a fixed-size array), reducers need a
@@ -137,15 +153,10 @@ def check_fields(expr: Expr, type_name: str, condition: bool = True) -> None:
 
     type_name = normalize_type(type_name)
     if type_name not in TYPESTORE.fielddefs:
-        raise ExprError(
-            f"unknown message type {type_name!r}",
-            None,
-            "give a ROS 2 type such as nav_msgs/msg/Odometry",
-            expr.text,
-        )
+        raise ExprError(f"unknown message type {type_name!r}", None, _hint(" is not a known type"), expr.text)
 
     def fail(message: str, column: int | None, hint: str | None = None) -> None:
-        raise ExprError(message, column, hint, expr.text)
+        raise ExprError(message, column, hint or _hint(message), expr.text)
 
     kinds: dict[int, str] = {}
     for p in expr._paths:
@@ -173,53 +184,32 @@ def check_fields(expr: Expr, type_name: str, condition: bool = True) -> None:
                         f"index it ({shown}[0]) or reduce it ({shown}.min())",
                     )
                 else:
-                    fail(
-                        f"'{shown}' is {_describe_type(cur)}; it has no field {seg!r}",
-                        col,
-                        f"compare '{shown}' itself",
-                    )
+                    fail(f"'{shown}' is {_describe_type(cur)}; it has no field {seg!r}", col)
                 shown = f"{shown}.{seg}" if shown else seg
             else:
                 if node in (Nodetype.ARRAY, Nodetype.SEQUENCE):
                     inner, length = detail
                     if node == Nodetype.ARRAY and not -length <= seg < length:
-                        fail(
-                            f"index {seg} is out of range: '{shown}' is {_describe_type(cur)}",
-                            col,
-                            f"indexes go from 0 to {length - 1} (or -1 for the last)",
-                        )
+                        fail(f"index {seg} is out of range: '{shown}' is {_describe_type(cur)}", col)
                     cur = inner
                 elif node == Nodetype.BASE and detail[0] in ("string", "wstring"):
                     pass  # a character of a string
                 else:
-                    fail(
-                        f"'{shown}' cannot be indexed; it is {_describe_type(cur)}",
-                        col,
-                        "only arrays, sequences and strings take [i]",
-                    )
+                    fail(f"'{shown}' cannot be indexed; it is {_describe_type(cur)}", col)
                 shown = f"{shown}[{seg}]"
         node, detail = cur
         kind = _kind_of_type(cur)
         if p.use == "len":
             if kind not in ("numseq", "seq", "str"):
-                fail(
-                    f"len() needs a sequence or a string; '{shown}' is {_describe_type(cur)}",
-                    p.column,
-                    "len() counts the items of a sequence field, such as ranges",
-                )
+                fail(f"len() needs a sequence or a string; '{shown}' is {_describe_type(cur)}", p.column)
         elif p.use in REDUCERS:
             if kind != "numseq":
-                fail(
-                    f"{p.use}() needs a sequence of numbers; '{shown}' is {_describe_type(cur)}",
-                    p.column,
-                    f"{p.use}() reduces a sequence field of numbers, such as ranges.{p.use}()",
-                )
+                fail(f"{p.use}() needs a sequence of numbers; '{shown}' is {_describe_type(cur)}", p.column)
         elif kind == "msg":
             names = [f[0] for f in TYPESTORE.fielddefs[detail][1]]
             fail(
                 f"'{shown}' is {_describe_type(cur)}, not a value; use one of its fields: {', '.join(names)}",
                 p.column,
-                f"e.g. {shown}.{names[0]}" if names else None,
             )
         kinds[id(p.node)] = kind
     kind = _infer(expr, expr._tree.body, kinds)
