@@ -10,6 +10,7 @@ from runner.errors import Location, Problem, ScenarioError, did_you_mean
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import MessageCheck, NoCollision, Scenario, TopicRate
 
+_OWN_NAME = "give each a `name:` of its own (results and events name assertions by it)"
 POSE_KINDS = ("reach", "stay_within", "max_speed", "max_tilt", "distance_traveled")
 
 
@@ -25,7 +26,9 @@ def check_names(sc: Scenario, doc: Document, model_names: set[str], has_sdf: boo
     for i, a in enumerate(sc.assertions):
         if a.name in names:
             where: PathKey = ("assertions", i, "name")
-            problems.append(Problem(f"two assertions named {a.name!r}", doc.locate(where), where))
+            problems.append(
+                Problem(f"two assertions named {a.name!r}", doc.locate(where), where, hint=_OWN_NAME)
+            )
         names.add(a.name)
         if a.type in POSE_KINDS and a.robot not in robots:  # type: ignore[union-attr]
             where = ("assertions", i, "robot")

@@ -60,7 +60,11 @@ class _World:
             if r.name == name:
                 body = f"{r.prefix}{r.root}"
                 if moving and r.fixed:
-                    raise self.problem(f"robot {name!r} is fixed to the world: it cannot be moved", where)
+                    raise self.problem(
+                        f"robot {name!r} is fixed to the world: it cannot be moved",
+                        where,
+                        hint="move a robot without `fixed: true`, or a model that is not static",
+                    )
                 return {"name": name, "body": body, "free": not r.fixed}
         for a in self.actors:
             if a.name == name:
@@ -69,13 +73,21 @@ class _World:
         if bid > 0:
             free = int(m.body_jntnum[bid]) == 1 and int(m.jnt_type[m.body_jntadr[bid]]) == 0
             if moving and not free:
-                raise self.problem(f"{name!r} is not free to move (it has no free joint)", where)
+                raise self.problem(
+                    f"{name!r} is not free to move (it has no free joint)",
+                    where,
+                    hint="move a robot, or a world-file model that is not static (a free body)",
+                )
             return {"name": name, "body": name, "free": free}
         gid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, name)
         if gid >= 0 and not moving:
             return {"name": name, "geom": name}
         if gid >= 0:
-            raise self.problem(f"{name!r} is a static model: it cannot be moved", where)
+            raise self.problem(
+                f"{name!r} is a static model: it cannot be moved",
+                where,
+                hint="set `static: false` on the model to make it free, or move a robot",
+            )
         raise self.problem(
             f"no robot, actor or model named {name!r}",
             where,
@@ -154,7 +166,12 @@ def compile_events(
         here: PathKey = ("events", i)
         if names.index(ev.name) != i:
             problems.add(
-                Problem(f"two events named {ev.name!r}", doc.locate((*here, "name")), (*here, "name"))
+                Problem(
+                    f"two events named {ev.name!r}",
+                    doc.locate((*here, "name")),
+                    (*here, "name"),
+                    hint="give each a `name:` of its own (`after:` and the report name events by it)",
+                )
             )
         plan: EventPlan | None = None
         with problems.each():
@@ -291,7 +308,9 @@ def _action(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
         target = w.ref(body, (*at, "body"), moving=True)
         if "actor" in target:
             raise w.problem(
-                f"{body!r} is an actor: it goes where its path says, forces do not move it", (*at, "body")
+                f"{body!r} is an actor: it goes where its path says, forces do not move it",
+                (*at, "body"),
+                hint="`teleport` or `stop` an actor; push a robot or a free model",
             )
         if act.push is not None:
             p = act.push
@@ -337,7 +356,11 @@ def _publish(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
     wanted = w.taken.get(key)
     if wanted is not None and msgs.normalize_type(wanted) != type_name:
         raise w.problem(
-            f"{p.topic} is taken by the world as {wanted}", (*at, "type"), expected=wanted, found=type_name
+            f"{p.topic} is taken by the world as {wanted}",
+            (*at, "type"),
+            expected=wanted,
+            found=type_name,
+            hint=f"publish a {wanted} there",
         )
     return {"kind": "publish", "key": key, "type": type_name, "data": p.data}
 
@@ -431,7 +454,11 @@ def _joint(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
     name = f"{robot.prefix}{ref.joint}"
     jid = mujoco.mj_name2id(w.model, mujoco.mjtObj.mjOBJ_JOINT, name)
     if jid < 0 or int(w.model.jnt_type[jid]) not in (2, 3):  # slide, hinge
-        raise w.problem(f"{ref.joint!r} is not a moving joint of the simulated robot", (*at, "joint"))
+        raise w.problem(
+            f"{ref.joint!r} is not a moving joint of the simulated robot",
+            (*at, "joint"),
+            hint="name a revolute, continuous or prismatic joint (fixed joints are merged away)",
+        )
     if act.cut is not None:
         m = w.model
         driven = [

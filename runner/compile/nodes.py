@@ -27,13 +27,15 @@ def compile_nodes(sc: Scenario, doc: Document, base: Path) -> list[NodePlan]:
     for i, node in enumerate(sc.nodes):
         if node.name in seen:
             where: PathKey = ("nodes", i, "name")
-            problems.append(Problem(f"two nodes named {node.name!r}", doc.locate(where), where))
+            hint = "give each a `name:` of its own (its output is prefixed with it)"
+            problems.append(Problem(f"two nodes named {node.name!r}", doc.locate(where), where, hint=hint))
         seen.add(node.name)
         try:
             argv = shlex.split(node.cmd) if isinstance(node.cmd, str) else list(node.cmd)
         except ValueError as e:
             where = ("nodes", i, "cmd")
-            problems.append(Problem(f"cannot split the command: {e}", doc.locate(where), where))
+            hint = "close its quotes, or give the command as a list: cmd: [python, my node.py]"
+            problems.append(Problem(f"cannot split the command: {e}", doc.locate(where), where, hint=hint))
             continue
         if not argv:
             where = ("nodes", i, "cmd")

@@ -209,12 +209,16 @@ def _compile_problem(e: ValueError, sc: Scenario, doc: Document, world: mujoco.M
     for i, m_ in enumerate(sc.world.models):
         if element == m_.name:
             where = ("world", "models", i)
-            return Problem(f"MuJoCo cannot compile model {m_.name!r}: {first}", doc.locate(where), where)
+            hint = "check the model's size, mass and pose: positive sizes, a positive mass if it moves"
+            return Problem(
+                f"MuJoCo cannot compile model {m_.name!r}: {first}", doc.locate(where), where, hint=hint
+            )
     where = ("world", "sdf") if sc.world.sdf else ("robots",)
     return Problem(
         f"MuJoCo cannot compile the world: {first}" + (f" (at {element!r})" if element else ""),
         doc.locate(where),
         where,
+        hint="MuJoCo's message names the element it refused; check its sizes, masses and names",
     )
 
 

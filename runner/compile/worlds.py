@@ -173,7 +173,10 @@ def _place(sc: Scenario, doc: Document) -> _Placement:
         if name in names[:i]:
             problems.append(
                 Problem(
-                    f"two worlds named {name!r}", doc.locate(("worlds", i, "name")), ("worlds", i, "name")
+                    f"two worlds named {name!r}",
+                    doc.locate(("worlds", i, "name")),
+                    ("worlds", i, "name"),
+                    hint="give each a `name:` of its own (its topics start with it)",
                 )
             )
     expected = "one of: " + ", ".join(names)
@@ -300,6 +303,7 @@ def _assertion_world(
                     doc.locate(where),
                     where,
                     expected="robots and models of one world",
+                    hint="name a robot (or model) of each side's world; worlds do not touch each other",
                 )
             )
     return w

@@ -25,7 +25,8 @@ class _Frames:
             if ch.tag in ("link", "model", "frame", "joint"):
                 n = ch.get("name")
                 if not n:
-                    raise reader.error(f"a <{ch.tag}> of model {model!r} has no name", src, ch)
+                    hint = f'give it one: <{ch.tag} name="...">'
+                    raise reader.error(f"a <{ch.tag}> of model {model!r} has no name", src, ch, hint=hint)
                 self.entries.setdefault(n, ch)
         self.resolved: dict[str, Pose] = {}
         self.busy: set[str] = set()
