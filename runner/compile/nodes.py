@@ -62,7 +62,8 @@ def compile_nodes(sc: Scenario, doc: Document, base: Path) -> list[NodePlan]:
                     + (f" (did you mean {near!r}?)" if (near := _near_file(cwd, exe)) else ""),
                 )
             )
-        elif cwd.is_dir():
+        elif cwd.is_dir() and (node.host is None or node.host == next(iter(sc.hosts), None)):
+            # (a node of another host runs its script there: it is not looked for here)
             missing = _missing_script(argv, list(node.args), isinstance(node.cmd, str), cwd, doc, i)
             if missing is not None:
                 problems.append(missing)
