@@ -97,7 +97,10 @@ class LidarParams(RatedParams):
     @model_validator(mode="after")
     def _angles(self) -> LidarParams:
         if self.max_angle < self.min_angle:
-            raise ValueError(f"max_angle ({self.max_angle}) is below min_angle ({self.min_angle})")
+            raise ValueError(
+                f"max_angle ({self.max_angle}) is below min_angle ({self.min_angle}): "
+                "write the smaller angle as min_angle (radians, e.g. min_angle: -3.14, max_angle: 3.14)"
+            )
         if self.range_max <= self.range_min:
             raise ValueError(f"range_max ({self.range_max}) must exceed range_min ({self.range_min})")
         for a, b in self.blind_sectors:

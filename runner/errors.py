@@ -7,10 +7,58 @@ these and exits 1; any other exception is a bug and keeps its traceback.
 
 from __future__ import annotations
 
+import difflib
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+
+
+def closest(name: str, names: Iterable[str]) -> str | None:
+    """The one of `names` that `name` was most likely meant as: the same but for case, else the closest by
+    `difflib` (a typo, a missing or doubled letter), else None."""
+    pool = sorted({str(n) for n in names})
+    folded = [n for n in pool if n.casefold() == name.casefold()]
+    if folded:
+        return folded[0]
+    close = difflib.get_close_matches(name, pool, n=1, cutoff=0.6)
+    return close[0] if close else None
+
+
+def did_you_mean(name: str, names: Iterable[str], what: str = "names", limit: int = 12) -> str:
+    """The hint for a name that names nothing (a robot, link, topic, node...): "did you mean 'r1'?" when
+    one of `names` is close, else the names there are (`what`: how to call them, "robots"), so that every
+    unknown name is said with what to write instead."""
+    pool = sorted({str(n) for n in names})
+    near = closest(name, pool)
+    if near is not None:
+        return f"did you mean {near!r}?"
+    if not pool:
+        return f"there are no {what} to name here"
+    shown = ", ".join(pool[:limit]) + (f" ... ({len(pool)} in all)" if len(pool) > limit else "")
+    return f"{what}: {shown}"
+
+
+def missing_file_hint(path: Path, relative_to: str = "the scenario's folder") -> str:
+    """The hint for a file that is not there: a file of a close name in its folder ("did you mean"), or the
+    first folder of its path that does not exist."""
+    folder = path.parent
+    if not folder.is_dir():
+        missing = folder
+        while not missing.parent.is_dir() and missing != missing.parent:
+            missing = missing.parent
+        return (
+            f"paths are relative to {relative_to}, and it has no folder {missing.name!r} "
+            f"(in {str(missing.parent)!r})"
+        )
+    try:
+        entries = [p.name for _, p in zip(range(5000), folder.iterdir(), strict=False)]
+    except OSError:
+        entries = []
+    near = closest(path.name, entries)
+    if near is not None:
+        return f"did you mean {near!r}? (in {str(folder)!r})"
+    return f"paths are relative to {relative_to}; {str(folder)!r} has no file of a name close to it"
 
 
 @dataclass(frozen=True)

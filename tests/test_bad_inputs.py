@@ -216,3 +216,147 @@ def test_checks_that_stop_early_say_so(write_scenario) -> None:
         proc = run_cli("validate", str(path))
         assert proc.returncode == 1 and "Traceback" not in proc.stderr, proc.stderr
         assert proc.stderr.rstrip().endswith(note), proc.stderr
+
+
+# Names: the one meant, whatever the case or typo, and what there is when nothing is close.
+def test_did_you_mean_names_the_closest_or_lists_what_there_is() -> None:
+    from runner.errors import closest, did_you_mean
+
+    assert closest("R1", ["r1", "r2"]) == "r1"  # case first
+    assert closest("left_wheel_jiont", ["left_wheel_joint", "right_wheel_joint"]) == "left_wheel_joint"
+    assert closest("zzz", ["r1", "r2"]) is None
+    assert did_you_mean("rover_1", ["rover1", "walker"], "robots") == "did you mean 'rover1'?"
+    assert did_you_mean("zzz", ["b", "a"], "robots") == "robots: a, b"
+    assert did_you_mean("zzz", [], "actors") == "there are no actors to name here"
+    many = did_you_mean("zzz", [f"n{k:02}" for k in range(30)], "topics")
+    assert many.startswith("topics: n00, n01") and many.endswith("(30 in all)")
+
+
+# Zenoh endpoints: Zenoh's configuration takes any text; these are what the run would refuse when it opens them.
+@pytest.mark.parametrize(
+    ("endpoint", "listen", "said"),
+    [
+        ("tcp/127.0.0.1:70000", True, "port 70000 is out of range (0-65535)"),
+        ("tcp/127.0.0.1:0", False, "port 0 is out of range (1-65535)"),
+        ("tcp/127.0.0.1", True, "no port"),
+        ("tcp/[::1]", False, "no port"),
+        ("tcp/:7447", True, "no address"),
+        ("tcp/127.0.0.1:x", True, "the port 'x' is not a number"),
+        ("tpc/127.0.0.1:7447", True, "unknown Zenoh protocol 'tpc': write tcp/127.0.0.1:7447"),
+        ("tcp/300.0.0.1:7447", True, "'300.0.0.1' is not an IPv4 address"),
+        ("tcp/[::1:7447", True, "an IPv6 address goes in brackets"),
+        ("127.0.0.1:7447", True, "write it with its protocol, e.g. tcp/127.0.0.1:7447"),
+    ],
+)
+def test_a_bad_zenoh_endpoint_is_said(endpoint: str, listen: bool, said: str) -> None:
+    from runner.scenario.schema.network import endpoint_error
+
+    error = endpoint_error(endpoint, listen)
+    assert error is not None and said in error, error
+    assert ": write " in error  # the fix, which the error's hint says
+
+
+@pytest.mark.parametrize(
+    "endpoint",
+    [
+        "tcp/127.0.0.1:7447",
+        "tcp/[::1]:7447",
+        "tls/localhost:7447",
+        "udp/10.0.0.2:7447",
+        "quic/127.0.0.1:7447",
+        "ws/127.0.0.1:8000",
+        "tcp/127.0.0.1:7447#iface=lo",
+        "tcp/127.0.0.1:7447?prio=1",
+        "unixsock-stream//tmp/zenoh.sock",
+        "serial//dev/ttyUSB0#baudrate=115200",
+    ],
+)
+def test_good_zenoh_endpoints_pass(endpoint: str) -> None:
+    from runner.scenario.schema.network import endpoint_error
+
+    assert endpoint_error(endpoint, listen=False) is None
+    assert endpoint_error(endpoint, listen=True) is None
+    assert endpoint_error("tcp/127.0.0.1:0", listen=True) is None  # any free port
+
+
+@pytest.mark.timeout(60)
+def test_a_record_folder_without_permission_is_said_by_validate(write_scenario) -> None:
+    """/proc/1 takes no new files, for root too (procfs refuses them, whatever the permissions say):
+    a recording there used to be found out only when the run started."""
+    path = write_scenario("name: x\nrecord: {path: /proc/1/runs/x.mcap}\n")
+    result = CliRunner().invoke(app, ["validate", str(path)])
+    assert result.exit_code == 1, result.output
+    assert (
+        f"{path}:2:" in result.output and "record.path: the recording '/proc/1/runs/x.mcap'" in result.output
+    )
+    assert "no permission to write in '/proc/1'" in result.output and "hint:" in result.output
+    assert not Path("/proc/1/runs").exists()
+    # ... while a folder to be made (several levels), a folder given with a trailing '/' and an existing file
+    # pass, and `validate` makes none of them
+    (path.parent / "old.mcap").write_bytes(b"")
+    for k, given in enumerate(["deep/er/x.mcap", "outs/", "old.mcap"]):
+        ok = write_scenario(f"name: x\nrecord: {{path: {given}}}\n", name=f"s{k}.yaml")
+        result = CliRunner().invoke(app, ["validate", str(ok)])
+        assert result.exit_code == 0, result.output
+    assert not (path.parent / "deep").exists() and not (path.parent / "outs").exists()
+
+
+@pytest.mark.timeout(120)
+def test_run_refuses_an_unwritable_record_path_before_it_starts_unless_it_records_nothing(
+    write_scenario,
+) -> None:
+    path = write_scenario("name: x\nduration: 0.2\nrecord: {path: /proc/1/runs/x.mcap}\n")
+    refused = run_cli("run", str(path), timeout=60)
+    assert refused.returncode == 1 and f"{path}:3:" in refused.stderr, refused.stderr
+    assert "record.path" in refused.stderr and "running x" not in refused.stderr, refused.stderr
+    unrecorded = run_cli("run", str(path), "--no-record", timeout=100)
+    assert unrecorded.returncode == 0, unrecorded.stderr
+
+
+@pytest.mark.timeout(60)
+def test_node_scripts_are_found_as_the_launcher_finds_them(write_scenario, tmp_path: Path) -> None:
+    """The node-script check resolves commands as the launcher does (runner/launch/nodes.py: Popen of the
+    argv in the node's cwd): of these, only the one whose script is not there is refused."""
+    (tmp_path / "ok.py").write_text("")
+    (tmp_path / "okmod.py").write_text("")
+    (tmp_path / "ok.sh").write_text("")
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "inner.py").write_text("")
+    path = write_scenario(
+        """
+        name: x
+        nodes:
+          - {name: a, cmd: python -c pass}
+          - {name: b, cmd: python -m json.tool}
+          - {name: c, cmd: python ./ok.py --rate 3}
+          - {name: d, cmd: [python, -u, ok.py]}
+          - {name: e, cmd: python -W ignore ok.py}
+          - {name: f, cmd: python -m okmod}
+          - {name: g, cmd: bash ok.sh}
+          - {name: h, cmd: python, args: [ok.py]}
+          - {name: i, cmd: python inner.py, cwd: sub}
+          - {name: j, cmd: python ok.py, cwd: sub}
+        """
+    )
+    result = CliRunner().invoke(app, ["validate", str(path)])
+    assert result.exit_code == 1, result.output
+    said = [ln for ln in result.output.splitlines() if ln.startswith(("error: /", "/"))]
+    assert len(said) == 1 and f"{path}:12:" in said[0], result.output
+    assert "nodes[9].cmd: script 'ok.py' not found" in said[0], result.output
+
+
+@pytest.mark.timeout(60)
+def test_a_missing_script_is_said_where_it_is_written(write_scenario, tmp_path: Path) -> None:
+    """In `args:` (its index there), in a `cmd:` list (its index), for bash as for Python."""
+    path = write_scenario(
+        """
+        name: x
+        nodes:
+          - {name: a, cmd: python, args: [-u, gone.py]}
+          - {name: b, cmd: [bash, gone.sh]}
+        """
+    )
+    result = CliRunner().invoke(app, ["validate", str(path)])
+    assert result.exit_code == 1, result.output
+    assert f"{path}:3:" in result.output and "nodes[0].args[1]: script 'gone.py' not found" in result.output
+    assert f"{path}:4:" in result.output and "nodes[1].cmd[1]: script 'gone.sh' not found" in result.output

@@ -222,9 +222,10 @@ def test_the_go_to_goal_example_reaches_its_goal(tmp_path: Path) -> None:
 
 
 @pytest.mark.timeout(60)
-def test_a_required_node_whose_script_is_missing_fails_the_run_without_a_traceback(write_scenario) -> None:
+def test_a_required_node_that_dies_at_once_fails_the_run_without_a_traceback(write_scenario) -> None:
     """The node dies at once, while the world is still starting: the world is stopped quietly (it used to
-    print a KeyboardInterrupt traceback) and the run fails with the node's own words."""
+    print a KeyboardInterrupt traceback) and the run fails with the node's own words. (A script that is not
+    there is refused before the run: test_a_node_whose_script_is_missing_is_refused_before_the_run.)"""
     path = write_scenario(
         """
         name: gone
@@ -233,13 +234,35 @@ def test_a_required_node_whose_script_is_missing_fails_the_run_without_a_traceba
         robots:
           - {name: r1, description: "{diffbot}", plugins: [{type: diff_drive}]}
         nodes:
-          - {name: driver, cmd: python missing_script.py, required: true}
+          - name: driver
+            cmd: [python, -c, "import sys; sys.exit('driver: cannot open /dev/motor0')"]
+            required: true
         """
     )
     r = run_cli("run", str(path), "--no-record", timeout=50)
     assert r.returncode == 1, r.stderr
-    assert "required node 'driver' exited with code 2" in r.stderr and "missing_script.py" in r.stderr
+    assert "required node 'driver' exited with code 1" in r.stderr and "cannot open /dev/motor0" in r.stderr
     assert "Traceback" not in r.stderr and "KeyboardInterrupt" not in r.stderr, r.stderr
+
+
+@pytest.mark.timeout(60)
+def test_a_node_whose_script_is_missing_is_refused_before_the_run(write_scenario) -> None:
+    """`python missing_script.py` used to start the world and then die with exit code 2, naming no line of
+    the scenario: `run` (as `validate`) now refuses it at the command's line, before anything starts."""
+    path = write_scenario(
+        """
+        name: gone
+        duration: 5
+        nodes:
+          - {name: driver, cmd: python missing_script.py, required: true}
+        """
+    )
+    (path.parent / "missing_scrpt.py").write_text("")
+    r = run_cli("run", str(path), "--no-record", timeout=50)
+    assert r.returncode == 1, r.stderr
+    assert f"{path}:4:" in r.stderr and "nodes[0].cmd: script 'missing_script.py' not found" in r.stderr
+    assert "did you mean 'missing_scrpt.py'?" in r.stderr, r.stderr
+    assert "exited with code" not in r.stderr and "Traceback" not in r.stderr, r.stderr
 
 
 def _tail_of(text: str, stopping: bool, capsys: pytest.CaptureFixture[str]) -> str:

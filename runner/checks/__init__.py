@@ -6,10 +6,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from runner.errors import Location, Problem, ScenarioError
+from runner.errors import Location, Problem, ScenarioError, did_you_mean
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import MessageCheck, NoCollision, Scenario, TopicRate
 
+_OWN_NAME = "give each a `name:` of its own (results and events name assertions by it)"
 POSE_KINDS = ("reach", "stay_within", "max_speed", "max_tilt", "distance_traveled")
 
 
@@ -25,7 +26,9 @@ def check_names(sc: Scenario, doc: Document, model_names: set[str], has_sdf: boo
     for i, a in enumerate(sc.assertions):
         if a.name in names:
             where: PathKey = ("assertions", i, "name")
-            problems.append(Problem(f"two assertions named {a.name!r}", doc.locate(where), where))
+            problems.append(
+                Problem(f"two assertions named {a.name!r}", doc.locate(where), where, hint=_OWN_NAME)
+            )
         names.add(a.name)
         if a.type in POSE_KINDS and a.robot not in robots:  # type: ignore[union-attr]
             where = ("assertions", i, "robot")
@@ -35,6 +38,7 @@ def check_names(sc: Scenario, doc: Document, model_names: set[str], has_sdf: boo
                     doc.locate(where),
                     where,
                     expected="one of: " + ", ".join(sorted(robots)) if robots else "a robot of this scenario",
+                    hint=did_you_mean(a.robot, robots, "robots"),  # type: ignore[union-attr]
                 )
             )
         if isinstance(a, NoCollision) and not has_sdf:
@@ -48,6 +52,7 @@ def check_names(sc: Scenario, doc: Document, model_names: set[str], has_sdf: boo
                             doc.locate(where),
                             where,
                             expected="one of: " + ", ".join(sorted(known)),
+                            hint=did_you_mean(n, known, "robots and models"),
                         )
                     )
     if problems:
@@ -91,7 +96,7 @@ def assertion_keys(
                     f"no topic {a.topic!r} is published in this scenario",
                     doc.locate(where),
                     where,
-                    hint="topics: " + ", ".join(sorted(k.split("/", 1)[1] for k in topics)),
+                    hint=did_you_mean(a.topic.strip("/"), (k.split("/", 1)[1] for k in topics), "topics"),
                 )
             )
             continue
@@ -113,8 +118,15 @@ def _expr_problem(expr: str, e: Exception, doc: Document, where: PathKey) -> Pro
         f"in `{expr}`" + (f" (column {column})" if column else "") + f": {getattr(e, 'message', e)}",
         Location(loc.file, loc.line, loc.column),
         where,
-        hint=getattr(e, "hint", None),
+        hint=getattr(e, "hint", None) or _EXPR_HINT,
     )
+
+
+# The hint of an expression error that has none of its own: what the language is made of.
+_EXPR_HINT = (
+    "an expression is one condition on the message's fields: field paths, numbers, strings, True/False, "
+    "+ - * / %, < <= > >= == !=, and/or/not, abs len min max, .min() .max() .mean() .sum() .std()"
+)
 
 
 def specs_from_plan(raw: list[dict[str, Any]]) -> list[Any]:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -153,7 +154,8 @@ def run(
     _check_endpoints(listen, connect)
     origins = _check_origins(foxglove_origin, foxglove)
     try:
-        plans = load_variants(file, record, variant)
+        # (with --no-record, the scenario's record.path is not checked: nothing is written there)
+        plans = load_variants(file, os.devnull if no_record else record, variant)
     except ScenarioError as e:
         raise fail(e) from None
     who = None if local else host

@@ -41,7 +41,8 @@ def check(
     from runner.tools.report import Suite, rejudge, write_junit
 
     try:
-        plans = load_variants(scenario, None, variant)
+        # the recording is given: the scenario's record.path is not used, nor checked
+        plans = load_variants(scenario, str(mcap), variant)
     except ScenarioError as e:
         raise fail(e) from None
     if len(plans) > 1:

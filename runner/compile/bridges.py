@@ -21,7 +21,7 @@ from typing import Any, NamedTuple
 
 import zenoh
 
-from runner.errors import Problem, ScenarioError
+from runner.errors import Problem, ScenarioError, closest, did_you_mean
 from runner.plan import BridgePlan, NodePlan, Ros2Plan, RunPlan
 from runner.scenario.loader import Document, PathKey, load_file
 from runner.scenario.schema import Bridge, Ros2, Scenario
@@ -89,9 +89,12 @@ class _Topics:
                 return [key]
         return sorted(k for k in self.table if k.endswith("/" + name) and not hidden_topic(k[len(run) + 1 :]))
 
+    def short(self) -> list[str]:
+        """The topics without the run's name, as a scenario writes them (`r1/scan`)."""
+        return sorted(k[len(self.run) + 1 :] for k in self.table if not hidden_topic(k[len(self.run) + 1 :]))
+
     def names(self) -> str:
-        keys = [k[len(self.run) + 1 :] for k in self.table if not hidden_topic(k[len(self.run) + 1 :])]
-        return ", ".join(sorted(keys))
+        return ", ".join(self.short())
 
 
 def _ros2_plan(setting: Ros2 | bool | None, default: Ros2 | None, run: str) -> Ros2Plan | None:
@@ -146,6 +149,7 @@ def attach_bridges(plan: RunPlan, sc: Scenario, doc: Document, unchecked: Sequen
                     doc.locate(at),
                     at,
                     expected="one of: " + ", ".join(robots) if robots else "a robot of this scenario",
+                    hint=did_you_mean(b.robot, robots, "robots"),
                 )
             )
             continue
@@ -259,7 +263,8 @@ def _sim_key(
             doc.locate(at),
             at,
             expected="one of: " + topics.names(),
-            hint="for a topic a node publishes, give its `type:`",
+            hint=(f"did you mean {near!r}? " if (near := closest(topic.strip("/"), topics.short())) else "")
+            + "for a topic a node publishes, give its `type:`",
         )
     )
     return None
@@ -277,7 +282,8 @@ def _one(
         return []
     if type_name is None:
         at = (*where, "type")
-        problems.append(Problem("the topic's type is not known here; give it", doc.locate(at), at))
+        hint = "add `type:` with the topic's ROS 2 type, e.g. geometry_msgs/msg/Twist"
+        problems.append(Problem("the topic's type is not known here; give it", doc.locate(at), at, hint=hint))
         return []
     rel = key[len(topics.run) + 1 :]
     common = {"where": _where(doc, where), "sim_key": key, "type": type_name, "direction": b.direction}
@@ -285,7 +291,11 @@ def _one(
     if ros2 is not None:
         if b.encoding != "cdr":
             at = (*where, "encoding")
-            problems.append(Problem("ROS 2 speaks CDR", doc.locate(at), at, expected="cdr", found=b.encoding))
+            hint = "remove `encoding:` (or set it to cdr) on a bridge to ROS 2"
+            problem = Problem(
+                "ROS 2 speaks CDR", doc.locate(at), at, expected="cdr", found=b.encoding, hint=hint
+            )
+            problems.append(problem)
             return []
         return [BridgePlan(**common, ros_topic=_qualify(b.ros_topic or rel, None), ros2=ros2)]
     other = (b.key or rel).strip("/")
@@ -302,7 +312,10 @@ def _key_ok(
     try:
         expr = zenoh.KeyExpr(other)
     except Exception as e:
-        problems.append(Problem(f"{other!r} is not a Zenoh key expression: {e}", doc.locate(at), at))
+        hint = "chunks separated by '/', no empty chunk, no leading or trailing '/'"
+        problems.append(
+            Problem(f"{other!r} is not a Zenoh key expression: {e}", doc.locate(at), at, hint=hint)
+        )
         return False
     if expr.intersects(zenoh.KeyExpr(f"{run}/**")) or other == run:
         problems.append(
@@ -363,6 +376,7 @@ def _from_file(
                 fdoc.locate(()),
                 expected="- ros_topic_name: ...\n    gz_topic_name: ...",
                 found=type(entries).__name__,
+                hint="write each entry as a list item starting with `- `, as ros_gz_bridge's config files do",
             )
         )
         return []
@@ -385,6 +399,18 @@ class _FileEntry(NamedTuple):
     lazy: bool
 
 
+# What to do, for the mistakes of a ros_gz_bridge file entry that are always said the same way
+_FILE_HINTS = {
+    "an entry is a mapping": "give the entry's keys under its `- `, one per line",
+    "services are not bridged (topics only)": "remove the entry; a node of the scenario can serve it instead",
+    "topic_name names both sides": "drop ros_topic_name/gz_topic_name, or topic_name",
+    "an entry names its topic": "add `topic_name:` when both sides use the same name",
+    "ros_type_name is missing": "add `ros_type_name:`",
+    "gz_type_name is missing": "add `gz_type_name:`",
+    "lazy is true or false": "write `lazy: true` or `lazy: false`",
+    "a Gazebo type is gz.msgs.<Name>": "write gz.msgs.<Name>, e.g. gz.msgs.LaserScan",
+}
+_DIRECTIONS_TEXT = "GZ_TO_ROS, ROS_TO_GZ or BIDIRECTIONAL"
 _Report = Callable[..., None]  # problem(message, key=None, **Problem's keywords) at an entry (and key)
 
 
@@ -402,6 +428,7 @@ def _file_entry(
 
     def problem(message: str, key: str | None = None, **kw: Any) -> None:
         at: PathKey = (j, key) if key else (j,)
+        kw.setdefault("hint", _FILE_HINTS.get(message, "see ros_gz_bridge's configuration file format"))
         problems.append(Problem(message, fdoc.locate(at), at, **kw))
 
     fields = _entry_fields(entry, problem, problems)
@@ -422,6 +449,7 @@ def _file_entry(
             "ros_type_name",
             expected=known,
             found=full,
+            hint="a bridge passes messages on as they are; give the topic's own type",
         )
         return None
     fq = _qualify(str(fields.ros_name), namespace)
@@ -454,13 +482,13 @@ def _entry_fields(entry: Any, problem: _Report, problems: list[Problem]) -> _Fil
                 f"unknown key {k!r}",
                 str(k),
                 expected=", ".join(sorted(_FILE_KEYS)),
-                hint=f"did you mean {near[0]!r}?" if near else None,
+                hint=f"did you mean {near[0]!r}?" if near else "remove it",
             )
     gz_name = entry.get("gz_topic_name", entry.get("ign_topic_name"))
     ros_name = entry.get("ros_topic_name")
     if "topic_name" in entry:
         if ros_name is not None or gz_name is not None:
-            problem("topic_name names both sides; drop ros_topic_name/gz_topic_name", "topic_name")
+            problem("topic_name names both sides", "topic_name")
         gz_name = ros_name = entry["topic_name"]
     elif gz_name is None or ros_name is None:
         problem(
@@ -475,9 +503,13 @@ def _entry_fields(entry: Any, problem: _Report, problems: list[Problem]) -> _Fil
         problem("gz_type_name is missing", expected="a Gazebo type, e.g. gz.msgs.LaserScan")
     direction = entry.get("direction", "BIDIRECTIONAL")
     if not isinstance(direction, str) or direction not in _GZ_DIRECTIONS:
-        problem(
-            f"unknown direction {direction!r}", "direction", expected="GZ_TO_ROS, ROS_TO_GZ or BIDIRECTIONAL"
+        near = closest(direction, _GZ_DIRECTIONS) if isinstance(direction, str) else None
+        hint = (
+            f"did you mean {near!r}?"
+            if near
+            else "one word, not a list: GZ_TO_ROS, ROS_TO_GZ or BIDIRECTIONAL"
         )
+        problem(f"unknown direction {direction!r}", "direction", expected=_DIRECTIONS_TEXT, hint=hint)
     lazy = entry.get("lazy", False)
     if not isinstance(lazy, bool):
         problem("lazy is true or false", "lazy", found=repr(lazy))
@@ -493,11 +525,8 @@ def _entry_type(fields: _FileEntry, problem: _Report) -> str | None:
     full = msgs.normalize_type(str(ros_type))
     if not msgs.is_known(full):
         near = msgs.similar_types(full)
-        problem(
-            f"unknown message type {ros_type!r}",
-            "ros_type_name",
-            hint=f"did you mean {', '.join(near)}?" if near else None,
-        )
+        hint = f"did you mean {', '.join(near)}?" if near else "a ROS 2 type, e.g. sensor_msgs/msg/LaserScan"
+        problem(f"unknown message type {ros_type!r}", "ros_type_name", hint=hint)
         return None
     gz_short = str(gz_type).removeprefix("gz.msgs.").removeprefix("ignition.msgs.")
     if gz_short == str(gz_type):
@@ -510,6 +539,7 @@ def _entry_type(fields: _FileEntry, problem: _Report) -> str | None:
             "gz_type_name",
             expected=" or ".join(f"gz.msgs.{a}" for a in sorted(allowed)),
             found=str(gz_type),
+            hint="use the Gazebo type ros_gz_bridge pairs with this ROS type (expected above)",
         )
         return None
     return full

@@ -17,7 +17,7 @@ import mujoco
 
 from runner.compile.nodes import declared_topics
 from runner.compile.timeline import message_of
-from runner.errors import Problem, Problems, ScenarioError
+from runner.errors import Problem, Problems, ScenarioError, closest, did_you_mean
 from runner.geometry import rpy_to_quat
 from runner.plan import ActorPlan, EventPlan, RobotPlan
 from runner.plugin.registry import load
@@ -60,7 +60,11 @@ class _World:
             if r.name == name:
                 body = f"{r.prefix}{r.root}"
                 if moving and r.fixed:
-                    raise self.problem(f"robot {name!r} is fixed to the world: it cannot be moved", where)
+                    raise self.problem(
+                        f"robot {name!r} is fixed to the world: it cannot be moved",
+                        where,
+                        hint="move a robot without `fixed: true`, or a model that is not static",
+                    )
                 return {"name": name, "body": body, "free": not r.fixed}
         for a in self.actors:
             if a.name == name:
@@ -69,19 +73,28 @@ class _World:
         if bid > 0:
             free = int(m.body_jntnum[bid]) == 1 and int(m.jnt_type[m.body_jntadr[bid]]) == 0
             if moving and not free:
-                raise self.problem(f"{name!r} is not free to move (it has no free joint)", where)
+                raise self.problem(
+                    f"{name!r} is not free to move (it has no free joint)",
+                    where,
+                    hint="move a robot, or a world-file model that is not static (a free body)",
+                )
             return {"name": name, "body": name, "free": free}
         gid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, name)
         if gid >= 0 and not moving:
             return {"name": name, "geom": name}
         if gid >= 0:
-            raise self.problem(f"{name!r} is a static model: it cannot be moved", where)
+            raise self.problem(
+                f"{name!r} is a static model: it cannot be moved",
+                where,
+                hint="set `static: false` on the model to make it free, or move a robot",
+            )
         raise self.problem(
             f"no robot, actor or model named {name!r}",
             where,
             expected=_choices(self.bodies(), "robots, actors or models"),
             found=name,
-            hint="a name of `robots:`, `world.actors` or `world.models` (or a body of the world file)",
+            hint=(f"did you mean {near!r}? " if (near := closest(name, self.bodies())) else "")
+            + "a name of `robots:`, `world.actors` or `world.models` (or a body of the world file)",
         )
 
     def problem(self, message: str, where: PathKey, **kw: Any) -> ScenarioError:
@@ -94,7 +107,8 @@ class _World:
                     f"no region named {value!r}",
                     where,
                     expected=_choices(set(self.sc.regions), "regions (`regions:`)"),
-                    hint="name it under `regions:` or give it here: {min: [x, y], max: [x, y]}",
+                    hint=(f"did you mean {near!r}? " if (near := closest(value, self.sc.regions)) else "")
+                    + "name it under `regions:` or give it here: {min: [x, y], max: [x, y]}",
                 )
             value = self.sc.regions[value]
         return value.model_dump(exclude_none=True)  # type: ignore[no-any-return]
@@ -114,6 +128,8 @@ class _World:
         )
         if published and key in self.heard:
             hint = "a node publishes it: the world can put a fault only on what it publishes itself"
+        elif (near := closest(topic.strip("/"), names)) is not None:
+            hint = f"did you mean {near!r}?"
         raise self.problem(
             f"no topic {topic!r} that {what}",
             where,
@@ -150,7 +166,12 @@ def compile_events(
         here: PathKey = ("events", i)
         if names.index(ev.name) != i:
             problems.add(
-                Problem(f"two events named {ev.name!r}", doc.locate((*here, "name")), (*here, "name"))
+                Problem(
+                    f"two events named {ev.name!r}",
+                    doc.locate((*here, "name")),
+                    (*here, "name"),
+                    hint="give each a `name:` of its own (`after:` and the report name events by it)",
+                )
             )
         plan: EventPlan | None = None
         with problems.each():
@@ -215,6 +236,7 @@ def _when(w: _World, ev: Event, here: PathKey, names: list[str]) -> dict[str, An
                 f"no event named {when.after.event!r}",
                 (*at, "event"),
                 expected=_choices([n for n in names if n != ev.name], "other events"),
+                hint=did_you_mean(when.after.event, [n for n in names if n != ev.name], "other events"),
             )
         if when.after.event == ev.name:
             raise w.problem("an event cannot follow itself", (*at, "event"), hint="use `repeat: true`")
@@ -223,7 +245,10 @@ def _when(w: _World, ev: Event, here: PathKey, names: list[str]) -> dict[str, An
     name = when.assertion.assertion
     if name not in w.assertions:
         raise w.problem(
-            f"no assertion named {name!r}", (*at, "assertion"), expected=_choices(w.assertions, "assertions")
+            f"no assertion named {name!r}",
+            (*at, "assertion"),
+            expected=_choices(w.assertions, "assertions"),
+            hint=did_you_mean(name, w.assertions, "assertions"),
         )
     return {
         "kind": "assertion",
@@ -268,7 +293,10 @@ def _action(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
         names = [a.name for a in w.actors]
         if name not in names:
             raise w.problem(
-                f"no actor named {name!r}", at, expected=_choices(names, "actors (`world.actors`)")
+                f"no actor named {name!r}",
+                at,
+                expected=_choices(names, "actors (`world.actors`)"),
+                hint=did_you_mean(name, names, "actors (`world.actors`)"),
             )
         return {"kind": kind, "actor": names.index(name), "name": name}
     if act.teleport is not None:
@@ -280,7 +308,9 @@ def _action(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
         target = w.ref(body, (*at, "body"), moving=True)
         if "actor" in target:
             raise w.problem(
-                f"{body!r} is an actor: it goes where its path says, forces do not move it", (*at, "body")
+                f"{body!r} is an actor: it goes where its path says, forces do not move it",
+                (*at, "body"),
+                hint="`teleport` or `stop` an actor; push a robot or a free model",
             )
         if act.push is not None:
             p = act.push
@@ -326,7 +356,11 @@ def _publish(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
     wanted = w.taken.get(key)
     if wanted is not None and msgs.normalize_type(wanted) != type_name:
         raise w.problem(
-            f"{p.topic} is taken by the world as {wanted}", (*at, "type"), expected=wanted, found=type_name
+            f"{p.topic} is taken by the world as {wanted}",
+            (*at, "type"),
+            expected=wanted,
+            found=type_name,
+            hint=f"publish a {wanted} there",
         )
     return {"kind": "publish", "key": key, "type": type_name, "data": p.data}
 
@@ -336,7 +370,12 @@ def _set_param(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
     assert s is not None
     robots = [r.name for r in w.robots]
     if s.robot not in robots:
-        raise w.problem(f"no robot named {s.robot!r}", (*at, "robot"), expected=_choices(robots, "robots"))
+        raise w.problem(
+            f"no robot named {s.robot!r}",
+            (*at, "robot"),
+            expected=_choices(robots, "robots"),
+            hint=did_you_mean(s.robot, robots, "robots"),
+        )
     index = sum(len(r.plugins) for r in w.robots[: robots.index(s.robot)])
     robot = w.robots[robots.index(s.robot)]
     plugins = [p.name for p in robot.plugins]
@@ -345,6 +384,7 @@ def _set_param(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
             f"robot {s.robot!r} has no plugin named {s.plugin!r}",
             (*at, "plugin"),
             expected=_choices(plugins, "plugins"),
+            hint=did_you_mean(s.plugin, plugins, f"plugins of {s.robot!r}"),
         )
     pp = robot.plugins[plugins.index(s.plugin)]
     cls = load(pp.type)
@@ -363,7 +403,12 @@ def _set_param(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
         cls.Params.model_validate({**pp.params, s.param: s.value})
     except ValidationError as e:
         first = e.errors()[0]
-        raise w.problem(f"{s.param}: {first['msg']}", (*at, "value"), found=repr(s.value)) from None
+        raise w.problem(
+            f"{s.param}: {first['msg']}",
+            (*at, "value"),
+            found=repr(s.value),
+            hint=f"give a value the {pp.type} plugin's `{s.param}` takes, as in its `params:`",
+        ) from None
     return {
         "kind": "set",
         "plugin": index + plugins.index(s.plugin),
@@ -381,7 +426,9 @@ def _check_noise_fields(w: _World, fields: list[str], type_name: str, where: Pat
             check_fields(compile_expr(f"{name} == {name}"), type_name)
         except ExprError as e:
             raise w.problem(
-                f"{type_name} has no field {name!r}: {getattr(e, 'message', e)}", (*where, k)
+                f"{type_name} has no field {name!r}: {getattr(e, 'message', e)}",
+                (*where, k),
+                hint=e.hint or "a field path of the message, such as pose.pose.position.x",
             ) from None
 
 
@@ -392,18 +439,26 @@ def _joint(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
     robot = robots.get(ref.robot)
     if robot is None:
         raise w.problem(
-            f"no robot named {ref.robot!r}", (*at, "robot"), expected=_choices(set(robots), "robots")
+            f"no robot named {ref.robot!r}",
+            (*at, "robot"),
+            expected=_choices(set(robots), "robots"),
+            hint=did_you_mean(ref.robot, robots, "robots"),
         )
     if ref.joint not in robot.joints:
         raise w.problem(
             f"robot {ref.robot!r} has no joint {ref.joint!r}",
             (*at, "joint"),
             expected=_choices(robot.joints, "joints"),
+            hint=did_you_mean(ref.joint, robot.joints, f"joints of {ref.robot!r}"),
         )
     name = f"{robot.prefix}{ref.joint}"
     jid = mujoco.mj_name2id(w.model, mujoco.mjtObj.mjOBJ_JOINT, name)
     if jid < 0 or int(w.model.jnt_type[jid]) not in (2, 3):  # slide, hinge
-        raise w.problem(f"{ref.joint!r} is not a moving joint of the simulated robot", (*at, "joint"))
+        raise w.problem(
+            f"{ref.joint!r} is not a moving joint of the simulated robot",
+            (*at, "joint"),
+            hint="name a revolute, continuous or prismatic joint (fixed joints are merged away)",
+        )
     if act.cut is not None:
         m = w.model
         driven = [

@@ -41,6 +41,20 @@ def check_expr(expr: str, doc: Document, where: PathKey, written: str | None = N
         ) from None
 
 
+def _check_endpoints(endpoints: list[Any], listen: bool, doc: Document, where: PathKey) -> None:
+    """The endpoints of a `connect/endpoints` or `listen/endpoints` setting, which Zenoh takes as any text
+    and refuses only when the run opens them."""
+    from runner.scenario.schema.network import endpoint_error
+
+    for j, endpoint in enumerate(endpoints):
+        error = endpoint_error(str(endpoint), listen)
+        if error:
+            what, _, fix = error.partition(": write ")
+            raise ScenarioError(
+                Problem(what, doc.locate((*where, j)), (*where, j), found=repr(endpoint), hint=f"write {fix}")
+            )
+
+
 def zenoh_settings(sc: Scenario, doc: Document) -> dict[str, Any]:
     """`zenoh:` checked against Zenoh itself (each setting inserted into a config), paths made absolute."""
 
@@ -65,7 +79,12 @@ def zenoh_settings(sc: Scenario, doc: Document) -> dict[str, Any]:
             zenoh.Config.from_file(str(path))
         except Exception as e:
             raise ScenarioError(
-                Problem(f"Zenoh cannot read this configuration: {zenoh_reason(e)}", doc.locate(where), where)
+                Problem(
+                    f"Zenoh cannot read this configuration: {zenoh_reason(e)}",
+                    doc.locate(where),
+                    where,
+                    hint="a JSON5 file as `zenohd --config` takes; check the line Zenoh names",
+                )
             ) from None
         file = str(path.resolve())
     settings: dict[str, Any] = {}
@@ -85,6 +104,8 @@ def zenoh_settings(sc: Scenario, doc: Document) -> dict[str, Any]:
                     hint="a path in Zenoh's configuration, e.g. transport/link/tls/root_ca_certificate",
                 )
             ) from None
+        if key.strip("/") in ("connect/endpoints", "listen/endpoints") and isinstance(value, list):
+            _check_endpoints(value, key.startswith("listen"), doc, where)
         settings[key] = value
     for i, endpoint in enumerate(sc.zenoh.listen):
         if "/" not in endpoint:
@@ -95,6 +116,7 @@ def zenoh_settings(sc: Scenario, doc: Document) -> dict[str, Any]:
                     doc.locate(where),
                     where,
                     expected="<protocol>/<address>:<port>, e.g. tcp/127.0.0.1:7447 or tls/127.0.0.1:7447",
+                    hint="write it with its protocol, e.g. tcp/127.0.0.1:7447",
                 )
             )
     return {"file": file, "settings": settings}

@@ -117,7 +117,8 @@ def build_plugins(
                 except ValidationError as e:
                     err = e.errors(include_url=False)[0]
                     param = ".".join(str(x) for x in err["loc"]) or None
-                    raise fail(f"{err['msg']} (found {err.get('input')!r})", param, None) from None
+                    hint = f"give `{param}` a value the {entry.type} plugin takes" if param else None
+                    raise fail(f"{err['msg']} (found {err.get('input')!r})", param, hint) from None
             try:
                 topics = cls.build(params, ctx, entry.name)
             except PluginConfigError as e:
@@ -194,6 +195,7 @@ def _plugin_error(
     hint: str | None,
 ) -> ScenarioError:
     """Point at the scenario when it set the parameter, else at the description's line."""
+    hint = hint or "see the plugin's parameters in docs/plugins.md"
     src = entry.source
     if src is None or (entry.scenario_index is not None and (param is None or param in entry.scenario_keys)):
         where: PathKey = (*here, "params", param) if param else here

@@ -7,9 +7,9 @@ from pathlib import Path
 
 from runner.checks.judge import contacts_key
 from runner.compile.network import check_expr, full_expr
-from runner.errors import Notices
+from runner.errors import Notices, Problem, ScenarioError
 from runner.plan import RecordPlan, RunPlan
-from runner.scenario.loader import Document
+from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import Record, Scenario
 from runner.wire.transport import hidden_topic, topic_key
 
@@ -24,6 +24,8 @@ def record_plan(sc: Scenario, doc: Document, record_path: str | None) -> RecordP
             path = path / f"{sc.name}.mcap"
     else:
         path = Path("runs") / f"{sc.name}.mcap"
+    if rec.enabled and rec.path is not None and record_path is None:
+        _check_writable(path, doc)
     record = RecordPlan(
         enabled=rec.enabled,
         path=str(path),
@@ -33,6 +35,44 @@ def record_plan(sc: Scenario, doc: Document, record_path: str | None) -> RecordP
     )
     _check_key_exprs(record, doc, rec)
     return record
+
+
+def _check_writable(path: Path, doc: Document) -> None:
+    """The recording can be made where `record.path` says: the file, if it is there, can be written, and
+    its folder can be made in the nearest folder that exists. Checked with `os.access` (nothing is
+    written, `validate` leaves no trace), so that a path the run would refuse at its start is said at its
+    line now."""
+    import os
+
+    where: PathKey = ("record", "path")
+    problem = None
+    if path.exists() and not path.is_file():
+        problem = ("is not a file", "give a file name ending in .mcap, or a folder ending in '/'")
+    elif path.is_file():
+        if not os.access(path, os.W_OK):
+            problem = ("cannot be written (no permission)", "choose another file, or change its permissions")
+    else:
+        ancestor = path.parent
+        while not ancestor.exists() and ancestor != ancestor.parent:
+            ancestor = ancestor.parent
+        if not ancestor.is_dir():
+            problem = (
+                f"cannot be made: {str(ancestor)!r} is a file, not a folder",
+                "choose a path whose folders are folders (or can be made)",
+            )
+        elif not os.access(ancestor, os.W_OK | os.X_OK):
+            made = "" if ancestor == path.parent else f" (to make {str(path.parent)!r})"
+            problem = (
+                f"cannot be written: no permission to write in {str(ancestor)!r}{made}",
+                "choose a folder you can write to, or record with `scenario run --record PATH`",
+            )
+    if problem is not None:
+        what, hint = problem
+        raise ScenarioError(
+            Problem(
+                f"the recording {str(path)!r} {what}", doc.locate(where), where, found=str(path), hint=hint
+            )
+        )
 
 
 def _check_key_exprs(record: RecordPlan, doc: Document, given: Record | None = None) -> None:

@@ -17,7 +17,7 @@ from runner.compile.plugins import build_plugins
 from runner.compile.urdf import RobotModel, urdf_to_model
 from runner.compile.wheels import anisotropic_wheels, wheel_links
 from runner.compile.xacro_expand import expand
-from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError
+from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError, missing_file_hint
 from runner.geometry import rpy_to_quat
 from runner.plan import RobotPlan
 from runner.scenario.loader import Document, PathKey
@@ -106,6 +106,7 @@ def _needs_file(path: Path, doc: Document, where: PathKey, what: str, kind: str)
                 where,
                 expected=f"{kind} (relative to the scenario's folder)",
                 found=str(path),
+                hint=missing_file_hint(path),
             )
         )
 

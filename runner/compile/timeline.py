@@ -36,7 +36,7 @@ def message_type(type_text: str, doc: Document, where: PathKey) -> str:
                 doc.locate(where),
                 where,
                 expected="a ROS 2 message type such as geometry_msgs/msg/Twist",
-                hint=f"did you mean {close[0]!r}?" if close else None,
+                hint=f"did you mean {close[0]!r}?" if close else "write it as <package>/msg/<Name>",
             )
         )
     return type_name
@@ -50,7 +50,9 @@ def message_of(type_text: str, data: dict[str, Any], doc: Document, here: PathKe
         msg = msgs.from_data(type_name, data)
     except msgs.MessageDataError as e:
         where: PathKey = (*here, "data", *e.path)
-        raise ScenarioError(Problem(str(e), doc.locate(where), where, hint=e.hint)) from None
+        raise ScenarioError(
+            Problem(str(e), doc.locate(where), where, hint=e.hint or _data_hint(str(e)))
+        ) from None
     bad = msgs.nonfinite(msg, type_name)
     if bad is not None:
         # (YAML's .nan, .inf, -.inf: the plan's JSON would carry them as null, a silent 0.0 in the world,
@@ -71,6 +73,31 @@ def message_of(type_text: str, data: dict[str, Any], doc: Document, here: PathKe
             )
         )
     return type_name
+
+
+# What to write instead, by how msgs.from_data's message starts (its errors say what was found, not the fix).
+_DATA_HINTS = {
+    "expected a number": "write a plain number (SI units), without quotes",
+    "expected an integer": "write a whole number, without quotes",
+    "expected true or false": "write true or false, without quotes",
+    "expected a string": "quote it: '...'",
+    "expected a list": "write a list: [a, b, c]",
+    "expected a mapping": "give the fields as a mapping: {x: 1.0, y: 0.0}",
+}
+
+
+def _data_hint(message: str) -> str:
+    """A hint for a message-data error that has none of its own."""
+    for start, hint in _DATA_HINTS.items():
+        if message.startswith(start):
+            return hint
+    if "out of range" in message:
+        return "give a value within the range"
+    if "items, found" in message:
+        return "give exactly as many items as the field holds"
+    if "has no field" in message:
+        return "remove it, or write one of the fields listed"
+    return "each field takes the type of its message definition (`ros2 interface show <type>`)"
 
 
 def timeline_entry(sc: Scenario, i: int, doc: Document) -> TimelinePlan:

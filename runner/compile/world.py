@@ -20,7 +20,7 @@ from runner.compile.sanity import check_start_overlaps
 from runner.compile.sdf import load_sdf_world
 from runner.compile.timeline import compile_timeline
 from runner.compile.wheels import check_geometry
-from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError
+from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError, missing_file_hint
 from runner.geometry import rpy_to_quat
 from runner.plan import NodePlan, RecordPlan, RobotPlan, RunPlan
 from runner.scenario.loader import Document, PathKey
@@ -209,12 +209,16 @@ def _compile_problem(e: ValueError, sc: Scenario, doc: Document, world: mujoco.M
     for i, m_ in enumerate(sc.world.models):
         if element == m_.name:
             where = ("world", "models", i)
-            return Problem(f"MuJoCo cannot compile model {m_.name!r}: {first}", doc.locate(where), where)
+            hint = "check the model's size, mass and pose: positive sizes, a positive mass if it moves"
+            return Problem(
+                f"MuJoCo cannot compile model {m_.name!r}: {first}", doc.locate(where), where, hint=hint
+            )
     where = ("world", "sdf") if sc.world.sdf else ("robots",)
     return Problem(
         f"MuJoCo cannot compile the world: {first}" + (f" (at {element!r})" if element else ""),
         doc.locate(where),
         where,
+        hint="MuJoCo's message names the element it refused; check its sizes, masses and names",
     )
 
 
@@ -275,6 +279,9 @@ def _load_sdf(
                 ("world", "sdf"),
                 expected="an SDF or .world file (relative to the scenario's folder)",
                 found=str(path),
+                hint=missing_file_hint(path)
+                if not path.is_dir()
+                else "name the .sdf or .world file in it: world: {sdf: <folder>/<file>.world}",
             )
         )
     try:

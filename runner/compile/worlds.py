@@ -14,7 +14,7 @@ from typing import Any
 from runner.compile.nodes import compile_nodes
 from runner.compile.record import record_plan
 from runner.compile.world import compile_world
-from runner.errors import Notices, Problem, Problems, ScenarioError
+from runner.errors import Notices, Problem, Problems, ScenarioError, closest, did_you_mean
 from runner.plan import NodePlan, RunPlan
 from runner.scenario.loader import Document, MappedDocument, PathKey
 from runner.scenario.schema import NoCollision, Scenario, World
@@ -173,7 +173,10 @@ def _place(sc: Scenario, doc: Document) -> _Placement:
         if name in names[:i]:
             problems.append(
                 Problem(
-                    f"two worlds named {name!r}", doc.locate(("worlds", i, "name")), ("worlds", i, "name")
+                    f"two worlds named {name!r}",
+                    doc.locate(("worlds", i, "name")),
+                    ("worlds", i, "name"),
+                    hint="give each a `name:` of its own (its topics start with it)",
                 )
             )
     expected = "one of: " + ", ".join(names)
@@ -182,7 +185,15 @@ def _place(sc: Scenario, doc: Document) -> _Placement:
         w = robot.world or names[0]
         if w not in names:
             where: PathKey = ("robots", i, "world")
-            problems.append(Problem(f"no world named {w!r}", doc.locate(where), where, expected=expected))
+            problems.append(
+                Problem(
+                    f"no world named {w!r}",
+                    doc.locate(where),
+                    where,
+                    expected=expected,
+                    hint=did_you_mean(w, names, "worlds"),
+                )
+            )
         robot_world[robot.name] = w
     timeline_world = [_timeline_world(sc, doc, i, names, problems) for i in range(len(sc.timeline))]
     models = {w.name: {m.name for m in w.models} for w in sc.worlds}
@@ -198,11 +209,29 @@ def _place(sc: Scenario, doc: Document) -> _Placement:
         w = node.world or by_ns or names[0]
         if w not in names:
             where = ("nodes", i, "world")
-            problems.append(Problem(f"no world named {w!r}", doc.locate(where), where, expected=expected))
+            problems.append(
+                Problem(
+                    f"no world named {w!r}",
+                    doc.locate(where),
+                    where,
+                    expected=expected,
+                    hint=did_you_mean(w, names, "worlds"),
+                )
+            )
         node_world[node.name] = w
     if problems:
         raise ScenarioError(problems)
     return _Placement(names, robot_world, timeline_world, assertion_world, node_world)
+
+
+def _topic_hint(first: str, names: list[str]) -> str:
+    """What to write for a topic of several worlds whose first part is not a world's name."""
+    if first in names:
+        return f"add the topic after the world's name: {first}/r1/cmd_vel"
+    near = closest(first, names)
+    if near is not None:
+        return f"did you mean {near!r}? a topic starts with its world's name"
+    return "start the topic with its world's name: " + ", ".join(names)
 
 
 def _timeline_world(sc: Scenario, doc: Document, i: int, names: list[str], problems: list[Problem]) -> str:
@@ -217,6 +246,7 @@ def _timeline_world(sc: Scenario, doc: Document, i: int, names: list[str], probl
                 doc.locate(where),
                 where,
                 expected=f"a topic starting with its world: {names[0]}/r1/cmd_vel",
+                hint=_topic_hint(w, names),
             )
         )
     return w
@@ -238,7 +268,14 @@ def _assertion_world(
         w = robot_world.get(a.robot)
         if w is None:
             where: PathKey = ("assertions", i, "robot")
-            problems.append(Problem(f"no robot named {a.robot!r}", doc.locate(where), where))
+            problems.append(
+                Problem(
+                    f"no robot named {a.robot!r}",
+                    doc.locate(where),
+                    where,
+                    hint=did_you_mean(a.robot, robot_world, "robots"),
+                )
+            )
     elif a.type in _TOPIC_KINDS:
         w, rest = _split_topic(a.topic)
         if w not in names or not rest:
@@ -249,6 +286,7 @@ def _assertion_world(
                     doc.locate(where),
                     where,
                     expected=f"a topic starting with its world: {names[0]}/r1/scan",
+                    hint=_topic_hint(w, names),
                 )
             )
             w = None
@@ -265,6 +303,7 @@ def _assertion_world(
                     doc.locate(where),
                     where,
                     expected="robots and models of one world",
+                    hint="name a robot (or model) of each side's world; worlds do not touch each other",
                 )
             )
     return w

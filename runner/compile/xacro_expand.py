@@ -25,7 +25,7 @@ import xacro.substitution_args as _sa
 
 from runner.compile.packages import PackageMap
 from runner.compile.xacro_sandbox import Sandbox, SandboxError
-from runner.errors import SourceError
+from runner.errors import SourceError, did_you_mean
 
 
 class XacroError(SourceError):
@@ -211,7 +211,7 @@ def _xacro_error(e: Exception, path: Path) -> XacroError:
             hint="a macro that calls itself needs an <xacro:if> that stops it",
         )
     file, line = _locate_message(message, file, sources)
-    return XacroError(message, file, line, hint=_hint(message))
+    return XacroError(message, file, line, hint=_hint(message) or _other_hint(message, sources))
 
 
 def _causes(e: BaseException) -> list[BaseException]:
@@ -376,3 +376,21 @@ def _hint(message: str) -> str | None:
     if "No such file" in message or "not found" in message:
         return "check the include's path; $(find pkg) and relative paths are resolved from the including file"
     return None
+
+
+def _other_hint(message: str, sources: list[Path]) -> str:
+    """A hint for what `_hint` has none for: an unknown macro with the defined one closest to it."""
+    import re
+
+    m = re.match(r"unknown macro name:?\s*(?:xacro:)?(\S+)", message)
+    if m:
+        defined = []
+        for src in sources:
+            try:
+                defined += re.findall(r"<xacro:macro\s+name=[\"']([^\"']+)", src.read_text(errors="replace"))
+            except OSError:
+                continue
+        return did_you_mean(m.group(1), defined, "macros defined") + (
+            " (a macro is called after its <xacro:macro>, in this file or one it includes)"
+        )
+    return "xacro stopped at this line: check the element's attributes and the ${...} in it"

@@ -23,6 +23,7 @@ import mujoco
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat
 
+from runner.errors import closest
 from runner.plugin.handle import RobotHandle
 
 if TYPE_CHECKING:
@@ -85,7 +86,9 @@ class BuildContext:
         body = self.spec.body(name) if name else None
         if body is None:
             raise PluginConfigError(
-                f"robot {self.robot!r} has no link {name!r}", param, hint="links: " + ", ".join(self.links)
+                f"robot {self.robot!r} has no link {name!r}",
+                param,
+                hint=_names_hint(name, self.links, "links"),
             )
         return body
 
@@ -94,9 +97,17 @@ class BuildContext:
         if joint is None:
             movable = [j.name for j in self.spec.joints if j.name and j.type != mujoco.mjtJoint.mjJNT_FREE]
             raise PluginConfigError(
-                f"robot {self.robot!r} has no joint {name!r}", param, hint="joints: " + ", ".join(movable)
+                f"robot {self.robot!r} has no joint {name!r}",
+                param,
+                hint=_names_hint(name, movable, "joints"),
             )
         return joint
+
+
+def _names_hint(name: str, names: list[str], what: str) -> str:
+    """The one of `names` closest to `name` ("did you mean"), then all of them: what a plugin may name."""
+    near = closest(name, names) if name else None
+    return (f"did you mean {near!r}? " if near else "") + f"{what}: " + ", ".join(names)
 
 
 class Publisher:

@@ -10,6 +10,7 @@ from functools import cache
 from importlib.metadata import EntryPoint, entry_points
 from typing import Any
 
+from runner.errors import closest
 from runner.plugin import Plugin
 
 GROUP = "scenario.plugins"
@@ -37,10 +38,8 @@ def available() -> list[str]:
 def load(name: str) -> type[Plugin]:
     eps = _entry_points().get(name)
     if not eps:
-        import difflib
-
-        close = difflib.get_close_matches(name, available(), n=1)
-        hint = f"did you mean {close[0]!r}? " if close else ""
+        near = closest(name, available())
+        hint = f"did you mean {near!r}? " if near else ""
         raise PluginLookupError(
             f"unknown plugin type {name!r}",
             hint=hint + "installed plugins: " + ", ".join(available()),

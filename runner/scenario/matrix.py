@@ -168,7 +168,13 @@ def _matrix(doc: Document) -> tuple[list[tuple[str, tuple[str | int, ...]]], int
             )
         elif not isinstance(values, list) or not values:
             problems.append(
-                Problem("expected a non-empty list of values", doc.locate(where), where, found=repr(values))
+                Problem(
+                    "expected a non-empty list of values",
+                    doc.locate(where),
+                    where,
+                    found=repr(values),
+                    hint="give the values to try as a list: `robots[0].pose.xyz: [[0, 0, 0], [1, 0, 0]]`",
+                )
             )
         else:
             paths.append((str(key), path))

@@ -367,7 +367,8 @@ def _with_hint(problem: Problem, value: Any) -> Problem:
             else (f"use one of: {', '.join(options)}" if options else None)
         )
     if hint is None and expected:
-        hint = f"give {expected}"
+        # pydantic's bounds ("greater than 0") are of a number: say so
+        hint = f"give a number {expected}" if expected.startswith(("greater", "less")) else f"give {expected}"
     if hint is None:
         hint = "see the scenario's JSON schema (`scenario schema`) for what this key takes"
     return dataclasses.replace(problem, hint=hint)

@@ -125,6 +125,22 @@ def _infer(expr: Expr, node: ast.AST, kinds: dict[int, str]) -> str:
     raise AssertionError(f"unchecked node {ast.dump(node)}")  # pragma: no cover
 
 
+# What to do, by what check_fields found (its messages say what is wrong; these, what to write instead)
+_HINTS = {
+    " is not a known type": "give a ROS 2 type such as nav_msgs/msg/Odometry",
+    "; it has no field ": "only a message has fields: compare this value itself",
+    " is out of range: ": "an index counts from 0 (or from -1 back from the end) within the array's length",
+    " cannot be indexed; ": "only arrays, sequences and strings take an index [i]",
+    "len() needs ": "len() counts the items of a sequence field, such as len(ranges)",
+    "() needs a sequence of numbers": "a reducer takes a sequence of numbers: ranges.min(), ranges.mean()",
+    ", not a value; ": "read one of its fields, e.g. pose.position.x rather than pose.position",
+}
+
+
+def _hint(message: str) -> str | None:
+    return next((hint for part, hint in _HINTS.items() if part in message), None)
+
+
 def check_fields(expr: Expr, type_name: str, condition: bool = True) -> None:
     """Check `expr` against the message type `type_name` (e.g. `nav_msgs/msg/Odometry`) without a message:
     every field must exist, indexes must follow a sequence (and fit a fixed-size array), reducers need a
@@ -137,10 +153,10 @@ def check_fields(expr: Expr, type_name: str, condition: bool = True) -> None:
 
     type_name = normalize_type(type_name)
     if type_name not in TYPESTORE.fielddefs:
-        raise ExprError(f"unknown message type {type_name!r}", None, None, expr.text)
+        raise ExprError(f"unknown message type {type_name!r}", None, _hint(" is not a known type"), expr.text)
 
     def fail(message: str, column: int | None, hint: str | None = None) -> None:
-        raise ExprError(message, column, hint, expr.text)
+        raise ExprError(message, column, hint or _hint(message), expr.text)
 
     kinds: dict[int, str] = {}
     for p in expr._paths:
@@ -158,7 +174,7 @@ def check_fields(expr: Expr, type_name: str, condition: bool = True) -> None:
                             f"'{shown + '.' if shown else ''}{seg}': {where} has no field {seg!r}; "
                             f"fields: {', '.join(names)}",
                             col,
-                            did_you_mean(seg, names),
+                            did_you_mean(seg, names) or "use one of the fields listed",
                         )
                     cur = dict(fields)[seg]
                 elif node in (Nodetype.ARRAY, Nodetype.SEQUENCE):

@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import ast
 import dataclasses
-import difflib
 import operator
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+
+from runner.errors import closest
 
 REDUCERS = ("min", "max", "mean", "sum", "std")
 FUNCTIONS = ("abs", "len", "min", "max")
@@ -182,5 +183,5 @@ ARRAY_HINT = "reduce a sequence to one value first: ranges.min() > 0.25, not ran
 def did_you_mean(name: str, names: list[str]) -> str | None:
     if name in ("true", "false"):
         return "booleans are written True and False"
-    close = difflib.get_close_matches(name, names, n=1)
-    return f"did you mean {close[0]!r}?" if close else None
+    near = closest(name, names)
+    return f"did you mean {near!r}?" if near else None

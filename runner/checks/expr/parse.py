@@ -22,6 +22,7 @@ from runner.checks.expr.language import (
     index_value,
     is_path,
 )
+from runner.errors import closest
 
 _IDENTIFIER = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 
@@ -41,6 +42,24 @@ _OTHER_CMPOPS: dict[type[ast.cmpop], str] = {
     ast.NotIn: "not in",
     ast.Is: "is",
     ast.IsNot: "is not",
+}
+
+_ONE_CONDITION = "an expression is one condition on the message's fields, e.g. ranges.min() > 0.25"
+
+# What to write instead of an operator or comparison the language refuses.
+_INSTEAD: dict[str, str] = {
+    "**": "write x * x (powers are not in the language)",
+    "//": "write / (division), and compare instead of rounding",
+    "@": "write * for a product of numbers",
+    "<<": "did you mean '<'?",
+    ">>": "did you mean '>'?",
+    "&": "write `and`",
+    "|": "write `or`",
+    "^": "write `!=` for 'one but not the other' of two conditions",
+    "in": "compare with == (joined with `or` for several values)",
+    "not in": "compare with != (joined with `and` for several values)",
+    "is": "write ==",
+    "is not": "write !=",
 }
 
 # Node kinds refused outright: what the message calls them, and a hint.
@@ -81,7 +100,12 @@ class _Checker:
         raise ExprError(message, column, hint, self.s.text)
 
     def refuse(self, what: str, node: ast.AST, hint: str | None = None, column: int | None = None):
-        self.fail(f"{what} is not allowed in an expression; allowed: {ALLOWED}", node, hint, column)
+        self.fail(
+            f"{what} is not allowed in an expression; allowed: {ALLOWED}",
+            node,
+            hint or _ONE_CONDITION,
+            column,
+        )
 
     def check(self, node: ast.AST, depth: int = 0) -> None:
         if depth > MAX_DEPTH:
@@ -94,7 +118,11 @@ class _Checker:
                 self.check(v, d)
         elif isinstance(node, ast.UnaryOp):
             if isinstance(node.op, ast.Invert):
-                self.fail("the operator '~' is not allowed; unary operators are -, + and not", node)
+                self.fail(
+                    "the operator '~' is not allowed; unary operators are -, + and not",
+                    node,
+                    hint="write `not`",
+                )
             self.check(node.operand, d)
         elif isinstance(node, ast.BinOp):
             op = type(node.op)
@@ -103,6 +131,7 @@ class _Checker:
                 self.fail(
                     f"the operator '{sym}' is not allowed; arithmetic is limited to + - * / %",
                     node,
+                    hint=_INSTEAD.get(sym),
                     column=self.s.between(node.left, node.right, sym),
                 )
             self.check(node.left, d)
@@ -115,6 +144,7 @@ class _Checker:
                     self.fail(
                         f"the comparison '{sym}' is not allowed; comparisons are < <= > >= == !=",
                         node,
+                        hint=_INSTEAD.get(sym),
                         column=self.s.between(left, right, sym),
                     )
                 left = right
@@ -127,7 +157,11 @@ class _Checker:
                 kind = {type(None): "None", bytes: "a bytes literal", complex: "a complex number"}.get(
                     type(v), repr(v)
                 )
-                self.fail(f"{kind} is not allowed; constants are numbers, strings and True/False", node)
+                self.fail(
+                    f"{kind} is not allowed; constants are numbers, strings and True/False",
+                    node,
+                    hint="compare with a number or a string: frame_id == 'map', len(ranges) > 0",
+                )
         elif is_path(node):
             self.path(node, "value", d)
         elif isinstance(node, ast.Call):
@@ -179,9 +213,17 @@ class _Checker:
 
     def name(self, name: str, node: ast.AST) -> None:
         if name.startswith("_"):
-            self.fail(f"names starting with '_' are not allowed; found {name!r}", node)
+            self.fail(
+                f"names starting with '_' are not allowed; found {name!r}",
+                node,
+                hint="read message fields: pose.pose.position.x",
+            )
         if not _IDENTIFIER.match(name):
-            self.fail(f"field names are plain ASCII identifiers (letters, digits, '_'); found {name!r}", node)
+            self.fail(
+                f"field names are plain ASCII identifiers (letters, digits, '_'); found {name!r}",
+                node,
+                hint="write the field's name as its message definition does: ranges, pose.position.x",
+            )
 
     def attr_name(self, node: ast.Attribute) -> None:
         if node.attr.startswith("_"):
@@ -220,36 +262,65 @@ class _Checker:
             if func.attr.startswith("_"):
                 self.attr_name(func)
             if func.attr not in REDUCERS:
+                near = closest(func.attr, REDUCERS)
                 self.fail(
                     f"calls are limited to {CALLS_ALLOWED}; found a call to '.{func.attr}()'",
                     node,
+                    hint=f"did you mean '.{near}()'?" if near else "reduce a sequence: ranges.min() > 0.25",
                     column=self.s.attr(func),
                 )
             shown = f".{func.attr}()"
         elif isinstance(func, ast.Name):
             if func.id not in FUNCTIONS:
-                self.fail(f"calls are limited to {CALLS_ALLOWED}; found a call to {func.id!r}", func)
+                near = closest(func.id, FUNCTIONS) or (f".{r}" if (r := closest(func.id, REDUCERS)) else None)
+                self.fail(
+                    f"calls are limited to {CALLS_ALLOWED}; found a call to {func.id!r}",
+                    func,
+                    hint=(
+                        f"did you mean {near.lstrip('.')!r}? (as a method: ranges{near}())"
+                        if near and near.startswith(".")
+                        else f"did you mean {near!r}?"
+                        if near
+                        else "functions: abs(x), len(seq), min/max(seq or a, b); reducers: .mean() .std()"
+                    ),
+                )
             shown = f"{func.id}()"
         else:
-            self.fail(f"calls are limited to {CALLS_ALLOWED}; found a call to {_what(func)}", func)
+            self.fail(
+                f"calls are limited to {CALLS_ALLOWED}; found a call to {_what(func)}",
+                func,
+                hint="call abs, len, min or max by name, or a reducer on a field: ranges.min()",
+            )
         for kw in node.keywords:
             found = f"'{kw.arg}='" if kw.arg else "'**'"
-            self.fail(f"{shown} takes no keyword arguments; found {found}", kw)
+            self.fail(
+                f"{shown} takes no keyword arguments; found {found}",
+                kw,
+                hint=f"write {shown} with plain arguments",
+            )
         for a in node.args:
             if isinstance(a, ast.Starred):
-                self.fail(f"{shown} takes no starred arguments (*x)", a)
+                self.fail(
+                    f"{shown} takes no starred arguments (*x)",
+                    a,
+                    hint="give the sequence itself: max(ranges)",
+                )
         n = len(node.args)
         if isinstance(func, ast.Attribute):
             if n:
-                self.fail(f"{shown} takes no arguments; found {n}", node.args[0])
+                self.fail(f"{shown} takes no arguments; found {n}", node.args[0], hint=f"write ranges{shown}")
             self.operand(func.value, func.attr, depth)
         elif func.id in ("abs", "len"):  # type: ignore[union-attr]
             if n != 1:
-                self.fail(f"{shown} takes one argument; found {n}", node)
+                self.fail(f"{shown} takes one argument; found {n}", node, hint=f"e.g. {shown[:-2]}(ranges)")
             self.operand(node.args[0], "len" if func.id == "len" else "value", depth)  # type: ignore[union-attr]
         else:
             if n not in (1, 2):
-                self.fail(f"{shown} takes one argument (a sequence) or two (numbers); found {n}", node)
+                self.fail(
+                    f"{shown} takes one argument (a sequence) or two (numbers); found {n}",
+                    node,
+                    hint=f"{shown[:-2]}(ranges) or {shown[:-2]}(a, b); nest them for more",
+                )
             if n == 1:
                 self.operand(node.args[0], func.id, depth)  # type: ignore[union-attr]
             else:
@@ -277,21 +348,32 @@ def _syntax_error(e: SyntaxError, source: Source) -> ExprError:
     text = source.text
     if not text.strip():
         return ExprError(
-            "the expression is empty; write a condition such as ranges.min() > 0.25", None, None, text
+            "the expression is empty",
+            None,
+            "write a condition such as ranges.min() > 0.25",
+            text,
         )
     # SyntaxError.offset counts characters from 1; 0 means "at the end of the text"
     col = source.shift + (e.offset if e.offset and e.offset > 0 else len(source.src.rstrip()) + 1)
     hint = None
     if re.match(r"\s*(import|from)\s", text):
         what = "an import statement is not allowed"
+        hint = _ONE_CONDITION
     elif ":=" in text:
         what = "an assignment (:=) is not allowed"
+        hint = "compare with == (an expression assigns nothing)"
     else:
         what = f"invalid expression ({e.msg or 'invalid syntax'})"
         if "&&" in text or "||" in text:
             hint = "write `and` and `or`"
         elif re.search(r"![^=]", text):
             hint = "write `not x` (and `!=` for 'not equal')"
+        elif re.search(r"(?<![<>=!])=(?!=)", text):
+            hint = "compare with == (a single = assigns)"
+        elif text.count("(") != text.count(")") or text.count("[") != text.count("]"):
+            hint = "close every ( and [ you open"
+        else:
+            hint = "a condition such as ranges.min() > 0.25 and abs(twist.twist.linear.x) < 0.5"
     return ExprError(f"{what}; allowed: {ALLOWED}", col, hint, text)
 
 

@@ -26,7 +26,10 @@ def run_controllers(g: ReaderBase, path: Path, where: Where) -> int:
     try:
         text = path.read_text()
     except OSError as e:
-        raise SourceError(f"controllers file {str(path)!r} cannot be read: {e.strerror or e}", path) from None
+        hint = "check the path (`controllers:` in the scenario, or the description's <parameters>)"
+        raise SourceError(
+            f"controllers file {str(path)!r} cannot be read: {e.strerror or e}", path, hint=hint
+        ) from None
     # `<rosparam subst_value="true">` substitutes launch arguments in such files: with none given here,
     # each `$(arg name)` is empty (the usual default of a `prefix`), and said
     args = sorted(set(_LAUNCH_ARG.findall(text)))
@@ -46,6 +49,7 @@ def run_controllers(g: ReaderBase, path: Path, where: Where) -> int:
             f"controllers file {str(path)!r} is not valid YAML: {getattr(e, 'problem', e)}",
             path,
             mark.line + 1 if mark else None,
+            hint="check the indentation and the `:` after each key at this line",
         ) from None
     entries, update_rate = _controller_entries(doc)
     ros1 = not _ros_parameters(doc)

@@ -12,7 +12,21 @@ from runner.compile.sdf.geometry import GREY
 from runner.compile.sdf.parts import Collected, Joint, Link
 from runner.compile.sdf.pose import IDENTITY, rotate, unit
 from runner.compile.sdf.reader import Reader
+from runner.errors import did_you_mean
 from runner.plugin import PIECES_GROUP, RAY_GROUP
+
+# The joint types of SDF (sdformat's joint.sdf), for a "did you mean" on a misspelt one.
+_SDF_JOINTS = (
+    "ball",
+    "continuous",
+    "fixed",
+    "gearbox",
+    "prismatic",
+    "revolute",
+    "revolute2",
+    "screw",
+    "universal",
+)
 
 
 class BodyBuilder(Reader):
@@ -27,6 +41,9 @@ class BodyBuilder(Reader):
                     f"joint type {j.type!r} (joint {j.name!r}) is not supported; its links are held fixed",
                     j.src,
                     j.el,
+                    hint=did_you_mean(j.type, _SDF_JOINTS, "SDF joint types")
+                    if j.type not in _SDF_JOINTS
+                    else "supported: fixed, revolute, continuous, prismatic, ball",
                 )
                 j.type = "fixed"
             if j.child.static:
@@ -92,10 +109,17 @@ class BodyBuilder(Reader):
         self.check(axis_el, src, {"xyz", "limit", "dynamics", "use_parent_model_frame"})
         xyz_el = axis_el.find("xyz")
         if xyz_el is None:
-            raise self.error(f"the <axis> of joint {j.name!r} has no <xyz>", src, axis_el)
+            raise self.error(
+                f"the <axis> of joint {j.name!r} has no <xyz>", src, axis_el, hint="e.g. <xyz>0 0 1</xyz>"
+            )
         axis = unit(self.floats(xyz_el, src, 3))
         if axis is None:
-            raise self.error(f"the axis of joint {j.name!r} is zero", src, xyz_el)
+            raise self.error(
+                f"the axis of joint {j.name!r} is zero",
+                src,
+                xyz_el,
+                hint="give the direction it turns or slides about, e.g. <xyz>0 0 1</xyz>",
+            )
         # Which frame the axis is expressed in: 1.4 the model; 1.5/1.6 the joint unless
         # use_parent_model_frame; 1.7+ `expressed_in`.
         expressed = xyz_el.get("expressed_in")

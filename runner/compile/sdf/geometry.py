@@ -44,7 +44,12 @@ class GeometryReader(Reader):
             self.note(f"{kind} pose relative_to {rel!r} is taken relative to its link", src, pel)
         g = el.find("geometry")
         if g is None:
-            raise self.error(f"a <{kind}> of link {link.body!r} has no <geometry>", src, el)
+            raise self.error(
+                f"a <{kind}> of link {link.body!r} has no <geometry>",
+                src,
+                el,
+                hint="e.g. <geometry><box><size>1 1 1</size></box></geometry>",
+            )
         what = f"{kind} {el.get('name') or kind!r} of {link.body!r}"
         self.last_pieces = None
         kw = self.shape(g, src, link, local, visual, what)
@@ -126,7 +131,10 @@ class GeometryReader(Reader):
             length = self.child_float(s, "length", src) * sz
             if r <= 0 or length <= 0:
                 raise self.error(
-                    f"a <cone> needs a positive radius and length, found {r} and {length}", src, s
+                    f"a <cone> needs a positive radius and length, found {r} and {length}",
+                    src,
+                    s,
+                    hint="give <radius> and <length> in metres, both above 0",
                 )
             return {"type": G.mjGEOM_MESH, "meshname": self.cone_mesh(r, length)}
         if s.tag == "sphere":
@@ -145,7 +153,9 @@ class GeometryReader(Reader):
         n_el = s.find("normal")
         normal = unit(self.floats(n_el, src, 3)) if n_el is not None else (0.0, 0.0, 1.0)
         if normal is None:
-            raise self.error("the <normal> of a plane is zero", src, n_el)
+            raise self.error(
+                "the <normal> of a plane is zero", src, n_el, hint="e.g. <normal>0 0 1</normal> for a floor"
+            )
         size_el = s.find("size")
         sx, sy = self.floats(size_el, src, 2) if size_el is not None else (1.0, 1.0)
         sx, sy = sx * link.scale[0], sy * link.scale[1]
@@ -252,7 +262,12 @@ class GeometryReader(Reader):
             try:
                 mask = int((mask_el.text or "").strip(), 0)
             except ValueError:
-                raise self.error("<collide_bitmask> must be an integer such as 0x01", src, mask_el) from None
+                raise self.error(
+                    "<collide_bitmask> must be an integer such as 0x01",
+                    src,
+                    mask_el,
+                    hint="write it in decimal (3) or hexadecimal (0x03)",
+                ) from None
             kw.update(contype=mask & 0xFFFFFFFF, conaffinity=mask & 0xFFFFFFFF)
         ode = ct.find("ode")
         if ode is None:

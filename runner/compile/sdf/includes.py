@@ -109,7 +109,9 @@ class IncludeReader(Reader):
             self.missing.append(e)
             return name or uri, None
         if file in self.stack:
-            raise self.error(f"include {uri!r} includes itself", src, uri_el)
+            raise self.error(
+                f"include {uri!r} includes itself", src, uri_el, hint="an <include> names another model"
+            )
         root, inc_src = self.parse(file, (src, uri_el))
         model = root.find("model")
         if model is None:
@@ -124,7 +126,9 @@ class IncludeReader(Reader):
         try:
             model_name = name or model.get("name")
             if not model_name:
-                raise self.error("a <model> has no name", inc_src, model)
+                raise self.error(
+                    "a <model> has no name", inc_src, model, hint='give it one: <model name="table">'
+                )
             if top:
                 self.top_model(model, inc_src, parent, name=model_name, pose=pose, static=static)
                 return model_name, None
@@ -189,7 +193,10 @@ class IncludeReader(Reader):
             if (folder / "model.sdf").is_file():
                 return folder / "model.sdf"
             raise self.error(
-                f"include {uri!r}: {folder} holds neither a model.config nor a model.sdf", src, at
+                f"include {uri!r}: {folder} holds neither a model.config nor a model.sdf",
+                src,
+                at,
+                hint="a model folder holds its model.config (naming its .sdf) or a model.sdf",
             )
         try:
             root = etree.parse(str(config), etree.XMLParser(remove_comments=True, no_network=True)).getroot()
@@ -199,7 +206,12 @@ class IncludeReader(Reader):
             parser = etree.XMLParser(remove_comments=True, no_network=True, recover=True)
             root = etree.parse(str(config), parser).getroot()
             if root is None:
-                raise SdfError(f"not well-formed XML: {e.msg}", config, e.lineno) from None
+                raise SdfError(
+                    f"not well-formed XML: {e.msg}",
+                    config,
+                    e.lineno,
+                    hint="check that every tag is closed and attribute values are quoted",
+                ) from None
             self.notices.add(
                 f"not well-formed XML ({e.msg}); read leniently, as Gazebo does", config, e.lineno
             )

@@ -10,6 +10,7 @@ from lxml import etree
 from runner.compile.sdf.parts import Collected, Joint, Link, Src
 from runner.compile.sdf.pose import IDENTITY, Pose
 from runner.compile.sdf.reader import Reader
+from runner.errors import closest
 
 
 class _Frames:
@@ -24,7 +25,8 @@ class _Frames:
             if ch.tag in ("link", "model", "frame", "joint"):
                 n = ch.get("name")
                 if not n:
-                    raise reader.error(f"a <{ch.tag}> of model {model!r} has no name", src, ch)
+                    hint = f'give it one: <{ch.tag} name="...">'
+                    raise reader.error(f"a <{ch.tag}> of model {model!r} has no name", src, ch, hint=hint)
                 self.entries.setdefault(n, ch)
         self.resolved: dict[str, Pose] = {}
         self.busy: set[str] = set()
@@ -142,7 +144,12 @@ class ModelReader(Reader):
             c = el.find(tag)
             ref = (c.text or "").strip() if c is not None else ""
             if not ref:
-                raise self.error(f"joint {jname!r} has no <{tag}>", src, el)
+                raise self.error(
+                    f"joint {jname!r} has no <{tag}>",
+                    src,
+                    el,
+                    hint=f"add <{tag}>link_name</{tag}> naming one of: " + ", ".join(links),
+                )
             if ref == "world" and tag == "parent":
                 ends.append(None)
                 continue
@@ -152,7 +159,9 @@ class ModelReader(Reader):
                     f"joint {jname!r} names {tag} link {ref!r}, which is not in model {model!r}",
                     src,
                     c,
-                    hint="links of the model: " + ", ".join(links),
+                    hint=(f"did you mean {near!r}? " if (near := closest(ref, links)) else "")
+                    + "links of the model: "
+                    + ", ".join(links),
                 )
             ends.append(links[ref])
         parent, child = ends

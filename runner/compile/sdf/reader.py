@@ -272,14 +272,21 @@ class Reader:
         path = path.resolve()
         if not path.is_file():
             if asked_by:
-                raise self.error(f"SDF file {str(path)!r} not found", asked_by[0], asked_by[1])
+                raise self.error(
+                    f"SDF file {str(path)!r} not found",
+                    asked_by[0],
+                    asked_by[1],
+                    hint="relative paths are resolved from the file that names it",
+                )
             raise SdfError(
                 f"SDF file {str(path)!r} not found", path, hint="paths are relative to the scenario"
             )
         try:
             data = _xml_bytes(path)
         except OSError as e:
-            raise SdfError(f"cannot read {str(path)!r}: {e.strerror or e}", path) from None
+            raise SdfError(
+                f"cannot read {str(path)!r}: {e.strerror or e}", path, hint="check the file's permissions"
+            ) from None
         parser = etree.XMLParser(
             remove_comments=True, remove_pis=True, resolve_entities=False, no_network=True
         )
@@ -336,7 +343,9 @@ class Reader:
         c = el.find(tag)
         if c is None:
             if default is None:
-                raise self.error(f"<{el.tag}> needs a <{tag}>", src, el)
+                raise self.error(
+                    f"<{el.tag}> needs a <{tag}>", src, el, hint=f"add <{tag}>...</{tag}> inside it"
+                )
             return default
         return self.floats(c, src, 1)[0]
 
@@ -346,7 +355,9 @@ class Reader:
             return None
         text = (c.text or "").strip().lower()
         if text not in ("true", "false", "1", "0"):
-            raise self.error(f"<{tag}> must be true or false, found {text!r}", src, c)
+            raise self.error(
+                f"<{tag}> must be true or false, found {text!r}", src, c, hint="write true, false, 1 or 0"
+            )
         return text in ("true", "1")
 
     def pose_of(self, el: etree._Element, src: Src) -> tuple[Pose, str | None, etree._Element | None]:
@@ -372,7 +383,7 @@ class Reader:
     def need(self, el: etree._Element, tag: str, src: Src) -> etree._Element:
         c = el.find(tag)
         if c is None:
-            raise self.error(f"<{el.tag}> needs a <{tag}>", src, el)
+            raise self.error(f"<{el.tag}> needs a <{tag}>", src, el, hint=f"add <{tag}>...</{tag}> inside it")
         return c
 
     def unique(self, kind: str, name: str) -> str:

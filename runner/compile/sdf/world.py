@@ -134,7 +134,12 @@ class WorldReader(Reader):
             if el is not None:
                 value = self.floats(el, src, 1)[0]
                 if value <= 0:
-                    raise self.error(f"<{tag}> must be positive, found {value}", src, el)
+                    raise self.error(
+                        f"<{tag}> must be positive, found {value}",
+                        src,
+                        el,
+                        hint="e.g. 0.001 (seconds) or 1.0",
+                    )
                 if tag == "max_step_size":
                     result.timestep = self.timestep = value
                 else:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from runner.errors import Notices, SourceError
+from runner.errors import Notices, SourceError, closest
 from runner.plan import ParityLine
 
 
@@ -91,7 +91,9 @@ def check_structure(root: Any, where: Any) -> str:
     for el in link_els:
         name = el.get("name")
         if not name:
-            raise DescriptionError("a <link> has no name", *where(el))
+            raise DescriptionError(
+                "a <link> has no name", *where(el), hint='give it one: <link name="base_link">'
+            )
         if name in links:
             raise DescriptionError(
                 f"link {name!r} is defined twice",
@@ -102,7 +104,11 @@ def check_structure(root: Any, where: Any) -> str:
     children: dict[str, str] = {}
     joint_lines: dict[str, Any] = {}
     for j in root.findall("joint"):
-        jname = j.get("name") or "?"
+        if not j.get("name"):
+            raise DescriptionError(
+                "a <joint> has no name", *where(j), hint='give it one: <joint name="wheel_joint" type="...">'
+            )
+        jname = j.get("name")
         if jname in joint_lines:
             first = where(joint_lines[jname])[1]
             raise DescriptionError(
@@ -113,24 +119,38 @@ def check_structure(root: Any, where: Any) -> str:
         joint_lines[jname] = j
         jtype = j.get("type")
         if jtype not in _JOINT_TYPES:
+            near = closest(jtype, _JOINT_TYPES) if jtype else None
             raise DescriptionError(
-                f"joint {jname!r} has type {jtype!r}",
+                f"joint {jname!r} has type {jtype!r}" if jtype else f"joint {jname!r} has no type",
                 *where(j),
-                hint="URDF joint types: " + ", ".join(sorted(_JOINT_TYPES)),
+                hint=(f"did you mean {near!r}? " if near else "")
+                + "URDF joint types: "
+                + ", ".join(sorted(_JOINT_TYPES)),
             )
         for tag in ("parent", "child"):
             el = j.find(tag)
             ref = el.get("link") if el is not None else None
+            if el is None or not ref:
+                raise DescriptionError(
+                    f"joint {jname!r} has no <{tag} link=...>"
+                    if el is None
+                    else f"its <{tag}> names no link",
+                    *where(j if el is None else el),
+                    hint=f'add <{tag} link="..."/> naming one of: ' + ", ".join(links),
+                )
             if ref not in links:
+                near = closest(ref, links)
                 raise DescriptionError(
                     f"joint {jname!r} names {tag} link {ref!r}, which is not defined",
-                    *where(j if el is None else el),
-                    hint="defined links: " + ", ".join(links),
+                    *where(el),
+                    hint=(f"did you mean {near!r}? " if near else "") + "defined links: " + ", ".join(links),
                 )
         child = j.find("child").get("link")
         if child in children:
             raise DescriptionError(
-                f"link {child!r} is the child of two joints ({children[child]!r} and {jname!r})", *where(j)
+                f"link {child!r} is the child of two joints ({children[child]!r} and {jname!r})",
+                *where(j),
+                hint="a link has one parent joint: the robot is a tree; rename one joint's <child> link",
             )
         children[child] = jname
     roots = [n for n in links if n not in children]

@@ -102,11 +102,35 @@ def _parse(urdf: str, file: Path | None, expanded: bool, where: Any) -> Any:
         root = parse(urdf)
     except etree.XMLSyntaxError as e:
         raise DescriptionError(
-            f"not well-formed XML: {e.msg}", file, None if expanded else e.lineno
+            f"not well-formed XML: {e.msg}",
+            file,
+            None if expanded else e.lineno,
+            hint=_malformed_hint(str(e.msg)),
         ) from None
     if root.tag != "robot":
-        raise DescriptionError(f"the top element is <{root.tag}>, expected <robot>", *where(root))
+        raise DescriptionError(
+            f"the top element is <{root.tag}>, expected <robot>",
+            *where(root),
+            hint="an SDF file is loaded as `world: {sdf: ...}`; a `description:` is a URDF or xacro file"
+            if root.tag in ("sdf", "model", "world")
+            else 'a URDF starts with <robot name="...">',
+        )
     return root
+
+
+def _malformed_hint(msg: str) -> str:
+    """What to look for, by libxml2's message."""
+    if "Document is empty" in msg or "Start tag expected" in msg:
+        return 'the file is empty or not XML: a URDF starts with <?xml version="1.0"?> and <robot name="...">'
+    if "mismatch" in msg or "Premature end" in msg or "not closed" in msg:
+        return "every tag is closed, in order: <link ...> ... </link>, or <link .../> for an empty one"
+    if "AttValue" in msg or "attributes construct" in msg or "Specification mandates value" in msg:
+        return 'attribute values are quoted: <origin xyz="0 0 1"/>'
+    if "Extra content" in msg:
+        return "one top element <robot>: everything else goes inside it"
+    if "EntityRef" in msg or "entity" in msg.lower():
+        return "write & as &amp; and < as &lt; in text and attribute values"
+    return "check that every tag is closed and attribute values are quoted"
 
 
 def _load(root: Any, where: Any, file: Path | None, shell: set[str]) -> mujoco.MjSpec:
@@ -154,7 +178,11 @@ def _mujoco_error(e: ValueError, root: Any, text: str, where: Any, file: Path | 
                     *where(mine),
                     hint="check that element's attributes: names, numbers and required children",
                 )
-    return DescriptionError(f"MuJoCo cannot load this URDF: {message}", file)
+    return DescriptionError(
+        f"MuJoCo cannot load this URDF: {message}",
+        file,
+        hint="MuJoCo's message names what it refused; check that element's attributes and children",
+    )
 
 
 def _unique_shape_names(root: Any) -> None:

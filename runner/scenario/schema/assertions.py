@@ -26,7 +26,10 @@ class Region(Strict):
     def _box(cls, v: tuple[float, float] | None, info: Any) -> tuple[float, float] | None:
         lo = info.data.get("min")
         if v is not None and lo is not None and (v[0] <= lo[0] or v[1] <= lo[1]):
-            raise ValueError(f"max {list(v)} must exceed min {list(lo)} on both axes")
+            raise ValueError(
+                f"max {list(v)} must exceed min {list(lo)} on both axes: write the lower corner as min and "
+                "the upper as max, e.g. {min: [0, 0], max: [1, 1]}"
+            )
         return v
 
     @model_validator(mode="after")
@@ -66,14 +69,17 @@ class _Window(Strict):
     def _after_until(cls, v: float | None, info: Any) -> float | None:
         start = info.data.get("after")
         if v is not None and start is not None and v < start:
-            raise ValueError(f"the window ends (until: {v}) before it starts (after: {start})")
+            raise ValueError(
+                f"the window ends (until: {v}) before it starts (after: {start}): "
+                "write an `until:` later than `after:`"
+            )
         return v
 
 
 def _min_below_max(v: float | None, info: Any, unit: str) -> float | None:
     lo = info.data.get("min")
     if v is not None and lo is not None and v < lo:
-        raise ValueError(f"max ({v} {unit}) is below min ({lo} {unit})")
+        raise ValueError(f"max ({v} {unit}) is below min ({lo} {unit}): write a max above the min")
     return v
 
 
@@ -102,10 +108,14 @@ class Reach(_AssertionBase):
     @model_validator(mode="after")
     def _goal(self) -> Reach:
         if (self.point is None) == (self.region is None):
-            raise ValueError("a reach assertion has either `point: [x, y]` or `region:`")
+            raise ValueError(
+                "a reach assertion has either `point: [x, y]` or `region:`: write one of them, "
+                "`point: [x, y]` (with `tolerance:`) or `region: {min: [x, y], max: [x, y]}`"
+            )
         if self.by is not None and self.by <= self.after:
             raise ValueError(
-                f"the deadline (by: {self.by:g}) is not after the window opens (after: {self.after:g})"
+                f"the deadline (by: {self.by:g}) is not after the window opens (after: {self.after:g}): "
+                "write a `by:` later than `after:`"
             )
         return self
 

@@ -8,11 +8,74 @@ from __future__ import annotations
 import re
 from typing import Annotated, Any, Literal
 
-from pydantic import Field, NonNegativeInt, PositiveFloat, field_validator, model_validator
+from pydantic import AfterValidator, Field, NonNegativeInt, PositiveFloat, field_validator, model_validator
 
+from runner.errors import closest
 from runner.scenario.schema.base import IDENT_RE, NODE_NAME_RE, TOPIC_RE, Namespace, Strict
 
 _ENDPOINT_PATTERN = r"^(tcp|udp|tls|quic|ws|unixsock-stream|unixpipe|serial|vsock)/\S+$"
+
+
+_PROTOCOLS = ("tcp", "udp", "tls", "quic", "ws", "unixsock-stream", "unixpipe", "serial", "vsock")
+_IP_PROTOCOLS = ("tcp", "udp", "tls", "quic", "ws")
+_IPV4 = re.compile(r"^[\d.]+$")
+
+
+def endpoint_error(value: str, listen: bool) -> str | None:
+    """Why `value` is not a Zenoh endpoint, as "<what is wrong>: write <the fix>" (the hint), or None.
+    Zenoh's configuration takes any text and the mistake shows only when the run opens it (a port of
+    70000, a protocol misspelt): it is said here, at its line. An endpoint to listen on may have port 0
+    (any free port); one to connect to may not."""
+    text = value.strip()
+    m = re.match(r"^([A-Za-z0-9-]+)/(.*)$", text)
+    if m is None:
+        example = text.split("/")[-1] or "10.0.0.2:7447"
+        return f"not a Zenoh endpoint: write it with its protocol, e.g. tcp/{example}"
+    proto, rest = m.group(1), m.group(2)
+    if proto not in _PROTOCOLS:
+        near = closest(proto.lower(), _PROTOCOLS)
+        return f"unknown Zenoh protocol {proto!r}: write " + (
+            f"{near}/{rest}" if near else f"one of {', '.join(_PROTOCOLS)}"
+        )
+    if proto not in _IP_PROTOCOLS:
+        return None
+    address = re.split(r"[?#]", rest, maxsplit=1)[0]
+    host, colon, port = address.rpartition(":")
+    if address.endswith("]"):  # an IPv6 address without its port
+        host, colon, port = address, "", ""
+    if not colon or not host or host == "[":
+        if not colon:
+            return f"no port: write {proto}/<address>:<port>, e.g. {proto}/{address or '127.0.0.1'}:7447"
+        return f"no address: write {proto}/<address>:<port>, e.g. {proto}/127.0.0.1:{port or 7447}"
+    if not port.isdigit():
+        return f"the port {port!r} is not a number: write a port from 1 to 65535, e.g. {proto}/{host}:7447"
+    low = 0 if listen else 1
+    if not low <= int(port) <= 65535:
+        return (
+            f"port {int(port)} is out of range ({low}-65535): write a port from 1 to 65535, "
+            f"e.g. {proto}/{host}:7447" + (" (or 0 for any free port)" if listen else "")
+        )
+    if host.startswith("[") != host.endswith("]"):
+        return f"an IPv6 address goes in brackets: write {proto}/[::1]:{port}"
+    if _IPV4.match(host) and (
+        len(host.split(".")) != 4 or any(not o.isdigit() or int(o) > 255 for o in host.split("."))
+    ):
+        return f"{host!r} is not an IPv4 address: write four numbers 0-255, e.g. {proto}/127.0.0.1:{port}"
+    return None
+
+
+def _listen_endpoint(value: str) -> str:
+    error = endpoint_error(value, listen=True)
+    if error:
+        raise ValueError(error)
+    return value
+
+
+def _connect_endpoint(value: str | None) -> str | None:
+    error = endpoint_error(value, listen=False) if value is not None else None
+    if error:
+        raise ValueError(error)
+    return value
 
 
 class Host(Strict):
@@ -31,7 +94,7 @@ class Host(Strict):
         if not re.match(_ENDPOINT_PATTERN, value):
             example = value.split("/")[-1] or "10.0.0.2:7447"
             raise ValueError(f"not a Zenoh endpoint: write it with its protocol, e.g. tcp/{example}")
-        return value
+        return _connect_endpoint(value)  # type: ignore[return-value]
 
 
 class Node(Strict):
@@ -96,7 +159,10 @@ class Resources(Strict):
     def _not_builtin(cls, v: dict[str, float]) -> dict[str, float]:
         for name in v:
             if name in ("CPU", "GPU", "memory", "object_store_memory"):
-                raise ValueError(f"custom.{name}: say it with num_cpus / num_gpus, not as a custom resource")
+                fix = {"GPU": "`num_gpus: 1`", "CPU": "`num_cpus: 2`"}.get(name, "num_cpus / num_gpus only")
+                raise ValueError(
+                    f"custom.{name}: say it with num_cpus / num_gpus, not as a custom resource: write {fix}"
+                )
         return v
 
 
@@ -109,7 +175,7 @@ class Ros2(Strict):
     node: Annotated[str, Field(pattern=IDENT_RE.pattern)] | None = Field(
         None, description="The ROS 2 node name the simulation appears as (default: the run's name)."
     )
-    router: str | None = Field(
+    router: Annotated[str | None, AfterValidator(_connect_endpoint)] = Field(
         None,
         description="Zenoh endpoint of a ROS 2 Zenoh router to join (e.g. `tcp/127.0.0.1:7447`, where "
         "`ros2 run rmw_zenoh_cpp rmw_zenohd` listens). Default: ROS 2 nodes join the run's own router "
@@ -134,7 +200,7 @@ class ZenohSettings(Strict):
         description="Settings by their path in Zenoh's configuration, on top of the file, e.g. "
         "`transport/link/tls/root_ca_certificate: certs/ca.pem` (file paths relative to the scenario).",
     )
-    listen: list[str] = Field(
+    listen: list[Annotated[str, AfterValidator(_listen_endpoint)]] = Field(
         default_factory=list,
         description="The run's router endpoints, e.g. `tls/127.0.0.1:7447` (default: a free TCP port on "
         "127.0.0.1: loopback only unless told otherwise; `--listen` overrides).",
@@ -203,7 +269,10 @@ class Bridge(Strict):
     @model_validator(mode="after")
     def _one_source(self) -> Bridge:
         if (self.topic is None) == (self.file is None):
-            raise ValueError("a bridge has either `topic:` (one mapping) or `file:` (a ros_gz_bridge file)")
+            raise ValueError(
+                "a bridge has either `topic:` (one mapping) or `file:` (a ros_gz_bridge file): "
+                "write one of them, in a bridge of its own"
+            )
         if self.file is not None:
             extra = [f for f in ("key", "ros_topic", "type") if getattr(self, f) is not None]
             if extra:

@@ -141,7 +141,10 @@ class Scenario(Strict):
         if v in ("realtime", "max"):
             return v
         if isinstance(v, bool) or not isinstance(v, int | float) or v <= 0:
-            raise ValueError("rate must be 'realtime', 'max' or a positive real-time factor (e.g. 2.0)")
+            raise ValueError(
+                "rate must be 'realtime', 'max' or a positive real-time factor (e.g. 2.0): "
+                "write `rate: realtime`, `rate: max` or a number above 0 such as `rate: 2.0`"
+            )
         return float(v)
 
     @field_validator("matrix")
@@ -156,7 +159,9 @@ class Scenario(Strict):
     @classmethod
     def _seed(cls, v: int) -> int:
         if v < 0:
-            raise ValueError("a seed is 0 or more (random generators take non-negative seeds)")
+            raise ValueError(
+                "a seed is 0 or more (random generators take non-negative seeds): write e.g. `seed: 42`"
+            )
         return v
 
     @field_validator("duration")
@@ -165,5 +170,6 @@ class Scenario(Strict):
         if v > MAX_DURATION:
             raise ValueError(
                 f"a run lasts at most {MAX_DURATION} s of sim time (the ROS clock counts seconds in an int32)"
+                ": write a shorter duration, in seconds"
             )
         return v

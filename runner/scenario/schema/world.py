@@ -51,7 +51,7 @@ class WorldModel(Strict):
         if need is not None and len(v) != need:
             shape = info.data["shape"]
             form = {"box": "[x, y, z]", "cylinder": "[radius, length]", "sphere": "[radius]"}[shape]
-            raise ValueError(f"a {shape} needs {need} number(s) {form}, found {len(v)}")
+            raise ValueError(f"a {shape} needs {need} number(s) {form}, found {len(v)}: write size: {form}")
         return v
 
 

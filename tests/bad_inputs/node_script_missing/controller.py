@@ -1,0 +1,1 @@
+"""A node the case's command misspells (it is never run)."""
