@@ -47,7 +47,7 @@ def message_of(type_text: str, data: dict[str, Any], doc: Document, here: PathKe
     `publish`), its data checked against the type's fields: each mistake located."""
     type_name = message_type(type_text, doc, (*here, "type"))
     try:
-        msgs.from_data(type_name, data)
+        msgs.check_data(type_name, data)
     except msgs.MessageDataError as e:
         where: PathKey = (*here, "data", *e.path)
         raise ScenarioError(Problem(str(e), doc.locate(where), where, hint=e.hint)) from None
