@@ -80,3 +80,92 @@ def test_a_20000_entry_timeline_validates(tmp_path: Path) -> None:
     assert len(plan.timeline) == 20_000
     assert plan.timeline[-1].data == {"linear": {"x": 0.1 + (19_999 % 7) * 0.01}, "angular": {"z": 0.4}}
     assert seconds < 30.0, seconds  # quadratic (or the pure-Python parser) would be far past this
+
+
+# ------------------------------------------------------------------------------------------------ URDF
+def chain_urdf(links: int, joint: str = "revolute", star: bool = False) -> str:
+    """`links` boxes, each on a joint to the one before (or, `star`, all to the first)."""
+    rows = ['<?xml version="1.0"?>', '<robot name="chain">']
+    for i in range(links):
+        rows.append(
+            f'<link name="l{i}"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" '
+            'ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry><box size="0.05 0.05 0.05"/>'
+            "</geometry></collision></link>"
+        )
+        if i:
+            limit = "" if joint == "fixed" else '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+            rows.append(
+                f'<joint name="j{i}" type="{joint}"><parent link="l{0 if star else i - 1}"/>'
+                f'<child link="l{i}"/><origin xyz="0 0 0.06"/>{limit}</joint>'
+            )
+    return "\n".join([*rows, "</robot>"]) + "\n"
+
+
+def validate(tmp_path: Path, urdf: str, timeout: float = 120.0) -> tuple[int, str, float]:
+    """`scenario validate` of a one-robot scenario around `urdf`, in its own process: (exit code, output,
+    peak resident MB)."""
+    import subprocess
+    import sys
+
+    (tmp_path / "robot.urdf").write_text(urdf)
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(
+        "name: big\nduration: 1.0\nrobots:\n  - name: r1\n    description: {file: robot.urdf}\n"
+        "    pose: {xyz: [0, 0, 0.1]}\n"
+    )
+    code = (
+        "import resource, sys\nfrom runner.cli import main\nsys.argv = ['scenario', 'validate', sys.argv[1]]\n"
+        "try:\n    main()\nfinally:\n"
+        "    print('PEAK_KB', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code, str(scenario)],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        cwd=tmp_path,
+    )
+    out = proc.stdout + proc.stderr
+    peak = next(int(x.split()[1]) for x in out.splitlines() if x.startswith("PEAK_KB")) / 1024
+    return proc.returncode, out, peak
+
+
+def test_a_10000_link_chain_is_refused_at_once_at_the_joint_past_mujocos_depth(tmp_path: Path) -> None:
+    """MuJoCo compiles no tree deeper than 1023 bodies; it found that out after minutes (printing nothing
+    for 300 s at 2.1 GB with 10,000 links). Now: the joint whose child is the 1024th link, named in the
+    URDF, at once."""
+    code, out, peak = validate(tmp_path, chain_urdf(10_000))
+    assert code == 1 and "Traceback" not in out, out
+    line = (
+        chain_urdf(10_000)
+        .splitlines()
+        .index(next(x for x in chain_urdf(10_000).splitlines() if '"j1023"' in x))
+    )
+    assert f"robot.urdf:{line + 1}: the chain of links from 'l0' to 'l9999' is 10000 links deep" in out, out
+    assert "at most 1023 bodies deep" in out and "hint:" in out
+    assert peak < 2048, peak
+
+
+def test_3000_links_on_fixed_joints(tmp_path: Path) -> None:
+    """All on one link (a star): they are welded together, so neither MuJoCo nor Gazebo collides them -
+    no contact exclusion is made (there were 4.5 M); MuJoCo's broad phase still overflows its default
+    arena, which is raised, with a warning. As a chain: past MuJoCo's depth, refused at its line."""
+    code, out, peak = validate(tmp_path, chain_urdf(3000, "fixed", star=True))
+    assert code == 0 and "Traceback" not in out, out
+    assert "MuJoCo's memory for this world raised to" in out and peak < 2048, peak
+    code, out, _ = validate(tmp_path, chain_urdf(3000, "fixed"))
+    assert code == 1 and "Traceback" not in out and "robot.urdf:" in out and "links deep" in out, out
+
+
+def test_contact_exclusions_are_made_only_where_mujoco_does_not_filter() -> None:
+    """Gazebo's no-self-collision rule: links welded together (fixed joints) and links joined by a joint
+    are left out by MuJoCo itself (same weld; its parent filter) and get no exclusion (300 links on fixed
+    joints made 44,551); any other pair of links that may move against each other does."""
+    from runner.compile.packages import PackageMap
+    from runner.compile.urdf.reader import urdf_to_model
+
+    packages = PackageMap.for_scenario(Path.cwd(), {})
+    welded = urdf_to_model(chain_urdf(300, "fixed", star=True), None, packages).spec.compile()
+    assert welded.nexclude == 0
+    hinged = urdf_to_model(chain_urdf(300), None, packages).spec.compile()
+    assert hinged.nexclude == 300 * 299 // 2 - 299
