@@ -10,32 +10,16 @@ from pathlib import Path
 
 import pytest
 
+from bench.limits import (
+    chain_urdf,
+    random_triangles,
+    sphere_triangles,
+    timeline_scenario,
+    write_obj,
+    write_stl,
+)
 from runner.errors import ScenarioError
 from runner.scenario.loader import MAX_ALIAS_VALUES, load_file, load_text
-
-REPO = Path(__file__).resolve().parents[1]
-DIFFBOT = REPO / "scenarios" / "robots" / "diffbot.urdf.xacro"
-
-
-def timeline_scenario(entries: int) -> str:
-    """A scenario with one diff-drive robot and `entries` timeline entries, written out (no anchors)."""
-    rows = [
-        "name: long_timeline",
-        "duration: 30.0",
-        "robots:",
-        "  - name: r1",
-        f"    description: {{file: {DIFFBOT}}}",
-        "    pose: {xyz: [0, 0, 0.06]}",
-        "    plugins:",
-        "      - {type: diff_drive, params: {rate: 50}}",
-        "timeline:",
-    ]
-    rows += [
-        f"  - {{t: {i * 0.001:.3f}, topic: r1/cmd_vel, type: geometry_msgs/msg/Twist, "
-        f"data: {{linear: {{x: {0.1 + (i % 7) * 0.01:.2f}}}, angular: {{z: {(i % 5) * 0.1:.1f}}}}}}}"
-        for i in range(entries)
-    ]
-    return "\n".join(rows) + "\n"
 
 
 # ------------------------------------------------------------------------------------------------ YAML
@@ -83,24 +67,6 @@ def test_a_20000_entry_timeline_validates(tmp_path: Path) -> None:
 
 
 # ------------------------------------------------------------------------------------------------ URDF
-def chain_urdf(links: int, joint: str = "revolute", star: bool = False) -> str:
-    """`links` boxes, each on a joint to the one before (or, `star`, all to the first)."""
-    rows = ['<?xml version="1.0"?>', '<robot name="chain">']
-    for i in range(links):
-        rows.append(
-            f'<link name="l{i}"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" '
-            'ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry><box size="0.05 0.05 0.05"/>'
-            "</geometry></collision></link>"
-        )
-        if i:
-            limit = "" if joint == "fixed" else '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
-            rows.append(
-                f'<joint name="j{i}" type="{joint}"><parent link="l{0 if star else i - 1}"/>'
-                f'<child link="l{i}"/><origin xyz="0 0 0.06"/>{limit}</joint>'
-            )
-    return "\n".join([*rows, "</robot>"]) + "\n"
-
-
 def validate(tmp_path: Path, urdf: str, timeout: float = 120.0) -> tuple[int, str, float]:
     """`scenario validate` of a one-robot scenario around `urdf`, in its own process: (exit code, output,
     peak resident MB)."""
@@ -169,3 +135,85 @@ def test_contact_exclusions_are_made_only_where_mujoco_does_not_filter() -> None
     assert welded.nexclude == 0
     hinged = urdf_to_model(chain_urdf(300), None, packages).spec.compile()
     assert hinged.nexclude == 300 * 299 // 2 - 299
+
+
+# ---------------------------------------------------------------------------------------------- meshes
+def test_a_binary_stl_over_the_budget_is_simplified_with_a_warning_at_its_urdf_line(tmp_path: Path) -> None:
+    """The budget lowered to 5,000 triangles (the mechanism of a 5 M-triangle mesh against 1 M, which the
+    bench measures): a 20,000-triangle sphere is simplified to at most 5,000, keeps its size, and the
+    warning names the URDF line and how to simplify it."""
+    import os
+    import subprocess
+    import sys
+
+    import numpy as np
+
+    from runner.compile.meshes import prepare_mesh
+
+    write_stl(tmp_path / "ball.stl", sphere_triangles(20_000))
+    (tmp_path / "robot.urdf").write_text(chain_urdf(2, mesh="ball.stl"))
+    (tmp_path / "s.yaml").write_text(
+        "name: m\nduration: 1.0\nrobots:\n  - name: r1\n    description: {file: robot.urdf}\n"
+        "    pose: {xyz: [0, 0, 0.5]}\n"
+    )
+    env = {**os.environ, "SCENARIO_MAX_MESH_TRIANGLES": "5000", "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    proc = subprocess.run(
+        [sys.executable, "-m", "runner.cli", "validate", "s.yaml"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=tmp_path,
+        env=env,
+    )
+    out = " ".join((proc.stdout + proc.stderr).split())
+    assert proc.returncode == 0 and "Traceback" not in out, out
+    assert f"warning: {tmp_path / 'robot.urdf'}:3: collision mesh 'ball.stl' has 20000 triangles, over" in out
+    assert "the budget of 5000: simplified to" in out and "Quadric Edge Collapse" in out, out
+    os.environ["XDG_CACHE_HOME"], old = str(tmp_path / "cache"), os.environ.get("XDG_CACHE_HOME")
+    os.environ["SCENARIO_MAX_MESH_TRIANGLES"] = "5000"
+    try:
+        prepared = prepare_mesh(tmp_path / "ball.stl")
+    finally:
+        del os.environ["SCENARIO_MAX_MESH_TRIANGLES"]
+        if old is None:
+            del os.environ["XDG_CACHE_HOME"]
+        else:
+            os.environ["XDG_CACHE_HOME"] = old
+    assert prepared.simplified == 20000 and 1000 < prepared.triangles <= 5000
+    assert np.allclose(prepared.extent, (0.2, 0.2, 0.2), atol=0.01)
+
+
+def test_an_obj_over_the_budget_is_refused_before_it_is_parsed(tmp_path: Path, monkeypatch) -> None:
+    from runner.compile.meshes import MeshError, prepare_mesh
+
+    monkeypatch.setenv("SCENARIO_MAX_MESH_TRIANGLES", "5000")
+    write_obj(tmp_path / "ball.obj", sphere_triangles(20_000))
+    with pytest.raises(MeshError) as err:
+        prepare_mesh(tmp_path / "ball.obj")
+    assert "20000 triangles, over the budget of 5000" in str(err.value)
+    assert "export it as binary STL" in (err.value.hint or "")
+
+
+def test_random_triangles_are_simplified_within_bounds() -> None:
+    """No structure to keep: the grid gets coarse, the result is small and still a mesh."""
+    from runner.compile.meshes import simplify
+
+    corners = random_triangles(50_000).reshape(-1, 3).astype("<f4")
+    vertices, faces = simplify(corners, 2000)
+    assert 0 < len(faces) <= 2000 and faces.max() < len(vertices)
+
+
+def test_too_many_exclusions_are_a_located_error(monkeypatch) -> None:
+    """Past MAX_EXCLUDES (lowered here: 3,000 hinged links on one link would need 4.5 M), the robot is
+    refused with the count, at its <robot> line, with a hint, before any exclusion is made."""
+    from runner.compile.packages import PackageMap
+    from runner.compile.urdf import link_props
+    from runner.compile.urdf.checks import DescriptionError
+    from runner.compile.urdf.reader import urdf_to_model
+
+    monkeypatch.setattr(link_props, "MAX_EXCLUDES", 100)
+    with pytest.raises(DescriptionError) as err:
+        urdf_to_model(chain_urdf(30, star=True), None, PackageMap.for_scenario(Path.cwd(), {}))
+    text = str(err.value)
+    assert "need 406 MuJoCo contact exclusions; at most 100 are made" in text, text
+    assert err.value.line == 2 and "self_collide" in (err.value.hint or "")
