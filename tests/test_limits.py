@@ -70,8 +70,7 @@ def test_a_20000_entry_timeline_validates(tmp_path: Path) -> None:
 def validate(tmp_path: Path, urdf: str, timeout: float = 120.0) -> tuple[int, str, float]:
     """`scenario validate` of a one-robot scenario around `urdf`, in its own process: (exit code, output,
     peak resident MB)."""
-    import subprocess
-    import sys
+    from bench.limits import validate_measured
 
     (tmp_path / "robot.urdf").write_text(urdf)
     scenario = tmp_path / "s.yaml"
@@ -79,21 +78,9 @@ def validate(tmp_path: Path, urdf: str, timeout: float = 120.0) -> tuple[int, st
         "name: big\nduration: 1.0\nrobots:\n  - name: r1\n    description: {file: robot.urdf}\n"
         "    pose: {xyz: [0, 0, 0.1]}\n"
     )
-    code = (
-        "import resource, sys\nfrom runner.cli import main\nsys.argv = ['scenario', 'validate', sys.argv[1]]\n"
-        "try:\n    main()\nfinally:\n"
-        "    print('PEAK_KB', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)\n"
-    )
-    proc = subprocess.run(
-        [sys.executable, "-c", code, str(scenario)],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        cwd=tmp_path,
-    )
-    out = proc.stdout + proc.stderr
-    peak = next(int(x.split()[1]) for x in out.splitlines() if x.startswith("PEAK_KB")) / 1024
-    return proc.returncode, out, peak
+    got = validate_measured(scenario, timeout=timeout)
+    assert got["code"] != "timeout", f"validate ran past {timeout} s"
+    return got["code"], " ".join(got["out"].split()), got["peak_mb"]
 
 
 def test_a_10000_link_chain_is_refused_at_once_at_the_joint_past_mujocos_depth(tmp_path: Path) -> None:
