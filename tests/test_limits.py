@@ -45,6 +45,14 @@ def test_aliases_past_the_limit_are_refused_at_the_first_alias() -> None:
     assert len(doc.data["many"]) == 99 and doc.data["many"][0] is not doc.data["many"][1]
 
 
+def test_an_alias_inside_its_own_anchor_is_located() -> None:
+    with pytest.raises(ScenarioError) as err:
+        load_text("name: x\nloop: &a [1, *a]\n")
+    rendered = err.value.render()
+    assert "<scenario>:2:14: this is not valid YAML: found an alias inside its own anchor 'a'" in rendered
+    assert "hint:" in rendered
+
+
 def test_merge_keys_take_the_anchors_keys_and_the_mappings_own_win() -> None:
     doc = load_text("base: &b {k: 1, j: 1}\nc:\n  j: 2\n  <<: *b\nd:\n  <<: [*b, {m: 3}]\n  k: 4\n")
     assert doc.data["c"] == {"j": 2, "k": 1} and doc.data["d"] == {"k": 4, "j": 1, "m": 3}

@@ -236,6 +236,8 @@ class _Builder:
                 key = memo.get((event.value, event.implicit, event.tag), self)
                 if key is self:
                     key = self.scalar(event, path)
+                if event.anchor is not None:  # `&k key: ...`: a key may be aliased too
+                    self.anchors[event.anchor] = (key, [((), key_loc)], 1)
             elif isinstance(event, yaml.AliasEvent) and event.anchor in self.anchors:
                 key = self.anchors[event.anchor][0]
             else:
@@ -425,6 +427,8 @@ def _yaml_problem(e: yaml.MarkedYAMLError, text: str, file: Path | None) -> Prob
         )
     elif "expected <block end>" in problem:
         hint = "check the indentation: the items of one list or mapping start in the same column"
+    elif "inside its own anchor" in problem:
+        hint = "an anchor cannot hold an alias of itself (that would repeat it without end)"
     elif "undefined alias" in problem:
         hint = "define the anchor (`&name`) before using it (`*name`)"
     elif "cannot start any token" in problem:
