@@ -133,7 +133,9 @@ def test_contact_exclusions_are_made_only_where_mujoco_does_not_filter() -> None
 
 
 # ---------------------------------------------------------------------------------------------- meshes
-def test_a_binary_stl_over_the_budget_is_simplified_with_a_warning_at_its_urdf_line(tmp_path: Path) -> None:
+def test_a_binary_stl_over_the_budget_is_simplified_with_a_warning_at_its_urdf_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """The budget lowered to 5,000 triangles (the mechanism of a 5 M-triangle mesh against 1 M, which the
     bench measures): a 20,000-triangle sphere is simplified to at most 5,000, keeps its size, and the
     warning names the URDF line and how to simplify it."""
@@ -164,21 +166,16 @@ def test_a_binary_stl_over_the_budget_is_simplified_with_a_warning_at_its_urdf_l
     assert proc.returncode == 0 and "Traceback" not in out, out
     assert f"warning: {tmp_path / 'robot.urdf'}:3: collision mesh 'ball.stl' has 20000 triangles, over" in out
     assert "the budget of 5000: simplified to" in out and "Quadric Edge Collapse" in out, out
-    os.environ["XDG_CACHE_HOME"], old = str(tmp_path / "cache"), os.environ.get("XDG_CACHE_HOME")
-    os.environ["SCENARIO_MAX_MESH_TRIANGLES"] = "5000"
-    try:
-        prepared = prepare_mesh(tmp_path / "ball.stl")
-    finally:
-        del os.environ["SCENARIO_MAX_MESH_TRIANGLES"]
-        if old is None:
-            del os.environ["XDG_CACHE_HOME"]
-        else:
-            os.environ["XDG_CACHE_HOME"] = old
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    monkeypatch.setenv("SCENARIO_MAX_MESH_TRIANGLES", "5000")
+    prepared = prepare_mesh(tmp_path / "ball.stl")
     assert prepared.simplified == 20000 and 1000 < prepared.triangles <= 5000
     assert np.allclose(prepared.extent, (0.2, 0.2, 0.2), atol=0.01)
 
 
-def test_an_obj_over_the_budget_is_refused_before_it_is_parsed(tmp_path: Path, monkeypatch) -> None:
+def test_an_obj_over_the_budget_is_refused_before_it_is_parsed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     from runner.compile.meshes import MeshError, prepare_mesh
 
     monkeypatch.setenv("SCENARIO_MAX_MESH_TRIANGLES", "5000")
@@ -198,7 +195,7 @@ def test_random_triangles_are_simplified_within_bounds() -> None:
     assert 0 < len(faces) <= 2000 and faces.max() < len(vertices)
 
 
-def test_too_many_exclusions_are_a_located_error(monkeypatch) -> None:
+def test_too_many_exclusions_are_a_located_error(monkeypatch: pytest.MonkeyPatch) -> None:
     """Past MAX_EXCLUDES (lowered here: 3,000 hinged links on one link would need 4.5 M), the robot is
     refused with the count, at its <robot> line, with a hint, before any exclusion is made."""
     from runner.compile.packages import PackageMap
