@@ -36,6 +36,12 @@ Sections (in order):
   cores, with a running cluster and with `--ray` starting its own (bench/ray.py): variants per minute and
   Ray's overhead per variant (target: under 1 s).
 
+- limits: large legitimate inputs against the issue-35 targets (bench/limits.py): a 20,000-entry timeline
+  validated (target: < 5 s); URDF chains of 500 to 10,000 hinged links and 3,000 links on fixed joints, and
+  a 5 M-triangle mesh (a sphere, random triangles: binary STL; a sphere as OBJ), each `scenario validate` in
+  its own process: wall time and peak memory against 60 s and 2 GB, and whether it validated or was
+  refused with a located error.
+
 Results go to bench/results/<section>.json (with machine info); `--readme` also writes the tables into
 README.md between the `bench:begin`/`bench:end` markers.
 """
@@ -94,6 +100,7 @@ SECTIONS = (
     "meshes",
     "actors",
     "ray",
+    "limits",
 )
 
 
@@ -790,6 +797,12 @@ def ray(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     return br.run(args.quick, args.repeat)
 
 
+def limits(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
+    from bench import limits as bl
+
+    return bl.run(args.quick)
+
+
 RUNNERS = {
     "two_robots": two_robots,
     "scaling": scaling,
@@ -803,6 +816,7 @@ RUNNERS = {
     "meshes": meshes,
     "actors": actors,
     "ray": ray,
+    "limits": limits,
 }
 
 

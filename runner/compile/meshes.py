@@ -11,6 +11,14 @@ converter's version (`_RECIPE`, trimesh's version): a change to any of them make
   is ignored, as Gazebo and RViz ignore it: ROS meshes are drawn Z-up whatever the tag says, and a Y_UP
   tag (pycollada's and Blender's default) on such a mesh would otherwise tip the robot over.
 
+Meshes have a budget, checked before the expensive work (MuJoCo's compile of a 5 M-triangle mesh took a
+minute and 5 GB): at most `MAX_MESH_MB` of file, and `mesh_budget()` triangles (1 M unless
+SCENARIO_MAX_MESH_TRIANGLES says), counted from the file before it is loaded (a binary STL's header; the
+face lines of an OBJ; a COLLADA's `count=` attributes; the facets of an ASCII STL). A binary STL over it is
+simplified (vertex clustering, `simplify`: ~`SIMPLIFIED_TRIANGLES` triangles, cached like a conversion);
+`PreparedMesh.simplified` then holds its first count, for the caller's located warning. Any other format
+over it is refused with a hint (simplify it, or export it as binary STL).
+
 `prepare_mesh` says plainly what is wrong with a file that is not a mesh: a Git LFS pointer left in place of
 the mesh, an empty placeholder, a file without triangles, one cut short. It also tells a flat mesh (all its
 vertices in one plane: no volume, no convex hull), which MuJoCo can draw (with `inertia="shell"`) but
@@ -36,6 +44,14 @@ import numpy as np
 # so that files converted by an older version are not reused.
 _RECIPE = "v3"  # v3: COLLADA comments stripped before loading
 MAX_STL_TRIANGLES = 200_000  # MuJoCo's STL reader refuses more
+MAX_MESH_MB = 600  # a mesh file larger than this is refused before it is read (5 M triangles of STL: 250 MB)
+MESH_BUDGET = 1_000_000  # triangles a mesh may have as it is (SCENARIO_MAX_MESH_TRIANGLES overrides)
+SIMPLIFIED_TRIANGLES = 200_000  # what a mesh over the budget is simplified to, at most (a binary STL)
+BUDGET_HINT = (
+    "simplify it for a better shape than ours: Blender's Decimate modifier (Collapse, ratio "
+    "{ratio:.2g}), or MeshLab's Filters > Remeshing > Quadric Edge Collapse Decimation to {target} faces; "
+    "SCENARIO_MAX_MESH_TRIANGLES raises the budget"
+)
 _LFS_POINTER = b"version https://git-lfs.github.com/spec/v1"
 _STL_RECORD = np.dtype([("normal", "<f4", (3,)), ("v", "<f4", (3, 3)), ("attr", "<u2")])
 _FLAT = 1e-9  # thickness / size below which a mesh is flat
@@ -60,6 +76,18 @@ class PreparedMesh:
     triangles: int  # 0 when not looked at (.msh)
     flat: bool  # all vertices in one plane (or line): zero volume, no convex hull
     extent: tuple[float, float, float] = (0.0, 0.0, 0.0)  # bounding box size, in the file's units (metres)
+    simplified: int = 0  # over the budget: the file's own triangle count (`triangles` is the simplified one)
+
+
+def mesh_budget() -> int:
+    """Triangles a mesh may have before it is simplified or refused."""
+    text = os.environ.get("SCENARIO_MAX_MESH_TRIANGLES", "")
+    return int(text) if text.isdigit() and int(text) > 0 else MESH_BUDGET
+
+
+def budget_hint(triangles: int) -> str:
+    target = min(mesh_budget(), SIMPLIFIED_TRIANGLES)
+    return BUDGET_HINT.format(ratio=target / max(triangles, 1), target=target)
 
 
 def mesh_cache() -> Path:
@@ -81,10 +109,16 @@ def prepare_mesh(path: Path) -> PreparedMesh:
         st = path.stat()
     except OSError as e:
         raise _error(path, f"cannot be read ({e.strerror or e})") from None
-    memo_key = (str(path), st.st_size, st.st_mtime_ns, str(mesh_cache()))
+    memo_key = (str(path), st.st_size, st.st_mtime_ns, str(mesh_cache()), mesh_budget())
     memo = _MEMO.get(memo_key)
     if memo is not None and memo.file.is_file():
         return memo
+    if st.st_size > MAX_MESH_MB * 1_000_000:
+        raise _error(
+            path,
+            f"the file is {st.st_size / 1e6:.0f} MB; meshes are read up to {MAX_MESH_MB} MB",
+            hint=budget_hint(st.st_size // 50),
+        )
     try:
         data = path.read_bytes()
     except OSError as e:
@@ -93,12 +127,14 @@ def prepare_mesh(path: Path) -> PreparedMesh:
     suffix = path.suffix.lower()
     if suffix == ".stl" and not _is_ascii_stl(data):
         prepared = _binary_stl(path, data)
-    elif suffix == ".obj":
-        prepared = _obj(path, data)
-    elif suffix == ".msh":
-        prepared = PreparedMesh(path, 0, False)
     else:
-        prepared = _convert(path, data)
+        _check_count(path, data, suffix)
+        if suffix == ".obj":
+            prepared = _obj(path, data)
+        elif suffix == ".msh":
+            prepared = PreparedMesh(path, 0, False)
+        else:
+            prepared = _convert(path, data)
     _MEMO[memo_key] = prepared
     return prepared
 
@@ -143,7 +179,7 @@ def _why(e: BaseException) -> str:
 
 
 def _check_not_a_placeholder(path: Path, data: bytes) -> None:
-    if not data.strip():
+    if not data or data.isspace():  # (strip() would copy a 250 MB mesh to say no)
         raise _error(
             path,
             "the file is empty" + (f" ({len(data)} bytes of blanks)" if data else " (0 bytes)"),
@@ -187,6 +223,8 @@ def _binary_stl(path: Path, data: bytes) -> PreparedMesh:
             f"{(len(data) - 84) // 50}",
             hint="the file was truncated (an interrupted download or copy): get it again",
         )
+    if count > mesh_budget():
+        return _simplified(path, data, count)
     if count > MAX_STL_TRIANGLES:
         return _convert(path, data)  # MuJoCo's STL reader stops at 200000 triangles; its OBJ reader does not
     vertices = np.frombuffer(data, _STL_RECORD, count=count, offset=84)["v"].reshape(-1, 3)
@@ -317,3 +355,135 @@ def _convert(path: Path, data: bytes) -> PreparedMesh:
     loaded.export(tmp, file_type=ext.lstrip("."))
     tmp.replace(out)
     return prepared
+
+
+# ------------------------------------------------------------------------------------------------ budget
+_DAE_COUNT = re.compile(rb"<(?:triangles|polylist|polygons|trifans|tristrips)\b[^>]*?\bcount=\"(\d+)\"")
+
+
+def _count(data: bytes, suffix: str) -> int | None:
+    """Triangles (at least faces) a mesh file holds, counted in its bytes (C speed, nothing built);
+    None for a format that cannot be counted so."""
+    if suffix == ".obj":
+        return data.count(b"\nf ") + data.count(b"\nf\t") + data.startswith((b"f ", b"f\t"))
+    if suffix == ".dae":
+        return sum(int(n) for n in _DAE_COUNT.findall(data))
+    if suffix == ".stl":  # ASCII
+        return data.count(b"endfacet")
+    return None
+
+
+def _check_count(path: Path, data: bytes, suffix: str) -> None:
+    """A format other than binary STL over the budget: refused before it is parsed (trimesh's loaders and
+    MuJoCo's take gigabytes for millions of triangles; only binary STL is simplified here)."""
+    count = _count(data, suffix)
+    if count is not None and count > mesh_budget():
+        raise _error(
+            path,
+            f"{count} triangles, over the budget of {mesh_budget()} a mesh may have",
+            hint=budget_hint(count) + "; or export it as binary STL, which is simplified when it is loaded "
+            "(SCENARIO_MAX_MESH_TRIANGLES raises the budget)",
+        )
+
+
+def _simplified(path: Path, data: bytes, count: int) -> PreparedMesh:
+    """A binary STL over the budget, simplified to a binary STL MuJoCo reads, cached by its content."""
+    target = min(mesh_budget(), SIMPLIFIED_TRIANGLES)
+    key = hashlib.sha256(f"{_RECIPE}\0simplify {target}\0".encode() + data).hexdigest()[:24]
+    out = mesh_cache() / f"{key}.stl"
+    corners = np.frombuffer(data, _STL_RECORD, count=count, offset=84)["v"].reshape(-1, 3)
+    if not np.isfinite(corners).all():
+        raise _error(path, "the mesh has vertices that are not numbers (NaN or infinite)")
+    if out.is_file():
+        prepared = prepare_mesh(out)
+    else:
+        vertices, faces = simplify(corners, target)
+        if len(faces) == 0:
+            raise _error(path, "the mesh has no triangles left once simplified", hint=budget_hint(count))
+        prepared = _looked_at(out, vertices, len(faces), path)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = out.with_name(f"{out.name}.{os.getpid()}.tmp")
+        _write_stl(tmp, vertices, faces)
+        tmp.replace(out)
+    return PreparedMesh(prepared.file, prepared.triangles, prepared.flat, prepared.extent, simplified=count)
+
+
+_LEVELS = 10  # bits per axis of the finest grid (1024 cells along the mesh's longest side)
+
+
+def _spread(x: np.ndarray) -> np.ndarray:
+    """10 bits of each value spread to every third bit (a Morton code's one axis)."""
+    x = x & 0x3FF
+    x = (x | (x << 16)) & 0x030000FF
+    x = (x | (x << 8)) & 0x0300F00F
+    x = (x | (x << 4)) & 0x030C30C3
+    return (x | (x << 2)) & 0x09249249
+
+
+def simplify(corners: np.ndarray, target: int) -> tuple[np.ndarray, np.ndarray]:
+    """Vertex clustering (Rossignac & Borrel): the triangles' corners (n*3, 3) snapped to a grid, each
+    cell's corners merged at their mean, the triangles that collapse dropped and duplicates merged; the
+    grid halved until at most `target` triangles are left. The corners are sorted once by their Morton
+    code on the finest grid: a coarser grid's cells are runs of that order (the code shifted), found in
+    one linear pass. A 5 M-triangle STL in seconds, within ~1 GB. It keeps the shape to a cell's size,
+    not its details: the warning's hint says how to do better."""
+    lo = corners.min(axis=0).astype(np.float64)
+    size = float((corners.max(axis=0) - lo).max()) or 1.0
+    finest = 1 << _LEVELS
+    code = np.zeros(len(corners), np.int64)
+    for k in range(3):  # an axis at a time: less memory at the peak than all three at once
+        axis = np.floor((corners[:, k] - lo[k]) * (finest / size)).astype(np.int64)
+        np.clip(axis, 0, finest - 1, out=axis)
+        code |= _spread(axis) << k
+        del axis
+    order = np.argsort(code, kind="stable")
+    code = code[order]
+    # a closed surface in a grid of c cells a side leaves ~12 c² triangles: start near the target
+    cells = max(8, int(math.sqrt(target / 12.0)) * 2)
+    level = max(0, _LEVELS - int(math.log2(cells)))
+    while True:
+        keys = code >> (3 * level)
+        first = np.empty(len(keys), bool)
+        first[0] = True
+        np.not_equal(keys[1:], keys[:-1], out=first[1:])
+        del keys
+        cluster = np.cumsum(first) - 1
+        del first
+        n = np.int64(cluster[-1] + 1)
+        inverse = np.empty(len(corners), np.int64)
+        inverse[order] = cluster
+        del cluster
+        tri = inverse.reshape(-1, 3)
+        keep = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 0] != tri[:, 2])
+        coarsest = level >= _LEVELS
+        # far more triangles than wanted (duplicates merge a few times over at most): a coarser grid at once
+        if int(keep.sum()) > 16 * target and int(n) ** 3 > 16 * target and not coarsest:
+            level += 1
+            continue
+        tri = tri[keep]
+        # the same triangle from several originals (any rotation of its corners; orientation kept)
+        start = tri.argmin(axis=1)
+        tri = np.take_along_axis(tri, (start[:, None] + np.arange(3)) % 3, axis=1)
+        tri = np.unique((tri[:, 0] * n + tri[:, 1]) * n + tri[:, 2])
+        if len(tri) <= target or coarsest:
+            break
+        level += 1
+    faces = np.stack([tri // (n * n), (tri // n) % n, tri % n], axis=1)
+    weights = np.bincount(inverse, minlength=int(n)).astype(np.float64)
+    vertices = np.stack(
+        [np.bincount(inverse, corners[:, k], minlength=int(n)) / weights for k in range(3)], axis=1
+    )
+    used, faces = np.unique(faces, return_inverse=True)
+    return vertices[used], faces.reshape(-1, 3)
+
+
+def _write_stl(path: Path, vertices: np.ndarray, faces: np.ndarray) -> None:
+    records = np.zeros(len(faces), _STL_RECORD)
+    tri = vertices[faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    length = np.linalg.norm(normal, axis=1, keepdims=True)
+    records["normal"] = np.divide(normal, length, out=np.zeros_like(normal), where=length > 0)
+    records["v"] = tri
+    with path.open("wb") as f:
+        f.write(b"simplified by scenario-runner".ljust(80, b"\0") + len(faces).to_bytes(4, "little"))
+        f.write(records.tobytes())

@@ -155,11 +155,29 @@ def compile_model(
     world: mujoco.MjSpec, robots: list[RobotPlan], sc: Scenario, doc: Document, notices: Notices
 ) -> str:
     """The world with its robots compiled by MuJoCo and checked (start overlaps, wheels): its MJCF."""
-    try:
-        compiled = world.compile()
-    except ValueError as e:
-        raise ScenarioError(_compile_problem(e, sc, doc, world)) from None
-    check_start_overlaps(compiled, sc, doc, notices)
+    for memory in (*ARENA_RETRIES, None):
+        try:
+            compiled = world.compile()
+            check_start_overlaps(compiled, sc, doc, notices)
+            break
+        except ValueError as e:
+            raise ScenarioError(_compile_problem(e, sc, doc, world)) from None
+        except mujoco.FatalError as e:
+            # MuJoCo's own abort: its arena (16 MB unless the model says) full at the first step. Its
+            # broad phase alone takes a slot for each pair of overlapping bodies, even bodies welded
+            # together that never collide: 3,000 links on fixed joints at one place overflow it. The run
+            # would end the same way, so the model gets more, or a located error instead of a traceback.
+            if memory is None or "stack" not in str(e):
+                raise ScenarioError(_fatal_problem(e, sc, doc)) from None
+            world.memory = memory
+            where = doc.locate(("robots",) if sc.robots else ("world",))
+            notices.add(
+                f"MuJoCo's memory for this world raised to {memory >> 20} MB: its {len(world.bodies)} bodies "
+                "overlap too much for the default 16 MB",
+                where.file,
+                where.line,
+                hint='a description can set its own with <mujoco><size memory="..."/></mujoco>',
+            )
     wheelless = check_geometry(compiled, robots, notices)
     if wheelless:
         raise ScenarioError(
@@ -177,6 +195,24 @@ def compile_model(
     if extent > 0:
         world.visual.map.shadowclip = max(float(world.visual.map.shadowclip), SHADOW_REACH_M / extent)
     return str(world.to_xml())
+
+
+# MuJoCo's arena sizes tried when its default overflows at the first step (bytes): allocated per MjData,
+# touched as used
+ARENA_RETRIES = (128 << 20, 512 << 20)
+
+
+def _fatal_problem(e: Exception, sc: Scenario, doc: Document) -> Problem:
+    first = " ".join(str(e).split("\n")[0].split())
+    where: PathKey = ("robots",) if sc.robots else ("world",)
+    return Problem(
+        f"MuJoCo cannot compute this world at t = 0: {first}",
+        doc.locate(where),
+        where,
+        hint="thousands of shapes touching at the start fill MuJoCo's memory: check for links placed inside "
+        "each other (with self-collision on) or robots inside each other; a description may give MuJoCo "
+        'more with <mujoco><size memory="256M"/></mujoco>',
+    )
 
 
 def _compile_problem(e: ValueError, sc: Scenario, doc: Document, world: mujoco.MjSpec) -> Problem:

@@ -111,12 +111,17 @@ class DrawnDocument(Document):
 
 def has_draws(data: Any, path: PathKey = ()) -> bool:
     """Whether `data` (a scenario's, `matrix:` aside) writes any draw."""
+    return _has_draws(data, path[-1] if path else None, top=not path)
+
+
+def _has_draws(data: Any, key: Any, top: bool) -> bool:
+    # (the parent's key, not the whole path: building a path per value of a long timeline cost seconds)
     if isinstance(data, dict):
-        if _draw_key(data) is not None or (path[-1:] == ("pose",) and "within" in data):
+        if _draw_key(data) is not None or (key == "pose" and "within" in data):
             return True
-        return any(has_draws(v, (*path, k)) for k, v in data.items() if (*path, k) != ("matrix",))
+        return any(_has_draws(v, k, False) for k, v in data.items() if not (top and k == "matrix"))
     if isinstance(data, list):
-        return any(has_draws(v, (*path, i)) for i, v in enumerate(data))
+        return any(_has_draws(v, None, False) for v in data)
     return False
 
 

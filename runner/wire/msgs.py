@@ -196,6 +196,45 @@ def from_data(type_name: str, data: Any, path: tuple[str | int, ...] = ()) -> An
     return T[type_name](**kwargs)
 
 
+def check_data(type_name: str, data: Any, path: tuple[str | int, ...] = ()) -> None:
+    """What `from_data` checks (each field given fits its type; the same errors), without building the
+    message: a field left out is its zero and needs no look. A 20,000-entry timeline is checked in a
+    fraction of the time building each message took."""
+    type_name = normalize_type(type_name)
+    if type_name not in T:
+        raise MessageDataError(f"unknown message type {type_name!r}", path)
+    _check_message(type_name, data, path)
+
+
+def _check_message(type_name: str, data: Any, path: tuple[str | int, ...]) -> None:
+    if data is None:
+        return
+    if not isinstance(data, dict):
+        raise MessageDataError(f"expected a mapping of fields for {type_name}, found {data!r}", path)
+    fields = _field_table(type_name)
+    for key, value in data.items():
+        desc = fields.get(key) if isinstance(key, str) else None
+        if desc is None:
+            from_data(type_name, data, path)  # raises the unknown field's error, worded once
+        if value is not None:
+            _check_field(desc, value, (*path, key))
+
+
+@cache
+def _field_table(type_name: str) -> dict[str, Any]:
+    return {name: desc for name, desc in TYPESTORE.fielddefs[type_name][1]}
+
+
+def _check_field(desc: tuple[Any, Any], value: Any, path: tuple[str | int, ...]) -> None:
+    node, detail = desc
+    if node == Nodetype.BASE:
+        _base_value(detail[0], value, path)
+    elif node == Nodetype.NAME:  # (a field's type name is a full one already)
+        _check_message(detail, value, path)
+    else:  # an array or sequence: the same checks as _field_value's
+        _field_value(desc, value, path)
+
+
 def to_data(msg: Any) -> Any:
     """A message as plain data (for printing and tests)."""
     if hasattr(msg, "__dataclass_fields__"):

@@ -12,7 +12,7 @@ import numpy as np
 from lxml import etree
 
 from runner.compile.decompose import cached_decomposition, decompose_file
-from runner.compile.meshes import MeshError, prepare_mesh
+from runner.compile.meshes import MeshError, budget_hint, mesh_budget, prepare_mesh
 from runner.compile.sdf.parts import Src
 from runner.compile.sdf.reader import Reader
 
@@ -159,6 +159,16 @@ class MeshReader(Reader):
         try:  # the same checks and conversions as a URDF's meshes (runner.compile.meshes)
             prepared = prepare_mesh(path)
             path, flat = prepared.file, prepared.flat
+            if prepared.simplified:
+                self.note(
+                    f"mesh {use.uri!r} has {prepared.simplified} triangles, over the budget of "
+                    f"{mesh_budget()}: simplified to {prepared.triangles} for MuJoCo (vertex clustering: its "
+                    "shape to within a grid cell, its details lost)",
+                    use.src,
+                    use.at,
+                    hint=budget_hint(prepared.simplified)
+                    + " (SCENARIO_MAX_MESH_TRIANGLES raises the budget)",
+                )
         except MeshError as e:
             # a format that cannot be converted may have an STL or OBJ export beside it
             alt = next(

@@ -160,7 +160,48 @@ def check_structure(root: Any, where: Any) -> str:
             *where(root),
             hint="every link but one must be the child of a joint",
         )
+    check_depth(root, roots[0], children, joint_lines, where)
     return roots[0]
+
+
+# MuJoCo refuses a kinematic tree deeper than this ("depth limit exceeded in signature computation",
+# measured with mujoco 3.17: a chain of 1023 bodies below the world compiles, 1024 does not). Each URDF link
+# is a body (fixed links are kept), so this is the longest chain of links. MuJoCo finds it only after its
+# compile has gone through the tree's joints: minutes for a few thousand hinges, against milliseconds here.
+MAX_TREE_DEPTH = 1023
+
+
+def check_depth(
+    root: Any, root_link: str, children: dict[str, str], joints: dict[str, Any], where: Any
+) -> None:
+    """The longest chain of links against MuJoCo's depth limit, before MuJoCo is asked."""
+    parent_of = {}
+    for j in joints.values():
+        parent_of[j.find("child").get("link")] = j.find("parent").get("link")
+    depth: dict[str, int] = {root_link: 1}
+    for link in parent_of:  # each link's depth, the chain above it walked once (iteratively: no recursion)
+        chain = []
+        x = link
+        while x not in depth:
+            chain.append(x)
+            x = parent_of.get(x)
+            if x is None or len(chain) > len(parent_of):
+                return  # a loop or a second root: check_structure says so
+        d = depth[x]
+        for y in reversed(chain):
+            d += 1
+            depth[y] = d
+    deepest = max(depth, key=depth.__getitem__)
+    if depth[deepest] > MAX_TREE_DEPTH:
+        first = MAX_TREE_DEPTH + 1
+        joint = next(j for j in joints.values() if depth.get(j.find("child").get("link")) == first)
+        raise DescriptionError(
+            f"the chain of links from {root_link!r} to {deepest!r} is {depth[deepest]} links deep; MuJoCo "
+            f"compiles a tree at most {MAX_TREE_DEPTH} bodies deep (this joint's child is the first past it)",
+            *where(joint),
+            hint="join links that never move relative to each other into one link (their shapes as several "
+            "<collision>/<visual> of it), or describe the chain as several robots",
+        )
 
 
 # The dimensions of each URDF shape (attribute, how many numbers)

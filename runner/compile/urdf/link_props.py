@@ -10,6 +10,7 @@ from typing import Any
 import mujoco
 
 from runner.compile.gazebo import GazeboInfo
+from runner.compile.urdf.checks import DescriptionError
 
 
 def apply_link_props(spec: mujoco.MjSpec, gazebo: GazeboInfo, timestep: float) -> None:
@@ -41,13 +42,25 @@ def apply_link_props(spec: mujoco.MjSpec, gazebo: GazeboInfo, timestep: float) -
                 geom.solref = [max(2.0 * timestep, 2.0 * math.pi * math.sqrt(mass / props.kp)), 1.0]
 
 
-def self_collision(root: Any, spec: mujoco.MjSpec, gazebo: GazeboInfo) -> list[str]:
+# Contact exclusions made for one robot at most: Gazebo's no-self-collision rule over n moving links is
+# n²/2 MuJoCo exclusions (a chain as deep as MuJoCo allows, 1023 hinged links, needs 522k: ~5 s to compile).
+MAX_EXCLUDES = 600_000
+
+
+def self_collision(
+    root: Any, spec: mujoco.MjSpec, gazebo: GazeboInfo, *, root_welded: bool = False, where: Any = None
+) -> list[str]:
     """Gazebo's rule: links of one model collide with each other only if one of the two has self_collide
     (the link's `<selfCollide>`, else the model's `<self_collide>`, off by default), and never when a joint
     connects them. Gazebo lumps links joined by fixed joints into one link: those never collide with each
-    other either, and a joint between two such groups connects all their links. MuJoCo only leaves out
-    parent-child pairs, so every other pair that Gazebo would not collide is excluded here. Returns the
-    links that self-collide."""
+    other either, and a joint between two such groups connects all their links. Returns the links that
+    self-collide.
+
+    MuJoCo leaves out by itself the pairs of bodies welded together (no joint between them: one fixed
+    group) and those whose welded groups are parent and child (engine_collision_driver.c, the parent
+    filter, unless a group is welded to the world): every other pair that Gazebo would not collide is
+    excluded here. (Excluding every pair, as this did, made 3,000 links on fixed joints 4.5 M exclusions.)
+    The pairs are counted first: past MAX_EXCLUDES, a located error says why."""
     parent: dict[str, str] = {}
     group = {el.get("name"): el.get("name") for el in root.findall("link")}
 
@@ -77,12 +90,36 @@ def self_collision(root: Any, spec: mujoco.MjSpec, gazebo: GazeboInfo) -> list[s
         b.name for b in spec.bodies if b.name in group and any(g.contype or g.conaffinity for g in b.geoms)
     ]
     on = [name for name in bodies if collides(name)]
-    for i, a in enumerate(bodies):
-        for b in bodies[i + 1 :]:
-            ga, gb = find(a), find(b)
-            if parent.get(a) == b or parent.get(b) == a:
-                continue  # MuJoCo leaves parent and child out by itself
-            if (collides(a) or collides(b)) and ga != gb and frozenset((ga, gb)) not in jointed:
-                continue
-            spec.add_exclude(bodyname1=a, bodyname2=b)
+    members: dict[str, list[str]] = {}  # group -> its bodies
+    for name in bodies:
+        members.setdefault(find(name), []).append(name)
+    roots = [name for name in group if name not in parent]
+    base = find(roots[0]) if roots else None  # the root link's group (welded to the world if fixed)
+    pairs: list[tuple[str, str]] = []
+    # a joint between two groups where one is welded to the world: MuJoCo's parent filter does not apply
+    for g1, g2 in (tuple(pair) for pair in jointed if root_welded and base in pair):
+        pairs += [(a, b) for a in members.get(g1, []) for b in members.get(g2, [])]
+    off = {g: [n for n in names if not collides(n)] for g, names in members.items()}
+    off = {g: names for g, names in off.items() if names}
+    sizes = {g: len(names) for g, names in off.items()}
+    total = sum(sizes.values())
+    count = (total * total - sum(n * n for n in sizes.values())) // 2 - sum(
+        sizes.get(g1, 0) * sizes.get(g2, 0) for g1, g2 in (tuple(pair) for pair in jointed)
+    )
+    if count + len(pairs) > MAX_EXCLUDES:
+        raise DescriptionError(
+            f"{len(bodies)} links that must not collide with each other (Gazebo's default: no "
+            f"<self_collide>) need {count + len(pairs)} MuJoCo contact exclusions; at most {MAX_EXCLUDES} "
+            "are made",
+            *(where(root) if where is not None else (None, None)),
+            hint="join links that never move relative to each other with fixed joints (a fixed group "
+            "costs nothing), or set <self_collide>true</self_collide> on the model if its links may touch",
+        )
+    groups = list(off)
+    for i, g1 in enumerate(groups):
+        for g2 in groups[i + 1 :]:
+            if frozenset((g1, g2)) not in jointed:
+                pairs += [(a, b) for a in off[g1] for b in off[g2]]
+    for a, b in pairs:
+        spec.add_exclude(bodyname1=a, bodyname2=b)
     return on

@@ -8,7 +8,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from runner.compile.meshes import MeshError, PreparedMesh, prepare_mesh
+from runner.compile.meshes import MeshError, PreparedMesh, budget_hint, mesh_budget, prepare_mesh
 from runner.compile.packages import PackageMap, resolve_uri
 from runner.compile.urdf.checks import DescriptionError
 from runner.errors import Notices
@@ -46,6 +46,15 @@ def rewrite_mesh(
         if link is not None:
             link.remove(role_el)
         return
+    if prepared.simplified:
+        notices.add(
+            f"{'visual' if visual else 'collision'} mesh {uri!r} has {prepared.simplified} triangles, over "
+            f"the budget of {mesh_budget()}: simplified to {prepared.triangles} for MuJoCo (vertex "
+            "clustering: "
+            "its shape to within a grid cell, its details lost)",
+            *location,
+            hint=budget_hint(prepared.simplified),
+        )
     scale = _scale(mesh)
     flat = prepared.flat or 0.0 in scale
     if flat and not visual:

@@ -85,7 +85,7 @@ def urdf_to_model(
     transmissions = read_transmissions(root, where, notices)
     spec = _load(root, where, file, shell)
     apply_link_props(spec, gazebo, timestep)
-    collide = self_collision(root, spec, gazebo)
+    collide = self_collision(root, spec, gazebo, root_welded=fixed or gazebo.static, where=where)
     body = spec.body(root_link)
     if not (fixed or gazebo.static):
         body.add_freejoint(name="root")
