@@ -180,20 +180,21 @@ def _place(sc: Scenario, doc: Document) -> _Placement:
                 )
             )
     expected = "one of: " + ", ".join(names)
+
+    def unknown_world(w: str, where: PathKey) -> Problem:
+        return Problem(
+            f"no world named {w!r}",
+            doc.locate(where),
+            where,
+            expected=expected,
+            hint=did_you_mean(w, names, "worlds"),
+        )
+
     robot_world: dict[str, str] = {}
     for i, robot in enumerate(sc.robots):
         w = robot.world or names[0]
         if w not in names:
-            where: PathKey = ("robots", i, "world")
-            problems.append(
-                Problem(
-                    f"no world named {w!r}",
-                    doc.locate(where),
-                    where,
-                    expected=expected,
-                    hint=did_you_mean(w, names, "worlds"),
-                )
-            )
+            problems.append(unknown_world(w, ("robots", i, "world")))
         robot_world[robot.name] = w
     timeline_world = [_timeline_world(sc, doc, i, names, problems) for i in range(len(sc.timeline))]
     models = {w.name: {m.name for m in w.models} for w in sc.worlds}
@@ -208,16 +209,7 @@ def _place(sc: Scenario, doc: Document) -> _Placement:
         )
         w = node.world or by_ns or names[0]
         if w not in names:
-            where = ("nodes", i, "world")
-            problems.append(
-                Problem(
-                    f"no world named {w!r}",
-                    doc.locate(where),
-                    where,
-                    expected=expected,
-                    hint=did_you_mean(w, names, "worlds"),
-                )
-            )
+            problems.append(unknown_world(w, ("nodes", i, "world")))
         node_world[node.name] = w
     if problems:
         raise ScenarioError(problems)
