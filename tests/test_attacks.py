@@ -1,0 +1,62 @@
+"""Hostile inputs beyond a scenario's own checks: names that are markup, terminal escapes or XML poison,
+on every way out (terminal, JUnit XML)."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from runner.checks.judge import Result
+from runner.cli import app
+from runner.cli.results import print_results
+from runner.tools.report import Suite, write_junit
+
+# markup rich would parse (a closing tag it cannot match: MarkupError), a link, terminal escapes (clear the
+# screen, set the window title), a bidirectional override, and characters XML 1.0 cannot hold
+HOSTILE = "a [/x] [link=https://example.org]b[/link] \x1b[2J\x1b]0;pwn\x07 \u202eevil \x01\ufffe ]]> <c>"
+
+
+def _result(name: str) -> Result:
+    return Result(name, "stay_within", "fail", 1_000_000_000, "(1.000, 0.000)", "inside the region", "out")
+
+
+def test_an_assertion_named_like_markup_is_printed_as_it_is(capsys: pytest.CaptureFixture[str]) -> None:
+    print_results([_result(HOSTILE)])  # raised rich's MarkupError (a traceback at the run's very end)
+    text = capsys.readouterr().out
+    assert "\x1b" not in text and "\u202e" not in text and "\x07" not in text  # shown, not obeyed
+    assert "a [/x] [link=https://example.org]b[/link] \\x1b[2J\\x1b]0;pwn\\x07 \\u202eevil" in text
+
+
+def test_a_recording_with_a_hostile_topic_is_listed(tmp_path: Path) -> None:
+    from mcap.writer import Writer
+
+    mcap = tmp_path / "evil.mcap"
+    with mcap.open("wb") as f:
+        w = Writer(f)
+        w.start("ros2", "test")
+        schema = w.register_schema("std_msgs/msg/String", "ros2msg", b"string data")
+        channel = w.register_channel(HOSTILE, "cdr", schema)
+        for t in (0, 1_000_000_000):
+            w.add_message(channel, t, b"\x00\x01\x00\x00\x01\x00\x00\x00\x00", t)
+        w.finish()
+    result = CliRunner().invoke(app, ["info", str(mcap)])
+    assert result.exception is None or isinstance(result.exception, SystemExit), result.exception
+    assert result.exit_code == 0, result.output
+    assert "\x1b" not in result.output
+    assert "[/x]" in result.output and "\\x1b[2J" in result.output
+
+
+def test_junit_xml_of_hostile_names_is_well_formed(tmp_path: Path) -> None:
+    path = tmp_path / "junit.xml"
+    suite = Suite(HOSTILE.replace(" ", "_"), [_result(HOSTILE)], error=f"node said: {HOSTILE}")
+    write_junit(path, [suite])
+    root = ET.parse(path).getroot()  # control characters made the whole file unreadable
+    names = [case.get("name") for case in root.iter("testcase")]
+    assert (
+        "a [/x] [link=https://example.org]b[/link] \\x1b[2J\\x1b]0;pwn\\x07 \u202eevil \\x01\\ufffe ]]> <c>"
+        in (names)
+    )
+    assert "\\x01" in (root.find("testsuite/testcase/error").text or "")
