@@ -60,3 +60,41 @@ def test_junit_xml_of_hostile_names_is_well_formed(tmp_path: Path) -> None:
         in (names)
     )
     assert "\\x01" in (root.find("testsuite/testcase/error").text or "")
+
+
+@pytest.mark.timeout(60)
+def test_a_stray_publisher_naming_a_new_type_each_time_is_said_a_bounded_number_of_times(
+    capfd: pytest.CaptureFixture[str],
+) -> None:
+    """Another session names a different (escape-laden) type in each sample on a world's command key: the
+    world's reasons, stderr lines and counts stay bounded and show the escapes instead of obeying them."""
+    import time
+
+    import zenoh
+
+    from runner.wire.transport import MAX_REASONS, OTHER_REASONS, ZenohBus, free_port, make_config
+
+    port = free_port()
+    key = "attack/r1/cmd_vel"
+    delivered: list[bytes] = []
+    with zenoh.open(make_config("peer", listen=[f"tcp/127.0.0.1:{port}"])) as world:
+        bus = ZenohBus(world)
+        bus.subscribe(key, lambda _k, payload, _a: delivered.append(payload), "geometry_msgs/msg/Twist")
+        with zenoh.open(make_config("peer", connect=[f"tcp/127.0.0.1:{port}"])) as stray:
+            pub = stray.declare_publisher(key)
+            deadline = time.monotonic() + 30
+            while not pub.matching_status.matching and time.monotonic() < deadline:
+                time.sleep(0.02)  # the world's subscription has reached the stray session
+            n = 200
+            for i in range(n):
+                encoding = zenoh.Encoding.APPLICATION_CDR.with_schema(f"x\x1b]0;pwn{i}\x07\x1b[2J/msg/T{i}")
+                pub.put(b"\x00\x01\x00\x00" + bytes(48), encoding=encoding)
+            while sum(bus.rejected.get(key, {}).values()) < n and time.monotonic() < deadline:
+                time.sleep(0.02)
+    counts = bus.rejected[key]
+    assert sum(counts.values()) == n and not delivered
+    assert len(counts) == MAX_REASONS + 1 and counts[OTHER_REASONS] == n - MAX_REASONS  # was 200 kinds
+    err = capfd.readouterr().err
+    said = [line for line in err.splitlines() if line.startswith("world: dropping messages on")]
+    assert len(said) == MAX_REASONS + 1, err  # was a line per sample
+    assert "\x1b" not in err and "\x07" not in err and "x\\x1b]0;pwn0\\x07\\x1b[2J/msg/T0" in err

@@ -4,7 +4,6 @@ exit 1."""
 
 from __future__ import annotations
 
-import re
 import sys
 from typing import Any
 
@@ -12,17 +11,7 @@ import typer
 from rich.console import Console
 from rich.text import Text
 
-from runner.errors import ScenarioError
-
-# Characters a terminal acts on rather than shows: C0 controls but tab and newline (ESC starts the
-# sequences that clear the screen, set the window title, write the clipboard), DEL, C1 controls, and the
-# bidirectional overrides that reorder what is shown ("Trojan Source").
-_CONTROLS = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]")
-
-
-def visible(text: str) -> str:
-    """`text` with every control character written as an escape (`\x1b`, `\u202e`), as `repr` would."""
-    return _CONTROLS.sub(lambda m: repr(m.group())[1:-1], text)
+from runner.errors import ScenarioError, visible
 
 
 class _Terminal(Console):

@@ -34,7 +34,7 @@ from runner.record.claim import claim, lock_of
 from runner.record.finisher import Guard
 from runner.record.mcap_file import CHUNK_SIZE, McapFile, RecordedChannel, TopicStats
 from runner.wire import msgs
-from runner.wire.transport import ATTACHMENT, type_from_encoding, unpack_attachment
+from runner.wire.transport import ATTACHMENT, count_reason, type_from_encoding, unpack_attachment
 
 # Samples queued for the drain thread, at most: bounds the memory a slow disk can take (1024 camera images
 # of 1 MB...); a larger queue records no faster (bench/recorder.py).
@@ -217,10 +217,9 @@ class Recorder:
         self._write(key, type_from_encoding(sample.encoding), sample.payload.to_bytes(), parsed)
 
     def _mistyped(self, key: str, why: str) -> None:
-        counts = self.mistyped.setdefault(key, {})
-        if why not in counts:
-            print(f"recorder: not recording messages on {key}: {why}", file=sys.stderr, flush=True)
-        counts[why] = counts.get(why, 0) + 1
+        first = count_reason(self.mistyped.setdefault(key, {}), why)
+        if first is not None:
+            print(f"recorder: not recording messages on {key}: {first}", file=sys.stderr, flush=True)
 
     def write(self, key: str, type_name: str | None, payload: bytes, att: tuple[int, int] | None) -> None:
         """Record one message: `att` is (sequence number, sim time ns) or None (no attachment)."""
