@@ -98,3 +98,61 @@ def test_a_stray_publisher_naming_a_new_type_each_time_is_said_a_bounded_number_
     said = [line for line in err.splitlines() if line.startswith("world: dropping messages on")]
     assert len(said) == MAX_REASONS + 1, err  # was a line per sample
     assert "\x1b" not in err and "\x07" not in err and "x\\x1b]0;pwn0\\x07\\x1b[2J/msg/T0" in err
+
+
+RECORDS_TO = """
+name: records_to
+duration: 0.3
+robots:
+  - name: r1
+    description: {file: "{diffbot}"}
+    pose: {xyz: [0, 0, 0.06]}
+record: {path: home/notes}
+"""
+
+
+@pytest.mark.timeout(120)
+def test_a_scenario_recording_into_a_users_folder_overwrites_and_removes_nothing_of_theirs(
+    write_scenario, tmp_path: Path
+) -> None:
+    """`record.path` names a user's file: it is not overwritten (it was, with MCAP bytes). Recording into a
+    folder clears only stale locks of recordings: a user's `.notes.lock` and the short `notes` beside it,
+    `..npmrc.lock` and `.npmrc`, were removed as if they were a killed run's."""
+    from tests.conftest import run_cli
+
+    home = tmp_path / "home"
+    home.mkdir()
+    theirs = {"notes": b"todo\n", ".notes.lock": b"", ".npmrc": b"k=v\n", "..npmrc.lock": b""}
+    for name, content in theirs.items():
+        (home / name).write_bytes(content)
+    # a run from before lock files said whose they are, killed: its empty lock and empty recording go
+    (home / ".old.mcap.lock").write_bytes(b"")
+    (home / "old.mcap").write_bytes(b"")
+    r = run_cli("run", str(write_scenario(RECORDS_TO)), "--no-judge", "-q", timeout=100)
+    assert r.returncode == 1, r.stderr[-2000:]
+    assert "Traceback" not in r.stderr
+    assert f"cannot write the recording {home / 'notes'}" in r.stderr or "home/notes" in r.stderr, r.stderr
+    assert "exists and is not an MCAP recording: it is not overwritten" in r.stderr, r.stderr
+    assert {p.name: p.read_bytes() for p in home.iterdir()} == {
+        **theirs,
+        ".old.mcap.lock": b"",
+        "old.mcap": b"",
+    }
+    r = run_cli(
+        "run", str(write_scenario(RECORDS_TO.replace("home/notes", "home/new.mcap"))), "--no-judge", "-q"
+    )
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert {p.name: p.read_bytes() for p in home.iterdir() if p.name != "new.mcap"} == theirs
+
+
+def test_a_recording_is_never_written_over_a_device(tmp_path: Path) -> None:
+    from runner.record.claim import refuse_foreign
+
+    with pytest.raises(FileExistsError, match="not a regular file"):
+        refuse_foreign(Path("/dev/null"))
+    refuse_foreign(tmp_path / "new.mcap")  # (not there: fine)
+    (tmp_path / "empty.mcap").write_bytes(b"")
+    refuse_foreign(tmp_path / "empty.mcap")
+    (tmp_path / "cut.mcap").write_bytes(b"\x89MCAP0\r\n" + bytes(100))
+    refuse_foreign(tmp_path / "cut.mcap")  # a recording of an earlier run: written over, as always
+

@@ -30,7 +30,7 @@ from typing import IO, Any
 
 import zenoh
 
-from runner.record.claim import claim, lock_of
+from runner.record.claim import claim, lock_of, refuse_foreign
 from runner.record.finisher import Guard
 from runner.record.mcap_file import CHUNK_SIZE, McapFile, RecordedChannel, TopicStats
 from runner.wire import msgs
@@ -78,9 +78,11 @@ class Recorder:
         self.path.parent.mkdir(parents=True, exist_ok=True)
         # the path the plan gave; `path` is the one recorded to (see `runner.record.claim`)
         self.asked = self.path
+        refuse_foreign(self.path)  # (before its lock is made: a user's `.notes.lock` beside `notes` too)
         self.path, self._claim_fd = claim(self.path)
         self._guard: Guard | None = None
         try:
+            refuse_foreign(self.path)
             # unbuffered: whole chunks are written at once, and a failed write (a full disk) leaves no
             # buffer behind that a later flush would write past the point the file is cut back to
             self._file: IO[bytes] = open(self.path, "wb", buffering=0)  # noqa: SIM115 - closed in close()
