@@ -156,3 +156,10 @@ def test_a_recording_is_never_written_over_a_device(tmp_path: Path) -> None:
     (tmp_path / "cut.mcap").write_bytes(b"\x89MCAP0\r\n" + bytes(100))
     refuse_foreign(tmp_path / "cut.mcap")  # a recording of an earlier run: written over, as always
 
+
+@pytest.mark.timeout(60)
+def test_validate_reads_no_more_of_an_endless_file_than_a_scenario_may_hold() -> None:
+    # /dev/zero is no regular file (its size says 0): it was read whole, to a MemoryError at 3.4 GB
+    result = CliRunner().invoke(app, ["validate", "/dev/zero"])
+    assert result.exit_code == 1 and "Traceback" not in result.output
+    assert "/dev/zero:1:1: this file goes on past 4 MB, the most a scenario may be" in result.output
