@@ -163,3 +163,20 @@ def test_validate_reads_no_more_of_an_endless_file_than_a_scenario_may_hold() ->
     result = CliRunner().invoke(app, ["validate", "/dev/zero"])
     assert result.exit_code == 1 and "Traceback" not in result.output
     assert "/dev/zero:1:1: this file goes on past 4 MB, the most a scenario may be" in result.output
+
+
+@pytest.mark.timeout(120)
+def test_a_damaged_recording_is_reported_as_damaged_without_a_traceback(
+    write_scenario, tmp_path: Path
+) -> None:
+    from tests.conftest import run_cli
+
+    mcap = tmp_path / "run.mcap"
+    scenario = write_scenario(RECORDS_TO.replace("home/notes", str(mcap)).replace("0.3", "1.0"))
+    assert run_cli("run", str(scenario), "--no-judge", "-q").returncode == 0
+    data = mcap.read_bytes()
+    mcap.write_bytes(data[: len(data) // 2])  # cut mid-record (a copy cut short, a disk gone bad)
+    result = CliRunner().invoke(app, ["report", str(mcap), "-o", str(tmp_path / "r.html")])
+    assert result.exception is None or isinstance(result.exception, SystemExit), result.exception
+    assert result.exit_code == 1, result.output
+    assert f"error: {mcap}: cannot read it as MCAP: " in " ".join(result.output.split())
