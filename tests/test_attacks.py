@@ -180,3 +180,24 @@ def test_a_damaged_recording_is_reported_as_damaged_without_a_traceback(
     assert result.exception is None or isinstance(result.exception, SystemExit), result.exception
     assert result.exit_code == 1, result.output
     assert f"error: {mcap}: cannot read it as MCAP: " in " ".join(result.output.split())
+
+
+LIDAR = """
+name: big_lidar
+duration: 1
+robots:
+  - name: r1
+    description: {file: "{diffbot}"}
+    pose: {xyz: [0, 0, 0.06]}
+    plugins:
+      - {type: lidar, params: {link: lidar_link, samples: 100000000}}
+"""
+
+
+def test_a_lidar_of_a_hundred_million_beams_is_refused_where_it_is_written(write_scenario) -> None:
+    # it passed validate, and the run's world ended in a MemoryError traceback (3.2 GB at a 4 GB limit)
+    path = write_scenario(LIDAR)
+    result = CliRunner().invoke(app, ["validate", str(path)])
+    assert result.exit_code == 1 and "Traceback" not in result.output
+    text = " ".join(result.output.split())
+    assert f"{path}:8:" in text and "robots[0].plugins[0].params: 100000000 x 1 = 100,000,000 beams" in text
