@@ -201,3 +201,32 @@ def test_a_lidar_of_a_hundred_million_beams_is_refused_where_it_is_written(write
     assert result.exit_code == 1 and "Traceback" not in result.output
     text = " ".join(result.output.split())
     assert f"{path}:8:" in text and "robots[0].plugins[0].params: 100000000 x 1 = 100,000,000 beams" in text
+
+
+def test_a_link_in_a_description_folder_reads_nothing_outside_and_says_where_it_points(
+    tmp_path: Path,
+) -> None:
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (outside / "parts.xacro").write_text(
+        '<?xml version="1.0"?><robot xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:property name="w" value="0.5"/></robot>'
+    )
+    desc = tmp_path / "scenario" / "pkg" / "urdf"
+    desc.mkdir(parents=True)
+    (desc / "linked").symlink_to(outside)
+    (desc / "robot.xacro").write_text(
+        '<?xml version="1.0"?>\n<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+        '  <xacro:include filename="linked/parts.xacro"/>\n'
+        '  <link name="base_link"><inertial><mass value="1"/>'
+        '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>\n</robot>\n'
+    )
+    scenario = tmp_path / "scenario" / "s.yaml"
+    scenario.write_text("name: s\nduration: 1\nrobots:\n  - {name: r1, description: pkg/urdf/robot.xacro}\n")
+    result = CliRunner().invoke(app, ["validate", str(scenario)])
+    assert result.exit_code == 1, result.output
+    text = " ".join(result.output.split())
+    assert (
+        f"robot.xacro:3: {desc / 'linked' / 'parts.xacro'} (a link to {outside / 'parts.xacro'}) is outside"
+        in text
+    ), text
