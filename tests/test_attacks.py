@@ -230,3 +230,45 @@ def test_a_link_in_a_description_folder_reads_nothing_outside_and_says_where_it_
         f"robot.xacro:3: {desc / 'linked' / 'parts.xacro'} (a link to {outside / 'parts.xacro'}) is outside"
         in text
     ), text
+
+
+@pytest.mark.timeout(90)
+def test_a_stray_session_putting_on_thousands_of_keys_is_told_in_twenty_lines(tmp_path: Path) -> None:
+    """A stray session put one message on each of 20,000 keys of its own under the run: 20,000 'outside:'
+    lines in the end table and 20,000 results properties. The recorder counts 1000 keys apart, the rest
+    together; the table and the results name the 19 busiest and fold the others into one line."""
+    import time
+    from types import SimpleNamespace
+
+    import zenoh
+
+    from runner.launch.parts import OUTSIDE_SHOWN, outside_of
+    from runner.record import Recorder
+    from runner.record.recorder import OTHER_KEYS, OUTSIDE_KEYS
+    from runner.wire.transport import free_port, make_config
+
+    port = free_port()
+    n = OUTSIDE_KEYS + 500
+    recorder = Recorder(tmp_path / "run.mcap", ["**"])
+    with zenoh.open(make_config("peer", listen=[f"tcp/127.0.0.1:{port}"])) as run_session:
+        recorder.subscribe(run_session, "run/**")
+        with zenoh.open(make_config("peer", connect=[f"tcp/127.0.0.1:{port}"])) as stray:
+            probe = stray.declare_publisher("run/probe")
+            deadline = time.monotonic() + 30
+            while not probe.matching_status.matching and time.monotonic() < deadline:
+                time.sleep(0.02)  # the recorder's subscription has reached the stray session
+            for _ in range(3):
+                probe.put(b"x")  # the busiest key
+            for i in range(n):
+                stray.put(f"run/junk{i:05d}", b"\x00\x01\x00\x00" + bytes(8))
+            while sum(recorder.outside.values()) < n + 3 and time.monotonic() < deadline:
+                time.sleep(0.02)
+        recorder.close()
+    assert sum(recorder.outside.values()) == n + 3
+    assert len(recorder.outside) == OUTSIDE_KEYS + 1 and recorder.outside[OTHER_KEYS] == n + 1 - OUTSIDE_KEYS
+    counts, _who = outside_of(SimpleNamespace(recorder=SimpleNamespace(recorder=recorder)))
+    assert len(counts) == OUTSIDE_SHOWN and sum(counts.values()) == n + 3
+    assert counts["run/probe"] == 3
+    assert counts[f"more than {OUTSIDE_KEYS - (OUTSIDE_SHOWN - 1)} other keys"] == n + 3 - 3 - (
+        OUTSIDE_SHOWN - 2
+    )

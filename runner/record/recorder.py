@@ -36,6 +36,11 @@ from runner.record.mcap_file import CHUNK_SIZE, McapFile, RecordedChannel, Topic
 from runner.wire import msgs
 from runner.wire.transport import ATTACHMENT, count_reason, type_from_encoding, unpack_attachment
 
+# Keys counted one by one for publishers outside the run, at most; past them, together under OTHER_KEYS (a
+# stray session putting on 20,000 keys of its own made 20,000 end-table lines and results properties).
+OUTSIDE_KEYS = 1000
+OTHER_KEYS = "(other keys)"
+
 # Samples queued for the drain thread, at most: bounds the memory a slow disk can take (1024 camera images
 # of 1 MB...); a larger queue records no faster (bench/recorder.py).
 FIFO_CAPACITY = 1024
@@ -190,7 +195,8 @@ class Recorder:
         att = sample.attachment
         raw = att.to_bytes() if att is not None else b""
         if len(raw) != _ATT_SIZE:
-            self.outside[key] = self.outside.get(key, 0) + 1
+            counted = key if key in self.outside or len(self.outside) < OUTSIDE_KEYS else OTHER_KEYS
+            self.outside[counted] = self.outside.get(counted, 0) + 1
         ch = self._channels.get(key)
         if self.types and key in self.types:
             given = type_from_encoding(sample.encoding)
