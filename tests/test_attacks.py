@@ -272,3 +272,12 @@ def test_a_stray_session_putting_on_thousands_of_keys_is_told_in_twenty_lines(tm
     assert counts[f"more than {OUTSIDE_KEYS - (OUTSIDE_SHOWN - 1)} other keys"] == n + 3 - 3 - (
         OUTSIDE_SHOWN - 2
     )
+
+
+def test_a_refused_origin_is_said_with_its_escapes_shown(capsys: pytest.CaptureFixture[str]) -> None:
+    # a client that is no browser sends any bytes as its Origin; the runner said them to its terminal as is
+    from runner.launch.live import _say_refused
+
+    _say_refused("http://evil.example\x1b]0;pwned\x07\x1b[2J")
+    err = capsys.readouterr().err
+    assert "\x1b" not in err and "origin http://evil.example\\x1b]0;pwned\\x07\\x1b[2J: not an allowed" in err
