@@ -281,3 +281,35 @@ def test_a_refused_origin_is_said_with_its_escapes_shown(capsys: pytest.CaptureF
     _say_refused("http://evil.example\x1b]0;pwned\x07\x1b[2J")
     err = capsys.readouterr().err
     assert "\x1b" not in err and "origin http://evil.example\\x1b]0;pwned\\x07\\x1b[2J: not an allowed" in err
+
+
+LOUD_NODE = """
+name: loud
+duration: 0.5
+robots:
+  - name: r1
+    description: {file: "{diffbot}"}
+    pose: {xyz: [0, 0, 0.06]}
+nodes:
+  - name: loud
+    cmd: python loud.py
+"""
+
+
+@pytest.mark.timeout(120)
+def test_a_node_writing_megabytes_without_a_newline_is_shown_cut(write_scenario, tmp_path: Path) -> None:
+    """Its output was read a line at a time, however long: 800 MB without a newline took the runner to
+    2.6 GB. A line is shown up to 64 KiB and the rest counted."""
+    from runner.launch.nodes import LINE_MAX
+    from tests.conftest import run_cli
+
+    (tmp_path / "loud.py").write_text(
+        "import sys\nsys.stdout.write('x' * 4_000_000 + '\\nafter\\n')\nsys.stdout.flush()\n"
+    )
+    r = run_cli("run", str(write_scenario(LOUD_NODE)), "--no-judge", "--no-record", timeout=100)
+    assert r.returncode == 0, r.stderr[-2000:]
+    lines = r.stderr.splitlines()
+    shown = next(line for line in lines if line.startswith("[loud] xxx"))
+    assert len(shown) == len("[loud] ") + LINE_MAX
+    assert f"[loud] (the line above went on for {4_000_000 - LINE_MAX + 1} more bytes, not shown)" in lines
+    assert "[loud] after" in lines
