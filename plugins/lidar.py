@@ -39,6 +39,8 @@ from runner.wire import msgs
 
 _EPS = 1e-4
 _HIDDEN_GROUP = 1  # the geom group rays skip (URDF visuals live there already)
+# Beams of one scan (samples x vertical_samples), at most: each costs ~100 bytes and a ray cast per scan.
+MAX_BEAMS = 1_000_000
 
 
 class LidarParams(RatedParams):
@@ -96,6 +98,14 @@ class LidarParams(RatedParams):
 
     @model_validator(mode="after")
     def _angles(self) -> LidarParams:
+        beams = self.samples * self.vertical_samples
+        if beams > MAX_BEAMS:
+            # 10^8 beams passed `validate` and ended the world in a MemoryError traceback at 3.2 GB (the
+            # beams' directions alone are 2.4 GB)
+            raise ValueError(
+                f"{self.samples} x {self.vertical_samples} = {beams:,} beams per scan, more than "
+                f"{MAX_BEAMS:,} (a 128-channel lidar has 128 x 2048 = 262,144)"
+            )
         if self.max_angle < self.min_angle:
             raise ValueError(
                 f"max_angle ({self.max_angle}) is below min_angle ({self.min_angle}): "

@@ -8,10 +8,22 @@ these and exits 1; any other exception is a bug and keeps its traceback.
 from __future__ import annotations
 
 import difflib
+import re
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+
+# Characters a terminal acts on rather than shows: C0 controls but tab and newline (ESC starts the
+# sequences that clear the screen, set the window title, write the clipboard), DEL, C1 controls, and the
+# bidirectional overrides that reorder what is shown ("Trojan Source").
+_CONTROLS = re.compile("[\\x00-\\x08\\x0b-\\x1f\\x7f-\\x9f\\u202a-\\u202e\\u2066-\\u2069]")
+
+
+def visible(text: str) -> str:
+    """`text` with every control character written as an escape (`\\x1b`, `\\u202e`), as `repr` would: for
+    what others wrote (a scenario's names, another process's type names) on its way to a terminal."""
+    return _CONTROLS.sub(lambda m: repr(m.group())[1:-1], text)
 
 
 def closest(name: str, names: Iterable[str]) -> str | None:

@@ -15,7 +15,10 @@ def bench(ctx: typer.Context) -> None:
     `--readme`. Same as `python -m bench`."""
     repo = Path(__file__).resolve().parents[2]  # (runner/cli/bench.py -> the checkout)
     if not (repo / "bench" / "__main__.py").is_file():
-        err.print("[red]error:[/red] the benchmark suite lives in a checkout's bench/ folder; none here")
+        err.print(
+            "[red]error:[/red] the benchmark suite lives in a checkout's bench/ folder; none here",
+            markup=True,
+        )
         raise typer.Exit(2)
     if str(repo) not in sys.path:
         sys.path.insert(0, str(repo))

@@ -5,15 +5,30 @@ exit 1."""
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 import typer
 from rich.console import Console
+from rich.text import Text
 
-from runner.errors import ScenarioError
+from runner.errors import ScenarioError, visible
+
+
+class _Terminal(Console):
+    """A console whose strings are text, never markup (`[/x]` in an assertion's name, a topic of another
+    process, a recording's topic made rich raise `MarkupError` and end the command with a traceback), and
+    whose control characters are shown, not obeyed. Markup is asked for where it is meant: `markup=True`,
+    `Text.from_markup`."""
+
+    def render_str(self, text: str, **kwargs: Any) -> Text:
+        return super().render_str(visible(text), **kwargs)
+
 
 # Wide tables when piped (CI logs): key names are long and worth reading whole.
-out = Console(highlight=False, emoji=False, width=None if sys.stdout.isatty() else 160)
-err = Console(stderr=True, highlight=False, emoji=False, width=None if sys.stderr.isatty() else 160)
+out = _Terminal(highlight=False, emoji=False, markup=False, width=None if sys.stdout.isatty() else 160)
+err = _Terminal(
+    stderr=True, highlight=False, emoji=False, markup=False, width=None if sys.stderr.isatty() else 160
+)
 
 
 def fail(e: Exception) -> typer.Exit:

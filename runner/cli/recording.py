@@ -71,6 +71,16 @@ def info(mcap: RecordingArg, show_all: AllOpt = False) -> None:
         )
 
 
+def _damaged() -> tuple[type[BaseException], ...]:
+    """What reading a damaged MCAP file raises (imported when needed: the CLI starts without them)."""
+    import struct
+
+    import zstandard
+    from mcap.exceptions import McapError
+
+    return (McapError, zstandard.ZstdError, struct.error, EOFError, OSError)
+
+
 def report(
     mcap: RecordingArg,
     output: Annotated[
@@ -102,6 +112,11 @@ def report(
         written = write_report(mcap, target, plan)
     except (RunError, ScenarioError) as e:
         raise fail(e) from None
+    except Exception as e:
+        if not isinstance(e, _damaged()):  # (anything else is a bug: its traceback is kept)
+            raise
+        # a damaged file (cut mid-chunk, a flipped byte): said as `check` says it, with no traceback
+        raise fail(RunError(f"{mcap}: cannot read it as MCAP: {type(e).__name__}: {e}")) from None
     out.print(
         f"{target}: {written['passed']}/{written['assertions']} assertions pass, "
         f"{written['charts']} signal plot(s), {written['frames']} camera frame(s)"

@@ -7,12 +7,18 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from rich.style import Style
 from rich.table import Table
+from rich.text import Text
 
 from runner.cli.console import err, out
 from runner.tools.report import event_rows
 
-MARKS = {"pass": "[green]pass[/]", "fail": "[bold red]FAIL[/]", "undecided": "[yellow]not decided[/]"}
+MARKS = {
+    "pass": Text("pass", "green"),
+    "fail": Text("FAIL", "bold red"),
+    "undecided": Text("not decided", "yellow"),
+}
 
 
 def plot_failure(plan: Any, mcap: Path, results: list[Any]) -> None:
@@ -98,7 +104,7 @@ def suites_table(suites: list[Any], reports: dict[str, str], where: dict[str, st
     )
     for s in suites:
         failed = sum(1 for r in s.results if r.status == "fail")
-        verdict = "[green]pass[/]" if s.passed else ("[bold red]ERROR[/]" if s.error else "[bold red]FAIL[/]")
+        verdict = MARKS["pass"] if s.passed else (Text("ERROR", "bold red") if s.error else MARKS["fail"])
         link = [_link(reports[s.name])] if s.name in reports else []
         table.add_row(
             s.name,
@@ -115,10 +121,10 @@ def suites_table(suites: list[Any], reports: dict[str, str], where: dict[str, st
     return table
 
 
-def _link(target: str) -> str:
+def _link(target: str) -> Text:
     """A terminal link to a report: a file, or a URL as it is."""
     url = target if "://" in target else f"file://{Path(target).resolve()}"
-    return f"[link={url}]{target}[/link]"
+    return Text(target, Style(link=url))
 
 
 def print_failures(suites: list[Any]) -> None:

@@ -16,6 +16,7 @@ from typing import Annotated, Any
 
 import typer
 from rich.table import Table
+from rich.text import Text
 
 from runner import interrupts
 from runner.cli.console import err, fail, out
@@ -429,7 +430,7 @@ def _print_summary(result: Any, show_all: bool = False) -> None:
             str(published) if published is not None else "-",
             str(t.count),
             f"{t.rate():.1f}",
-            f"[red]{n_lost}[/red]" if n_lost else "0",
+            Text(str(n_lost), "red") if n_lost else "0",
         )
     if hidden:
         table.caption = f"and {hidden} helper topic(s) (`_truth`, `_state`...): --all lists them"

@@ -78,7 +78,8 @@ def _print_headline(plan: Any, parts: list[Any]) -> None:
     worlds = f"{len(parts)} worlds, " if plan.worlds else ""
     out.print(
         f"[bold]{plan.name}[/]: {plan.duration_ns / 1e9:g} s sim at {rate}, step {plan.step_ns / 1e6:g} ms, "
-        f"{worlds}{robots_n} robot(s), seed {plan.seed}"
+        f"{worlds}{robots_n} robot(s), seed {plan.seed}",
+        markup=True,  # (a run's name is letters, digits, '_', '.' and '-': no markup of its own)
     )
 
 

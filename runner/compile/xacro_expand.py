@@ -163,8 +163,10 @@ def _check_readable(sources: list[Path], path: Path, packages: PackageMap) -> No
 
 
 def _outside(read: Path, holder: Path) -> OutsidePackages:
+    target = read.resolve()
+    link = f" (a link to {target})" if target != read.absolute() else ""  # (it looks inside; it is not)
     return OutsidePackages(
-        f"{read} is outside the scenario's folder and packages",
+        f"{read}{link} is outside the scenario's folder and packages",
         holder,
         _line_of(holder, read.name),
         hint="a robot description may read files of the scenario's folder, its own folder "

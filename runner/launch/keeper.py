@@ -238,8 +238,11 @@ def clear_stale_lock(lock: Path) -> bool:
         if os.stat(lock).st_ino != os.fstat(fd).st_ino:
             return False
         recording = lock.with_name(lock.name[1 : -len(".lock")])
-        with contextlib.suppress(OSError):
-            if recording.stat().st_size < EMPTY_BELOW:
+        head = None  # (only the start of an MCAP file is removed: runner.record.claim.holds_nothing)
+        with contextlib.suppress(OSError), open(recording, "rb") as f:
+            head = f.read(EMPTY_BELOW)
+        if head is not None and len(head) < EMPTY_BELOW and head[:8] == b"\x89MCAP0\r\n"[: len(head)]:
+            with contextlib.suppress(OSError):
                 recording.unlink()
         lock.unlink()
         return True

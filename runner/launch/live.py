@@ -21,7 +21,7 @@ from typing import Any
 
 import zenoh
 
-from runner.errors import RunError
+from runner.errors import RunError, visible
 from runner.wire import msgs
 from runner.wire.transport import type_from_encoding, unpack_attachment
 
@@ -30,6 +30,7 @@ TIME_PERIOD_S = 0.02  # how often viewers are told the sim time, at most (wall)
 
 def _say_refused(origin: str) -> None:
     """Said once per origin on the runner's console: a web page of another site tried to read the run."""
+    origin = visible(origin[:200])  # (any bytes a client sends: escape sequences are shown, not obeyed)
     print(
         f"Foxglove: refused a WebSocket from origin {origin}: not an allowed origin; "
         f"allow it with --foxglove-origin {origin}",

@@ -22,6 +22,9 @@ from runner.launch import keeper
 from runner.plan import NodePlan, RunPlan
 
 STOP_GRACE_S = 3.0
+# A line of a child's output is shown up to this many bytes; the rest of it is counted, not kept: a node
+# that wrote 800 MB without a newline (binary data on stdout) took the runner to 2.6 GB.
+LINE_MAX = 64 * 1024
 
 
 class OutputTail(threading.Thread):
@@ -40,8 +43,20 @@ class OutputTail(threading.Thread):
         self._held: list[str] = []
 
     def run(self) -> None:
-        for raw in iter(self.stream.readline, b""):
+        left_out: int | None = None  # bytes of an over-long line not shown so far (None: not in one)
+        for raw in iter(lambda: self.stream.readline(LINE_MAX), b""):
+            ended = raw.endswith(b"\n")
+            if left_out is not None:
+                left_out += len(raw)
+                if ended:
+                    self._line(f"(the line above went on for {left_out} more bytes, not shown)")
+                    left_out = None
+                continue
+            if not ended and len(raw) >= LINE_MAX:
+                left_out = 0
             self._line(raw.decode(errors="replace").rstrip())
+        if left_out is not None:
+            self._line(f"(the line above went on for {left_out} more bytes, not shown)")
         self._flush()
 
     def _line(self, line: str) -> None:

@@ -24,6 +24,7 @@ from runner.launch.nodes import NodeError, Nodes
 from runner.plan import NodePlan, RunPlan
 from runner.record import Recorder
 from runner.record.claim import lock_of
+from runner.record.recorder import OTHER_KEYS
 from runner.wire import msgs
 from runner.wire.graph import GraphTokens
 from runner.wire.transport import meta_key, unpack_attachment
@@ -99,8 +100,18 @@ def outside_of(run: Run) -> tuple[dict[str, int], list[str]]:
     """The messages put on the run's keys by publishers outside the run (per key), and who they are."""
     recorder = run.recorder.recorder if run.recorder is not None else None
     counts = dict(recorder.outside) if recorder is not None else {}
+    if len(counts) > OUTSIDE_SHOWN:  # the keys with most messages, the others together
+        beyond = counts.pop(OTHER_KEYS, 0)  # (the recorder's own "more keys than it counts apart")
+        top = sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
+        rest = top[OUTSIDE_SHOWN - 1 :]
+        counts = dict(top[: OUTSIDE_SHOWN - 1])
+        label = f"{'more than ' if beyond else ''}{len(rest)} other keys"
+        counts[label] = sum(n for _, n in rest) + beyond
     part = getattr(run, "outside", None)
     return counts, part.seen.foreign() if part is not None and counts else []
+
+
+OUTSIDE_SHOWN = 20  # keys of publishers outside the run named in the end table and the results, at most
 
 
 class Part:

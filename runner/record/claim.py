@@ -17,6 +17,54 @@ from pathlib import Path
 
 # a recording shorter than the MCAP magic and one record's head holds nothing (runner.launch.keeper too)
 EMPTY_BELOW = 8 + 9
+MAGIC = b"\x89MCAP0\r\n"  # (runner.record.finisher's; not imported: the keeper script has the same checks)
+# what a lock file of ours says: `clear_stale` removes no other (a folder a scenario records into may be
+# anyone's: it removed a user's `.notes.lock` and the 5-byte `notes` beside it)
+LOCK_MARK = b"scenario-runner recording lock\n"
+
+
+def ours(lock: Path) -> bool:
+    """Whether `lock` is a recording's lock file: it says so, or it is the empty `.<name>.mcap.lock` of a
+    run from before locks said so."""
+    try:
+        with open(lock, "rb") as f:
+            head = f.read(len(LOCK_MARK))
+    except OSError:
+        return False
+    return head == LOCK_MARK or (head == b"" and lock.name.endswith(".mcap.lock"))
+
+
+def holds_nothing(recording: Path) -> bool:
+    """Whether `recording` is a recording that never got past its first bytes: shorter than a record, and
+    what it has is the start of an MCAP file (a user's short file beside a lock is not ours to remove)."""
+    try:
+        with open(recording, "rb") as f:
+            head = f.read(EMPTY_BELOW)
+    except OSError:
+        return False
+    return len(head) < EMPTY_BELOW and head[: len(MAGIC)] == MAGIC[: len(head)]
+
+
+def refuse_foreign(path: Path) -> None:
+    """Raise `FileExistsError` when `path` is something a recording must not overwrite: anything but a
+    regular file, or a file that is neither empty nor an MCAP recording. A scenario names its `record.path`,
+    and one from elsewhere named `../../.bashrc`; a device (`/dev/sda`) would have been written over too."""
+    try:
+        st = path.stat()
+    except FileNotFoundError:
+        return
+    import errno
+    import stat
+
+    if not stat.S_ISREG(st.st_mode):
+        raise FileExistsError(errno.EEXIST, f"{path} exists and is not a regular file: it is not written to")
+    if st.st_size:
+        with open(path, "rb") as f:
+            head = f.read(len(MAGIC))
+        if head != MAGIC[: len(head)]:
+            raise FileExistsError(
+                errno.EEXIST, f"{path} exists and is not an MCAP recording: it is not overwritten"
+            )
 
 
 def lock_of(path: Path) -> Path:
@@ -63,6 +111,9 @@ def claim(path: Path) -> tuple[Path, int]:
         if not _still_named(lock, fd):  # removed (stale) between our open and our lock: open it again
             os.close(fd)
             continue
+        if os.fstat(fd).st_size == 0:
+            with contextlib.suppress(OSError):  # (a full disk: an empty `.<name>.mcap.lock` is ours too)
+                os.write(fd, LOCK_MARK)
         return candidate, fd
     raise OSError(f"a thousand runs are recording beside {path}")
 
@@ -74,7 +125,9 @@ def clear_stale(folder: Path) -> list[Path]:
 
     removed: list[Path] = []
     try:
-        locks = [p for p in folder.iterdir() if p.name.startswith(".") and p.name.endswith(".lock")]
+        locks = [
+            p for p in folder.iterdir() if p.name.startswith(".") and p.name.endswith(".lock") and ours(p)
+        ]
     except OSError:  # (no folder yet: nothing stale in it)
         return removed
     for lock in locks:
@@ -88,7 +141,7 @@ def clear_stale(folder: Path) -> list[Path]:
                 continue
             recording = lock.with_name(lock.name[1 : -len(".lock")])
             with contextlib.suppress(OSError):
-                if recording.stat().st_size < EMPTY_BELOW:
+                if holds_nothing(recording):
                     recording.unlink()
                     removed.append(recording)
             lock.unlink()

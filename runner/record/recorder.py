@@ -30,11 +30,16 @@ from typing import IO, Any
 
 import zenoh
 
-from runner.record.claim import claim, lock_of
+from runner.record.claim import claim, lock_of, refuse_foreign
 from runner.record.finisher import Guard
 from runner.record.mcap_file import CHUNK_SIZE, McapFile, RecordedChannel, TopicStats
 from runner.wire import msgs
-from runner.wire.transport import ATTACHMENT, type_from_encoding, unpack_attachment
+from runner.wire.transport import ATTACHMENT, count_reason, type_from_encoding, unpack_attachment
+
+# Keys counted one by one for publishers outside the run, at most; past them, together under OTHER_KEYS (a
+# stray session putting on 20,000 keys of its own made 20,000 end-table lines and results properties).
+OUTSIDE_KEYS = 1000
+OTHER_KEYS = "(other keys)"
 
 # Samples queued for the drain thread, at most: bounds the memory a slow disk can take (1024 camera images
 # of 1 MB...); a larger queue records no faster (bench/recorder.py).
@@ -78,9 +83,11 @@ class Recorder:
         self.path.parent.mkdir(parents=True, exist_ok=True)
         # the path the plan gave; `path` is the one recorded to (see `runner.record.claim`)
         self.asked = self.path
+        refuse_foreign(self.path)  # (before its lock is made: a user's `.notes.lock` beside `notes` too)
         self.path, self._claim_fd = claim(self.path)
         self._guard: Guard | None = None
         try:
+            refuse_foreign(self.path)
             # unbuffered: whole chunks are written at once, and a failed write (a full disk) leaves no
             # buffer behind that a later flush would write past the point the file is cut back to
             self._file: IO[bytes] = open(self.path, "wb", buffering=0)  # noqa: SIM115 - closed in close()
@@ -188,7 +195,8 @@ class Recorder:
         att = sample.attachment
         raw = att.to_bytes() if att is not None else b""
         if len(raw) != _ATT_SIZE:
-            self.outside[key] = self.outside.get(key, 0) + 1
+            counted = key if key in self.outside or len(self.outside) < OUTSIDE_KEYS else OTHER_KEYS
+            self.outside[counted] = self.outside.get(counted, 0) + 1
         ch = self._channels.get(key)
         if self.types and key in self.types:
             given = type_from_encoding(sample.encoding)
@@ -217,10 +225,9 @@ class Recorder:
         self._write(key, type_from_encoding(sample.encoding), sample.payload.to_bytes(), parsed)
 
     def _mistyped(self, key: str, why: str) -> None:
-        counts = self.mistyped.setdefault(key, {})
-        if why not in counts:
-            print(f"recorder: not recording messages on {key}: {why}", file=sys.stderr, flush=True)
-        counts[why] = counts.get(why, 0) + 1
+        first = count_reason(self.mistyped.setdefault(key, {}), why)
+        if first is not None:
+            print(f"recorder: not recording messages on {key}: {first}", file=sys.stderr, flush=True)
 
     def write(self, key: str, type_name: str | None, payload: bytes, att: tuple[int, int] | None) -> None:
         """Record one message: `att` is (sequence number, sim time ns) or None (no attachment)."""

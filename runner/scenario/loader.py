@@ -544,7 +544,19 @@ def load_file(path: str | Path) -> Document:
                     hint="keep data (meshes, maps, long timelines) in files the scenario refers to",
                 )
             )
-        text = p.read_text(encoding="utf-8")
+        # at most MAX_BYTES + 1 whatever it is: `validate /dev/zero` read until a MemoryError at 3.4 GB
+        # (a pipe, `validate <(envsubst < s.yaml)`, is read as a file is)
+        with p.open("rb") as f:
+            data = f.read(MAX_BYTES + 1)
+        if len(data) > MAX_BYTES:
+            raise ScenarioError(
+                Problem(
+                    f"this file goes on past {MAX_BYTES / 1e6:.0f} MB, the most a scenario may be",
+                    Location(p, 1, 1),
+                    hint="keep data (meshes, maps, long timelines) in files the scenario refers to",
+                )
+            )
+        text = data.decode("utf-8").replace("\r\n", "\n").replace("\r", "\n")  # (as read_text reads)
     except FileNotFoundError:
         raise ScenarioError(
             Problem("file not found", Location(p), hint="check the path (relative to the current folder)")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import struct
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
@@ -302,8 +303,22 @@ def write_junit(path: Path, suites: list[Suite]) -> None:
     root.set("failures", str(failures))
     root.set("errors", str(errors))
     root.set("time", f"{wall:.3f}")
+    for el in root.iter():  # names, messages and node output may hold what XML 1.0 cannot carry
+        el.text = _xml_text(el.text) if el.text else el.text
+        for key, value in el.attrib.items():
+            el.set(key, _xml_text(value))
     path.parent.mkdir(parents=True, exist_ok=True)
     ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
+
+
+# What XML 1.0 cannot hold, even as a character reference (its `Char` production): ElementTree writes
+# them as they are and every reader then refuses the whole file.
+_NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+
+
+def _xml_text(text: str) -> str:
+    """`text` with the characters XML cannot hold written as escapes (`\x1b`), as `repr` would."""
+    return _NOT_XML.sub(lambda m: repr(m.group())[1:-1], text)
 
 
 JUNIT_EVENT_LINES = 1000  # firings written to a suite's <system-out>, at most (a repeating event...)

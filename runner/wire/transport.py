@@ -21,6 +21,8 @@ from typing import Any, Protocol
 
 import zenoh
 
+from runner.errors import visible
+
 ATTACHMENT = struct.Struct("<Qq")
 META = "@meta"
 
@@ -56,6 +58,25 @@ def type_from_encoding(encoding: Any) -> str | None:
     if text.startswith(("application/cdr;", "application/protobuf;")):
         return text.split(";", 1)[1] or None
     return None
+
+
+# Kinds of dropped sample told apart per key, at most: the type another publisher names and a payload's
+# size are theirs to choose, and a stray session that named a new type in each of 10,000 samples made
+# 10,000 stderr lines (their escape sequences obeyed by the terminal), end-table lines and 0.7 MB of
+# metadata. Past this, they are counted together.
+MAX_REASONS = 8
+OTHER_REASONS = f"other reasons (more than {MAX_REASONS} kinds)"
+
+
+def count_reason(counts: dict[str, int], why: str) -> str | None:
+    """Count a dropped sample under `why` in `counts` (one key's), or under `OTHER_REASONS` past
+    `MAX_REASONS` kinds; the reason to say on stderr when it is the first of its kind, else None."""
+    why = visible(why[:200])
+    if why not in counts and len(counts) >= MAX_REASONS:
+        why = OTHER_REASONS
+    first = why not in counts
+    counts[why] = counts.get(why, 0) + 1
+    return why if first else None
 
 
 def meta_key(run: str, *parts: str) -> str:
@@ -267,10 +288,12 @@ class ZenohBus:
 
     def reject(self, key: str, why: str) -> None:
         """Count a dropped inbound sample; the first of each kind on a key is said on stderr."""
-        counts = self.rejected.setdefault(key, {})
-        if why not in counts:
-            print(f"world: dropping messages on {key}: {why} (another publisher's mistake)", file=sys.stderr)
-        counts[why] = counts.get(why, 0) + 1
+        first = count_reason(self.rejected.setdefault(key, {}), why)
+        if first is not None:
+            print(
+                f"world: dropping messages on {key}: {first} (another publisher's mistake)",
+                file=sys.stderr,
+            )
 
     def all_matched(self) -> bool:
         """Whether every publisher declared so far has a subscriber somewhere."""
@@ -306,8 +329,7 @@ class MemoryBus:
         self._subs.setdefault(key, []).append(callback)
 
     def reject(self, key: str, why: str) -> None:
-        counts = self.rejected.setdefault(key, {})
-        counts[why] = counts.get(why, 0) + 1
+        count_reason(self.rejected.setdefault(key, {}), why)
 
     def inject(self, key: str, payload: bytes, attachment: bytes | None = None) -> None:
         for cb in self._subs.get(key, []):
