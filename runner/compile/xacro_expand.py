@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import os
 import re
 import threading
 import xml.parsers.expat
@@ -176,7 +177,9 @@ def _check_readable(sources: list[Path], path: Path, packages: PackageMap) -> No
 
 def _outside(read: Path, holder: Path) -> OutsidePackages:
     target = read.resolve()
-    link = f" (a link to {target})" if target != read.absolute() else ""  # (it looks inside; it is not)
+    # (it looks inside; it is not). `..` alone is no link: compared with the path's `..` folded away
+    # (Path.absolute keeps them, and every `../x` was said to be "a link to" itself)
+    link = f" (a link to {target})" if target != Path(os.path.abspath(read)) else ""
     return OutsidePackages(
         f"{read}{link} is outside the scenario's folder and packages",
         holder,
