@@ -11,6 +11,8 @@ import mujoco
 
 from runner.checks import truth_robots
 from runner.checks.judge import TRUTH_RATE, TRUTH_TOPIC
+from runner.compile.filesize import HINT as SIZE_HINT
+from runner.compile.filesize import too_large
 from runner.compile.packages import PackageMap
 from runner.compile.parity import summarize
 from runner.compile.plugins import build_plugins
@@ -137,6 +139,9 @@ def robot_model(
         _needs_file(found, doc, ("robots", i, "controllers", k), "controllers", "a ros_control YAML file")
         controllers.append(found)
     try:
+        oversize = too_large(path)
+        if oversize is not None:  # (before it is read or parsed; its includes: xacro_expand._cycle_guard)
+            raise SourceError(oversize, path, hint=SIZE_HINT)
         if path.suffix == ".xacro" or _looks_like_xacro(path):
             args = {k: _xacro_str(v) for k, v in robot.desc.args.items()}
             result = expand(path, args, packages)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import os
 import re
 import threading
 import xml.parsers.expat
@@ -23,6 +24,8 @@ from typing import Any
 import xacro
 import xacro.substitution_args as _sa
 
+from runner.compile.filesize import HINT as SIZE_HINT
+from runner.compile.filesize import too_large
 from runner.compile.packages import PackageMap
 from runner.compile.xacro_sandbox import Sandbox, SandboxError
 from runner.errors import SourceError, did_you_mean
@@ -38,6 +41,10 @@ class MissingPackage(XacroError):
 
 class IncludeCycle(XacroError):
     pass
+
+
+class TooLarge(XacroError):
+    """An included file larger than a description file may be (runner/compile/filesize.py)."""
 
 
 class OutsidePackages(XacroError):
@@ -75,7 +82,7 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
             sources = [path] + [Path(f) for f in dict.fromkeys(xacro.all_includes)]
             _check_readable(sources, path, packages)
             return Expanded(doc.toprettyxml(indent="  "), sources)
-        except (MissingPackage, IncludeCycle, OutsidePackages):
+        except (MissingPackage, IncludeCycle, OutsidePackages, TooLarge):
             raise
         except xml.parsers.expat.ExpatError as e:
             raise XacroError(
@@ -126,6 +133,12 @@ def _cycle_guard(real_parse: Callable[..., Any], path: Path, packages: PackageMa
         if inp is None and filename and len(stack) > 1:
             if not packages.readable(Path(filename), path):
                 raise _outside(Path(filename), Path(stack[-2]))
+            oversize = too_large(Path(filename))
+            if oversize is not None:  # before expat reads it
+                includer = Path(stack[-2])
+                raise TooLarge(
+                    oversize, includer, _line_of(includer, Path(filename).name, "include"), hint=SIZE_HINT
+                )
             again = _same_file_index(stack[:-1], filename)
             if again is not None:
                 chain = [Path(f).name for f in stack[again:-1]] + [Path(filename).name]
@@ -164,7 +177,9 @@ def _check_readable(sources: list[Path], path: Path, packages: PackageMap) -> No
 
 def _outside(read: Path, holder: Path) -> OutsidePackages:
     target = read.resolve()
-    link = f" (a link to {target})" if target != read.absolute() else ""  # (it looks inside; it is not)
+    # (it looks inside; it is not). `..` alone is no link: compared with the path's `..` folded away
+    # (Path.absolute keeps them, and every `../x` was said to be "a link to" itself)
+    link = f" (a link to {target})" if target != Path(os.path.abspath(read)) else ""
     return OutsidePackages(
         f"{read}{link} is outside the scenario's folder and packages",
         holder,

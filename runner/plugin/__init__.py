@@ -160,14 +160,18 @@ class RuntimeContext:
     rng: np.random.Generator
     run: str
     _make_publisher: Callable[[str, str], Publisher] = field(repr=False)
-    _subscribe: Callable[[str, str, Callable[[Any, int], None]], None] = field(repr=False)
+    _subscribe: Callable[..., None] = field(repr=False)
 
     def publisher(self, topic: str, type_name: str) -> Publisher:
         return self._make_publisher(topic, type_name)
 
-    def subscribe(self, topic: str, type_name: str, callback: Callable[[Any, int], None]) -> None:
-        """`callback(msg, stamp_ns)` is called in the sim loop, between physics steps."""
-        self._subscribe(topic, type_name, callback)
+    def subscribe(
+        self, topic: str, type_name: str, callback: Callable[[Any, int], None], max_bytes: int | None = None
+    ) -> None:
+        """`callback(msg, stamp_ns)` is called in the sim loop, between physics steps. A message from
+        another process holding a NaN or Inf, or larger than `max_bytes` (by default
+        runner.sim.pubsub.MAX_INBOUND_BYTES, 8 MiB), is dropped and counted before it reaches the callback."""
+        self._subscribe(topic, type_name, callback, max_bytes=max_bytes)
 
 
 class Plugin:

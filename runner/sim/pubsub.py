@@ -23,6 +23,24 @@ if TYPE_CHECKING:
 # Why an inbound message was dropped, as the end-of-run table and the recording's metadata count it
 NONFINITE = "NaN or Inf values"
 
+# The most bytes a message from another process may have on a key a plugin takes, checked before it is
+# decoded or queued: a valid 96 MB JointState (12 M names) cost the world 16.6 s and 400 MB to decode. The
+# built-in plugins take commands of bytes to kilobytes (a Twist is 48 bytes of data; a JointState or
+# Float64MultiArray for 100 joints, a few KB). A plugin that takes larger ones (a map, a trajectory of
+# 100,000 points) says so in its subscription: `ctx.subscribe(..., max_bytes=...)`.
+MAX_INBOUND_BYTES = 8 * 1024 * 1024
+
+
+def _size_text(n: int) -> str:
+    return f"{n // (1024 * 1024)} MiB" if n % (1024 * 1024) == 0 else f"{n:,} bytes"
+
+
+def too_large(limit: int) -> str:
+    """The reason a message over `limit` bytes is dropped, as the end table and metadata count it (one kind
+    whatever the sizes: a stray publisher's sizes are its own to vary; the first one's is said on stderr)."""
+    return f"more than the {_size_text(limit)} limit for a message a plugin takes"
+
+
 # A subscriber in this process: (type, callback, peek): `peek(payload)` gives what the callback reads of
 # each message this process publishes (runner.wire.cdr.Peek), or None for the whole decoded message
 Local = tuple[str, Callable[[Any, int], None], Callable[[bytes], Any] | None]
@@ -100,6 +118,10 @@ class PubSub:
         # controller's state for good: a diff drive's integral never forgets it)
         self._checked: set[str] = set()
         self._nonfinite_said: set[str] = set()
+        # the same keys: the most bytes a message there may have (MAX_INBOUND_BYTES, or what its plugins
+        # ask for), checked on arrival: a larger one is neither decoded nor queued
+        self._max_bytes: dict[str, int] = {}
+        self._too_large_said: set[str] = set()
 
     def make_publisher(self, key: str, type_name: str) -> Outgoing:
         out = self._out.get(key)
@@ -125,17 +147,21 @@ class PubSub:
 
         return make
 
-    def _subscriber_factory(
-        self, namespace: str, checked: bool = True
-    ) -> Callable[[str, str, Callable[[Any, int], None]], None]:
-        """`subscribe(topic, type, callback)` for a robot's plugins; `checked`: messages from other
-        processes holding a NaN or Inf are dropped (plugins), or delivered as they are (what an event
-        watches: a node's LaserScan says "no return" with +inf, REP 117)."""
+    def _subscriber_factory(self, namespace: str, checked: bool = True) -> Callable[..., None]:
+        """`subscribe(topic, type, callback, max_bytes=None)` for a robot's plugins; `checked`: messages
+        from other processes holding a NaN or Inf, or of more than `max_bytes` (MAX_INBOUND_BYTES), are
+        dropped (plugins), or delivered as they are (what an event watches: a node's LaserScan says "no
+        return" with +inf, REP 117; a node's camera image may be large)."""
 
-        def subscribe(topic: str, type_name: str, callback: Callable[[Any, int], None]) -> None:
+        def subscribe(
+            topic: str, type_name: str, callback: Callable[[Any, int], None], max_bytes: int | None = None
+        ) -> None:
             key = topic_key(self.plan.name, namespace, topic)
             if checked:
                 self._checked.add(key)
+                # several plugins on a key: the largest bound, so that each gets what it asked for
+                limit = MAX_INBOUND_BYTES if max_bytes is None else int(max_bytes)
+                self._max_bytes[key] = max(limit, self._max_bytes.get(key, 0))
             # the same list as the publisher's `local`, if this process also publishes the key
             self._local.setdefault(key, []).append((msgs.normalize_type(type_name), callback, None))
             if key not in self._remote_subscribed:
@@ -146,8 +172,22 @@ class PubSub:
 
     def _on_remote(self, key: str, payload: bytes, att: bytes | None) -> None:
         """A message from another process (a Zenoh thread): queued for the next boundary, and counted, so
-        lockstep knows when everything a node sent has arrived."""
-        self._inbox.put((key, payload, att))
+        lockstep knows when everything a node sent has arrived (a dropped one too: it arrived). On a key a
+        plugin takes, one over its size bound is dropped here, before it is decoded or queued."""
+        limit = self._max_bytes.get(key)
+        if limit is not None and len(payload) > limit:
+            why = too_large(limit)
+            if key not in self._too_large_said:
+                self._too_large_said.add(key)
+                print(
+                    f"world: {key}: a message of {len(payload):,} bytes, more than the {_size_text(limit)} "
+                    "limit for a message a plugin takes; dropped before it is decoded (its subscriber keeps "
+                    "the last good one)",
+                    file=sys.stderr,
+                )
+            self._reject(key, why)
+        else:
+            self._inbox.put((key, payload, att))
         self._received[key] = self._received.get(key, 0) + 1
         lockstep = self._lockstep
         if lockstep is not None:

@@ -13,6 +13,8 @@ from pathlib import Path
 import mujoco
 from lxml import etree
 
+from runner.compile.filesize import HINT as SIZE_HINT
+from runner.compile.filesize import too_large
 from runner.compile.packages import PackageMap
 from runner.compile.sdf.parts import ModelState, SdfWorld, Src
 from runner.compile.sdf.pose import IDENTITY, Pose
@@ -281,6 +283,9 @@ class Reader:
             raise SdfError(
                 f"SDF file {str(path)!r} not found", path, hint="paths are relative to the scenario"
             )
+        oversize = too_large(path)
+        if oversize is not None:  # before it is read or parsed
+            raise SdfError(oversize, path, hint=SIZE_HINT)
         try:
             data = _xml_bytes(path)
         except OSError as e:
