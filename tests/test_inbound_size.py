@@ -94,6 +94,8 @@ def test_an_oversized_command_put_by_another_session_in_a_real_run_is_dropped_an
     rejected = json.loads(notes["scenario"]["rejected"])["big/r1/cmd_vel"]
     assert rejected[TOO_LARGE] == 1, rejected  # (the recorder says too that it did not record it)
     assert not any("do not decode" in why and "not recorded" not in why for why in rejected), rejected
+    # the recorder neither decodes it (a valid 96 MB one would hold its callback for seconds) nor records it
+    assert not any("do not decode" in why for why in rejected), rejected
     truth = [m for topic, _, _t, m in read_mcap(mcap) if topic == "big/r1/ground_truth"]
     assert abs(truth[-1].twist.twist.linear.x - 0.3) < 0.05, truth[-1].twist.twist
 

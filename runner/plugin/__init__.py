@@ -30,6 +30,13 @@ if TYPE_CHECKING:
     from runner.wire.cdr import Layout
 
 
+# The most bytes a message from another process may have on a key a plugin takes, checked before it is
+# decoded or queued: a valid 96 MB JointState (12 M names) cost the world 16.6 s and 400 MB to decode. The
+# built-in plugins take commands of bytes to kilobytes (a Twist is 48 bytes of data; a JointState or
+# Float64MultiArray for 100 joints, a few KB). A plugin that takes larger ones (a map, a trajectory of
+# 100,000 points) says so in its subscription: `ctx.subscribe(..., max_bytes=...)`.
+MAX_INBOUND_BYTES = 8 * 1024 * 1024
+
 # MuJoCo geom groups with a meaning across the run (compile puts geoms there, sensors read them):
 RAY_GROUP = 4  # a world mesh as drawn: no contacts, hit by rays
 PIECES_GROUP = 5  # its convex pieces: contacts, not hit by rays, never drawn
@@ -170,7 +177,7 @@ class RuntimeContext:
     ) -> None:
         """`callback(msg, stamp_ns)` is called in the sim loop, between physics steps. A message from
         another process holding a NaN or Inf, or larger than `max_bytes` (by default
-        runner.sim.pubsub.MAX_INBOUND_BYTES, 8 MiB), is dropped and counted before it reaches the callback."""
+        MAX_INBOUND_BYTES, 8 MiB), is dropped and counted before it reaches the callback."""
         self._subscribe(topic, type_name, callback, max_bytes=max_bytes)
 
 

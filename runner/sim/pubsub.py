@@ -11,7 +11,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from runner.plan import RunPlan
-from runner.plugin import Publisher
+from runner.plugin import MAX_INBOUND_BYTES, Publisher
 from runner.wire import msgs
 from runner.wire.transport import ATTACHMENT as _ATT
 from runner.wire.transport import Bus, topic_key
@@ -22,13 +22,6 @@ if TYPE_CHECKING:
 
 # Why an inbound message was dropped, as the end-of-run table and the recording's metadata count it
 NONFINITE = "NaN or Inf values"
-
-# The most bytes a message from another process may have on a key a plugin takes, checked before it is
-# decoded or queued: a valid 96 MB JointState (12 M names) cost the world 16.6 s and 400 MB to decode. The
-# built-in plugins take commands of bytes to kilobytes (a Twist is 48 bytes of data; a JointState or
-# Float64MultiArray for 100 joints, a few KB). A plugin that takes larger ones (a map, a trajectory of
-# 100,000 points) says so in its subscription: `ctx.subscribe(..., max_bytes=...)`.
-MAX_INBOUND_BYTES = 8 * 1024 * 1024
 
 
 def _size_text(n: int) -> str:
