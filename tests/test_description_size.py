@@ -83,3 +83,14 @@ def test_an_sdf_world_past_the_bound_is_refused_before_it_is_parsed(tmp_path: Pa
     assert f"big.sdf is {MAX_DESCRIPTION_BYTES + 1:,} bytes, more than the 16 MiB" in text, text
     assert "keep meshes in mesh files" in text, text
     assert took < 20, took
+
+
+def test_one_value_past_the_xml_readers_10_mb_says_so(tmp_path: Path) -> None:
+    """Under the file bound, one attribute of 11 MB: libxml2 refuses it ("Buffer size limit exceeded, try
+    XML_PARSE_HUGE"), which is no syntax mistake: the hint says what the limit is and what to do."""
+    big = '<robot name="big"><link name="base"/><gazebo><x a="' + "x" * 11_000_000 + '"/></gazebo></robot>\n'
+    (tmp_path / "big.urdf").write_text(big)
+    out, _ = _validate(tmp_path, "big.urdf")
+    assert "big.urdf:1: not well-formed XML: Resource limit exceeded" in out, out
+    assert "more than 10 MB, the most the XML reader takes" in out, out
+    assert "Traceback" not in out

@@ -102,7 +102,7 @@ def _parse(urdf: str, file: Path | None, expanded: bool, where: Any) -> Any:
         root = parse(urdf)
     except etree.XMLSyntaxError as e:
         raise DescriptionError(
-            f"not well-formed XML: {e.msg}",
+            f"not well-formed XML: {' '.join(str(e.msg).split())}",
             file,
             None if expanded else e.lineno,
             hint=_malformed_hint(str(e.msg)),
@@ -120,6 +120,12 @@ def _parse(urdf: str, file: Path | None, expanded: bool, where: Any) -> Any:
 
 def _malformed_hint(msg: str) -> str:
     """What to look for, by libxml2's message."""
+    if "Buffer size limit exceeded" in msg or "Huge input lookup" in msg or "XML_PARSE_HUGE" in msg:
+        # (libxml2 refuses one text or attribute value past 10 MB: the file is well-formed but too large)
+        return (
+            "one attribute or text holds more than 10 MB, the most the XML reader takes: keep meshes and "
+            "data in files of their own (a mesh's filename=), or split the generated value"
+        )
     if "Document is empty" in msg or "Start tag expected" in msg:
         return 'the file is empty or not XML: a URDF starts with <?xml version="1.0"?> and <robot name="...">'
     if "mismatch" in msg or "Premature end" in msg or "not closed" in msg:
