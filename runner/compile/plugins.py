@@ -4,7 +4,6 @@ its mistakes pointed at the scenario's line or the description's."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -16,7 +15,7 @@ from runner.errors import Location, Problem, Problems, ScenarioError
 from runner.plan import PluginPlan, TopicPlan
 from runner.plugin import BuildContext, PluginConfigError
 from runner.plugin.registry import PluginLookupError, drive_frames, load
-from runner.scenario.loader import Document, PathKey
+from runner.scenario.loader import Document, PathKey, non_finite
 from runner.scenario.schema import Robot, Scenario
 from runner.scenario.validate import validate_model
 from runner.wire.transport import topic_key
@@ -149,22 +148,10 @@ def build_plugins(
     return plans
 
 
-def _non_finite(value: Any, path: tuple[Any, ...] = ()) -> tuple[tuple[Any, ...], float] | None:
-    """(path, value) of the first NaN or infinity in plain data, or None."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return path, value
-    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
-    for k, v in items:
-        found = _non_finite(v, (*path, k))
-        if found is not None:
-            return found
-    return None
-
-
 def _check_finite(entry: _Entry, doc: Document, here: PathKey, fail: Any) -> None:
     """NaN and infinity are no parameter's meaning (a plugin's model may let them through): an error at
     the scenario's line when the scenario set it, else at the description's."""
-    found = _non_finite(entry.params)
+    found = non_finite(entry.params)
     if found is None:
         return
     path, value = found

@@ -3,12 +3,11 @@ type against the one its topic's subscriber takes."""
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 from runner.errors import Problem, Problems, ScenarioError
 from runner.plan import RobotPlan, TimelinePlan
-from runner.scenario.loader import Document, PathKey
+from runner.scenario.loader import Document, PathKey, non_finite
 from runner.scenario.schema import Scenario
 from runner.wire import msgs
 
@@ -43,24 +42,6 @@ def message_type(type_text: str, doc: Document, where: PathKey) -> str:
     return type_name
 
 
-def _nonfinite_in(data: Any, path: tuple[str | int, ...]) -> tuple[str | int, ...] | None:
-    """The path of the first NaN or ±Inf in plain message data (checked on the data, as check_data is: a
-    20,000-entry timeline builds no message)."""
-    if isinstance(data, float):
-        return None if math.isfinite(data) else path
-    if isinstance(data, dict):
-        items: Any = data.items()
-    elif isinstance(data, list | tuple):
-        items = enumerate(data)
-    else:
-        return None
-    for key, value in items:
-        found = _nonfinite_in(value, (*path, key))
-        if found is not None:
-            return found
-    return None
-
-
 def message_of(type_text: str, data: dict[str, Any], doc: Document, here: PathKey) -> str:
     """The type of a message given as `type` and `data` under `here` (a timeline entry, an event's
     `publish`), its data checked against the type's fields: each mistake located."""
@@ -72,21 +53,18 @@ def message_of(type_text: str, data: dict[str, Any], doc: Document, here: PathKe
         raise ScenarioError(
             Problem(str(e), doc.locate(where), where, hint=e.hint or _data_hint(str(e)))
         ) from None
-    bad = _nonfinite_in(data, ())
+    bad = non_finite(data)
     if bad is not None:
         # (YAML's .nan, .inf, -.inf: the plan's JSON would carry them as null, a silent 0.0 in the world,
         # and the world drops such a message from any other publisher)
-        where = (*here, "data", *bad)
-        value = data
-        for part in bad:
-            value = value[part]
+        where = (*here, "data", *bad[0])
         raise ScenarioError(
             Problem(
                 "a message field must be a finite number",
                 doc.locate(where),
                 where,
                 expected="a finite number (within its type's range)",
-                found=str(value),
+                found=str(bad[1]),
                 hint="a command of NaN or Inf cannot be obeyed: write the number meant (a large speed is "
                 "limited by the robot's drive anyway)",
             )

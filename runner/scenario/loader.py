@@ -8,6 +8,7 @@ later pass can point at the line. Duplicate keys are an error (plain PyYAML keep
 from __future__ import annotations
 
 import datetime
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -575,3 +576,16 @@ def load_file(path: str | Path) -> Document:
             )
         ) from None
     return load_text(text, p.resolve())
+
+
+def non_finite(value: Any, path: tuple[Any, ...] = ()) -> tuple[tuple[Any, ...], float] | None:
+    """(path, value) of the first NaN or infinity in plain data as loaded (YAML's .nan, .inf and numbers
+    beyond 1.8e308), or None."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return path, value
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    for k, v in items:
+        found = non_finite(v, (*path, k))
+        if found is not None:
+            return found
+    return None
