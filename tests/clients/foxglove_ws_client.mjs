@@ -24,7 +24,10 @@ const out = { protocol: null, server: null, capabilities: [], times: [], message
 let reader = null;
 let subscription = null;
 
+let finished = false;
 const finish = (code) => {
+  if (finished) return; // (closing the client below may emit its "close")
+  finished = true;
   process.stdout.write(JSON.stringify(out) + "\n");
   client.close();
   process.exit(code);
@@ -33,6 +36,8 @@ setTimeout(() => finish(2), 60_000).unref();
 
 client.on("open", () => { out.protocol = ws.protocol; });
 client.on("error", (e) => { out.error = String(e?.message ?? e); finish(3); });
+// closed before COUNT messages (by the server, or the run ending): said, not a silent exit 0 with no output
+client.on("close", (e) => { out.closed = { code: e?.code ?? null, reason: String(e?.reason ?? "") }; finish(4); });
 client.on("serverInfo", (info) => { out.server = info.name; out.capabilities = info.capabilities; });
 client.on("time", (t) => { if (out.times.length < 1000) out.times.push(t.timestamp.toString()); });
 client.on("advertise", (channels) => {
