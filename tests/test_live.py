@@ -149,8 +149,9 @@ def test_foxgloves_own_client_library_decodes_scans_and_follows_sim_time() -> No
         )
     finally:
         run.send_signal(signal.SIGINT)
-        run.communicate(timeout=30)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
+        _, run_err = run.communicate(timeout=30)
+    # (the run's own words too: a server that closed the connection early says why there)
+    assert proc.returncode == 0, proc.stdout + proc.stderr + "\nthe run said:\n" + run_err[-3000:]
     got = json.loads(proc.stdout.strip().splitlines()[-1])
     assert got["protocol"] == "foxglove.websocket.v1" and "time" in got["capabilities"], got
     assert got["channel"] == {
