@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from runner.sim.pubsub import MAX_INBOUND_BYTES, too_large
+from runner.plugin import MAX_INBOUND_BYTES, too_large
 from runner.wire.transport import encoding_for
 from tests.conftest import read_mcap, scenario_cmd
 from tests.test_nonfinite import DRIVE, TWIST, _join, _world, twist

@@ -80,6 +80,14 @@ def wait_for_published(run: Run, counts: Callable[[], dict[str, int]], wanted: C
             run.hurry.wait(0.01)
 
 
+def published_of(run: Run) -> dict[str, int]:
+    """What the worlds published, per key (each key is one world's: its name leads the key)."""
+    published: dict[str, int] = {}
+    for world in run.worlds:
+        published.update(world.end_info.get("published", {}))
+    return published
+
+
 def rejected_of(run: Run) -> dict[str, dict[str, int]]:
     """The inbound messages dropped, per key and why: by the worlds (NaN or Inf values, another type) and
     by the recorder (not recorded)."""
@@ -378,10 +386,7 @@ class JudgePart(Part):
             judge.data_stops(
                 recorder.stopped_ns, stops("the recording", recorder.stopped_ns, cause), self.tapped
             )
-        published: dict[str, int] = {}
-        for world in run.worlds:
-            for key, n in world.end_info.get("published", {}).items():
-                published[key] = published.get(key, 0) + n
+        published = published_of(run)
         with self._lock:
             fed = dict(self.fed)
         for key in sorted(judge.keys - judge.events_keys):

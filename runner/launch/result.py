@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from runner.launch.parts import outside_of, rejected_of
+from runner.launch.parts import outside_of, published_of, rejected_of
 from runner.record import TopicStats
 
 if TYPE_CHECKING:
@@ -44,9 +44,6 @@ def result_of(run: Supervisor) -> RunResult:
     """What a finished supervisor tells: how the run ended, its times, what was published and recorded."""
     infos = [w.end_info for w in run.worlds]
     walls = [float(i["wall_s"]) for i in infos if "wall_s" in i]
-    published: dict[str, int] = {}
-    for i in infos:
-        published.update(i.get("published", {}))
     recorder = run.recorder.recorder if run.recorder is not None else None
     outside, outsiders = outside_of(run)
     return RunResult(
@@ -55,7 +52,7 @@ def result_of(run: Supervisor) -> RunResult:
         wall_s=max(walls) if len(walls) == len(infos) else time.perf_counter() - run.wall0,
         mcap=Path(run.plan.record.path) if recorder else None,
         topics=recorder.stats() if recorder else [],
-        published=published,
+        published=published_of(run),
         error=run.error,
         endpoints=run.listen,
         rejected=rejected_of(run),

@@ -37,6 +37,17 @@ if TYPE_CHECKING:
 # 100,000 points) says so in its subscription: `ctx.subscribe(..., max_bytes=...)`.
 MAX_INBOUND_BYTES = 8 * 1024 * 1024
 
+
+def _size_text(n: int) -> str:
+    return f"{n // (1024 * 1024)} MiB" if n % (1024 * 1024) == 0 else f"{n:,} bytes"
+
+
+def too_large(limit: int) -> str:
+    """The reason a message over `limit` bytes is dropped, as the end table and metadata count it (one kind
+    whatever the sizes: a stray publisher's sizes are its own to vary; the first one's is said on stderr)."""
+    return f"more than the {_size_text(limit)} limit for a message a plugin takes"
+
+
 # MuJoCo geom groups with a meaning across the run (compile puts geoms there, sensors read them):
 RAY_GROUP = 4  # a world mesh as drawn: no contacts, hit by rays
 PIECES_GROUP = 5  # its convex pieces: contacts, not hit by rays, never drawn

@@ -30,7 +30,7 @@ from typing import IO, Any
 
 import zenoh
 
-from runner.plugin import MAX_INBOUND_BYTES
+from runner.plugin import MAX_INBOUND_BYTES, too_large
 from runner.record.claim import claim, lock_of, refuse_foreign
 from runner.record.finisher import Guard
 from runner.record.mcap_file import CHUNK_SIZE, McapFile, RecordedChannel, TopicStats
@@ -209,7 +209,7 @@ class Recorder:
                 if len(sample.payload) > MAX_INBOUND_BYTES:
                     # not decoded here either (a valid 96 MB JointState would hold this callback 16 s), and
                     # not recorded undecoded: readers of the recording decode every message of a channel
-                    self._mistyped(key, "more than the 8 MiB limit for a message a plugin takes")
+                    self._mistyped(key, too_large(MAX_INBOUND_BYTES))
                     return
                 try:
                     msgs.decode(sample.payload.to_bytes(), self.types[key])

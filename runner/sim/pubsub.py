@@ -11,7 +11,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from runner.plan import RunPlan
-from runner.plugin import MAX_INBOUND_BYTES, Publisher
+from runner.plugin import MAX_INBOUND_BYTES, Publisher, too_large
 from runner.wire import msgs
 from runner.wire.transport import ATTACHMENT as _ATT
 from runner.wire.transport import Bus, topic_key
@@ -22,16 +22,6 @@ if TYPE_CHECKING:
 
 # Why an inbound message was dropped, as the end-of-run table and the recording's metadata count it
 NONFINITE = "NaN or Inf values"
-
-
-def _size_text(n: int) -> str:
-    return f"{n // (1024 * 1024)} MiB" if n % (1024 * 1024) == 0 else f"{n:,} bytes"
-
-
-def too_large(limit: int) -> str:
-    """The reason a message over `limit` bytes is dropped, as the end table and metadata count it (one kind
-    whatever the sizes: a stray publisher's sizes are its own to vary; the first one's is said on stderr)."""
-    return f"more than the {_size_text(limit)} limit for a message a plugin takes"
 
 
 # A subscriber in this process: (type, callback, peek): `peek(payload)` gives what the callback reads of
@@ -173,9 +163,8 @@ class PubSub:
             if key not in self._too_large_said:
                 self._too_large_said.add(key)
                 print(
-                    f"world: {key}: a message of {len(payload):,} bytes, more than the {_size_text(limit)} "
-                    "limit for a message a plugin takes; dropped before it is decoded (its subscriber keeps "
-                    "the last good one)",
+                    f"world: {key}: a message of {len(payload):,} bytes, {why}; dropped before it is decoded "
+                    "(its subscriber keeps the last good one)",
                     file=sys.stderr,
                 )
             self._reject(key, why)
