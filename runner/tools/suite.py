@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from runner.errors import ScenarioError
+from runner.launch import keeper
 from runner.tools.report import Suite
 
 STOP_S = 15.0  # a run told to stop (SIGTERM) finishes its recording in ~2 s; then it is killed
@@ -94,7 +95,8 @@ def run_variant(
             stderr=subprocess.PIPE,
             text=True,
             cwd=cwd,
-            preexec_fn=_stop_with_parent if die_with_parent and sys.platform == "linux" else None,
+            # (a run never outlives the Ray worker or `scenario test` that started it)
+            preexec_fn=keeper.dies_with_runner(signal.SIGTERM) if die_with_parent else None,
         )
         try:
             out = _wait(proc, timeout_s, cancelled)
@@ -151,12 +153,3 @@ def _stop(proc: subprocess.Popen[str]) -> tuple[str, str]:
     except subprocess.TimeoutExpired:
         proc.kill()
         return proc.communicate()
-
-
-def _stop_with_parent() -> None:
-    """(In the child, before exec) SIGTERM when the parent dies: a run never outlives the Ray worker that
-    started it."""
-    import ctypes
-
-    pr_set_pdeathsig = 1
-    ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, signal.SIGTERM)
