@@ -29,12 +29,11 @@ import mujoco
 import numpy as np
 from pydantic import Field, NonNegativeFloat, PositiveFloat
 
+from plugins._actuators import auto_gains, claim_actuator, find_actuator
 from runner.plugin import BuildContext, Plugin, PluginConfigError, PluginParams, Topic
 
 log = logging.getLogger(__name__)
 
-_OMEGA_STEPS = 0.15  # position servo: natural frequency × timestep
-_VELOCITY_STEPS = 2.0  # velocity servo: time constant in physics steps
 _MESSAGE_TYPES = {
     "float64": "std_msgs/msg/Float64",
     "float64_array": "std_msgs/msg/Float64MultiArray",
@@ -75,26 +74,6 @@ def _message_of(params: JointControllerParams) -> str:
     return params.message or ("float64" if len(params.joints) == 1 else "float64_array")
 
 
-def _kind(gaintype: int, biastype: int, dyntype: int, gain0: float, bias: Any) -> str | None:
-    """The mode a joint actuator serves: effort (motor), position or velocity (servo), else None."""
-    if int(dyntype) != int(mujoco.mjtDyn.mjDYN_NONE) or int(gaintype) != int(mujoco.mjtGain.mjGAIN_FIXED):
-        return None
-    if int(biastype) == int(mujoco.mjtBias.mjBIAS_NONE):
-        return "effort" if gain0 != 0 else None
-    if int(biastype) == int(mujoco.mjtBias.mjBIAS_AFFINE) and bias[0] == 0:
-        if bias[1] != 0 and math.isclose(-bias[1], gain0):
-            return "position"
-        if bias[1] == 0 and bias[2] != 0 and math.isclose(-bias[2], gain0):
-            return "velocity"
-    return None
-
-
-def _spec_kind(act: Any) -> str | None:
-    if act.gear[0] == 0:
-        return None
-    return _kind(act.gaintype, act.biastype, act.dyntype, act.gainprm[0], act.biasprm)
-
-
 class JointController(Plugin):
     Params = JointControllerParams
     params: JointControllerParams
@@ -119,7 +98,9 @@ class JointController(Plugin):
             joint = ctx.joint(jname, "joints")
             if joint.type not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
                 raise PluginConfigError(f"joint {jname!r} is not revolute, continuous or prismatic", "joints")
-            _build_actuator(params, ctx, name, jname, joint)
+            claim_actuator(
+                ctx.spec, name, joint, params.mode, kp=params.kp, kv=params.kv, max_effort=params.max_effort
+            )
         topic = params.topic or f"{name}/command"
         return [Topic(topic, _MESSAGE_TYPES[message], "sub")]
 
@@ -139,13 +120,13 @@ class JointController(Plugin):
         self.warned: set[str] = set()
         dt = float(m.opt.timestep)
         for k, (jname, jid, dof) in enumerate(zip(p.joints, jids, dofs, strict=True)):
-            a, own = _find_actuator(m, r, self.name, jname, jid, p.mode)
+            a, own = find_actuator(m, r, self.name, jname, jid, p.mode)
             self.act[k] = a
             self.gear[k] = float(m.actuator_gear[a, 0])
             if m.jnt_limited[jid]:
                 self.lo[k], self.hi[k] = m.jnt_range[jid]
             if own:
-                _auto_gains(m, a, p, float(m.dof_M0[dof]), dt)
+                auto_gains(m, a, p.mode, float(m.dof_M0[dof]), dt, p.kp, p.kv)
         if p.mode == "position":
             start = np.clip(np.array(p.initial) if p.initial else d.qpos[self.qadr], self.lo, self.hi)
             if p.initial:
@@ -199,82 +180,3 @@ class JointController(Plugin):
             k = self.index.get(jname)
             if k is not None and i < len(values):
                 self._set(k, float(values[i]))
-
-
-def _build_actuator(
-    params: JointControllerParams, ctx: BuildContext, name: str, jname: str, joint: Any
-) -> None:
-    mode = params.mode
-    existing = [a for a in ctx.spec.actuators if a.trntype == mujoco.mjtTrn.mjTRN_JOINT and a.target == jname]
-    act = next((a for a in existing if _spec_kind(a) == mode), None)
-    for other in existing:
-        if other is not act and other.gear[0] != 0:
-            other.gear = [0.0] * 6  # another kind of actuator on this joint would fight ours
-    if act is None:
-        act = ctx.spec.add_actuator(name=f"{name}/{jname}", target=jname, trntype=mujoco.mjtTrn.mjTRN_JOINT)
-        # placeholder gains when not given: setup() sets them from the compiled model's inertia
-        if mode == "position":
-            act.set_to_position(kp=params.kp or 1.0, kv=params.kv or 0.0)
-        elif mode == "velocity":
-            act.set_to_velocity(kv=params.kv or 1.0)
-        else:
-            act.set_to_motor()
-        limited = joint.actfrclimited == mujoco.mjtLimited.mjLIMITED_TRUE or (
-            joint.actfrclimited == mujoco.mjtLimited.mjLIMITED_AUTO
-            and joint.actfrcrange[0] < joint.actfrcrange[1]
-        )
-        if limited and params.max_effort is None:
-            act.forcelimited = True
-            act.forcerange = list(joint.actfrcrange)
-    else:  # reused: change only what was asked for
-        if mode == "position" and params.kp is not None:
-            act.gainprm[0] = params.kp
-            act.biasprm[1] = -params.kp
-        if params.kv is not None and mode == "position":
-            act.biasprm[2] = -params.kv
-        if params.kv is not None and mode == "velocity":
-            act.gainprm[0] = params.kv
-            act.biasprm[2] = -params.kv
-    if params.max_effort is not None:
-        act.forcelimited = True
-        act.forcerange = [-params.max_effort, params.max_effort]
-
-
-def _find_actuator(
-    m: mujoco.MjModel, robot: Any, name: str, jname: str, jid: int, mode: str
-) -> tuple[int, bool]:
-    """The actuator driving `jname`: ours (added in build) or the one that was reused."""
-    try:
-        return robot.actuator_id(f"{name}/{jname}"), True
-    except KeyError:
-        pass
-    for a in range(m.nu):
-        if int(m.actuator_trntype[a]) != int(mujoco.mjtTrn.mjTRN_JOINT) or int(m.actuator_trnid[a, 0]) != jid:
-            continue
-        kind = _kind(
-            m.actuator_gaintype[a],
-            m.actuator_biastype[a],
-            m.actuator_dyntype[a],
-            m.actuator_gainprm[a, 0],
-            m.actuator_biasprm[a],
-        )
-        if kind == mode and m.actuator_gear[a, 0] != 0:
-            return a, False
-    raise KeyError(f"no {mode} actuator drives joint {jname!r}")
-
-
-def _auto_gains(m: mujoco.MjModel, a: int, p: JointControllerParams, inertia: float, dt: float) -> None:
-    """Default gains of an actuator this plugin added, from the inertia the joint moves."""
-    if p.mode == "position":
-        if p.kp is None:
-            omega = _OMEGA_STEPS / dt
-            kp = inertia * omega**2
-            m.actuator_gainprm[a, 0] = kp
-            m.actuator_biasprm[a, 1] = -kp
-        if p.kv is None:
-            kp = float(m.actuator_gainprm[a, 0])
-            m.actuator_biasprm[a, 2] = -2.0 * math.sqrt(kp * inertia)
-    elif p.mode == "velocity" and p.kv is None:
-        kv = inertia / (_VELOCITY_STEPS * dt)
-        m.actuator_gainprm[a, 0] = kv
-        m.actuator_biasprm[a, 2] = -kv

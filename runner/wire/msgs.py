@@ -34,6 +34,64 @@ float64[] depths
 std_msgs/Header header
 gazebo_msgs/ContactState[] states
 """,
+    # control_msgs (ros2_control's controllers, Jazzy branch 5.8): what the controllers publish and take
+    "control_msgs/msg/InterfaceValue": """\
+string[] interface_names
+float64[] values
+""",
+    "control_msgs/msg/DynamicJointState": """\
+std_msgs/Header header
+string[] joint_names
+InterfaceValue[] interface_values
+""",
+    "control_msgs/msg/JointTrajectoryControllerState": """\
+std_msgs/Header header
+string[] joint_names
+trajectory_msgs/JointTrajectoryPoint reference
+trajectory_msgs/JointTrajectoryPoint feedback
+trajectory_msgs/JointTrajectoryPoint error
+trajectory_msgs/JointTrajectoryPoint output
+string[] multi_dof_joint_names
+trajectory_msgs/MultiDOFJointTrajectoryPoint multi_dof_reference
+trajectory_msgs/MultiDOFJointTrajectoryPoint multi_dof_feedback
+trajectory_msgs/MultiDOFJointTrajectoryPoint multi_dof_error
+trajectory_msgs/MultiDOFJointTrajectoryPoint multi_dof_output
+float64 speed_scaling_factor
+""",
+    "control_msgs/msg/GripperCommand": """\
+float64 position
+float64 max_effort
+""",
+    "control_msgs/msg/JointControllerState": """\
+std_msgs/Header header
+float64 set_point
+float64 process_value
+float64 process_value_dot
+float64 error
+float64 time_step
+float64 command
+float64 p
+float64 i
+float64 d
+float64 i_clamp
+bool antiwindup
+""",
+    "control_msgs/msg/MecanumDriveControllerState": """\
+std_msgs/Header header
+float64 front_left_wheel_velocity
+float64 back_left_wheel_velocity
+float64 back_right_wheel_velocity
+float64 front_right_wheel_velocity
+geometry_msgs/Twist reference_velocity
+""",
+    "control_msgs/msg/SteeringControllerStatus": """\
+std_msgs/Header header
+float64[] traction_wheels_position
+float64[] traction_wheels_velocity
+float64[] steer_positions
+float64[] linear_velocity_command
+float64[] steering_angle_command
+""",
 }
 
 

@@ -10,14 +10,15 @@ from pathlib import Path
 from typing import Any
 
 from runner.compile.gazebo.base import ReaderBase
-from runner.compile.gazebo.info import DescribedPlugin, Where
+from runner.compile.gazebo.control import ControlContext, ControllerSpec, handler_for
+from runner.compile.gazebo.info import Where
 from runner.compile.gazebo.tags import TagReader
 from runner.errors import SourceError
 
 _LAUNCH_ARG = re.compile(r"\$\(arg\s+([^)\s]+)\s*\)")
 
 
-def run_controllers(g: ReaderBase, path: Path, where: Where) -> int:
+def run_controllers(g: ReaderBase, path: Path, where: Where, remap: dict[str, str] | None = None) -> int:
     """Run the diff drive and joint state controllers of a ros_control / ros2_control controllers file
     (as `<parameters>` names it, or the scenario's `controllers:`); returns how many. Other controllers
     are said, with their type."""
@@ -53,28 +54,16 @@ def run_controllers(g: ReaderBase, path: Path, where: Where) -> int:
         ) from None
     entries, update_rate = _controller_entries(doc)
     ros1 = not _ros_parameters(doc)
+    ctx = ControlContext(g, where, dict(remap or {}))
     count = 0
     for name, kind, params in entries:
-        if kind.endswith("DiffDriveController"):
-            type_name, drive = _diff_drive_controller(g, name, params, ros1, where)
-            g.info.plugins.append(
-                DescribedPlugin(
-                    type_name,
-                    g.unique(name),
-                    {k: v for k, v in drive.items() if v is not None},
-                    *where,
-                )
-            )
-        elif kind.endswith(("JointStateBroadcaster", "JointStateController")):
-            rate = params.get("publish_rate") if ros1 else update_rate
-            js = {"topic": "joint_states", "joints": params.get("joints") or None, "rate": rate}
-            g.info.plugins.append(
-                DescribedPlugin("joint_states", g.unique(name), {k: v for k, v in js.items() if v}, *where)
-            )
-        else:
+        spec = ControllerSpec(name, kind, params, path, None, ros1, update_rate)
+        handler = handler_for(kind)
+        if handler is None:
             g.notices.add(f"ros_control controller {name!r} ({kind}) is not run", *where)
             continue
-        count += 1
+        if handler(ctx, spec):
+            count += 1
     return count
 
 
@@ -84,7 +73,7 @@ def ros_control(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> None:
     controllers file, whose diff drive and joint state broadcaster are run as Gazebo runs them."""
     r.mark(*[c.tag for c in r.el if isinstance(c.tag, str)])
     files = [e for e in r.children("parameters") if (e.text or "").strip().endswith((".yaml", ".yml"))]
-    ran = sum(_ros2_controllers(g, r.el, e) for e in files)
+    ran = sum(_ros2_controllers(g, r.el, e, remap) for e in files)
     if ran or g.controller_files:  # the scenario's `controllers:` are run (read at the end)
         return None
     g.note(
@@ -96,16 +85,6 @@ def ros_control(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> None:
         "`diff_drive` plugin with the controller's wheels and topics",
     )
     return None
-
-
-def by_wheels(params: dict[str, Any], lefts: list[str], rights: list[str]) -> tuple[str, dict[str, Any]]:
-    """A drive with one wheel a side is a diff_drive; with several, a skid_steer driving them all."""
-    if len(lefts) > 1 or len(rights) > 1:
-        params["left_joints"], params["right_joints"] = lefts, rights
-        return "skid_steer", params
-    params["left_joint"] = lefts[0] if lefts else None
-    params["right_joint"] = rights[0] if rights else None
-    return "diff_drive", params
 
 
 def _ros_parameters(doc: Any, path: tuple[str, ...] = ()) -> dict[str, dict[str, Any]]:
@@ -121,26 +100,14 @@ def _ros_parameters(doc: Any, path: tuple[str, ...] = ()) -> dict[str, dict[str,
     return out
 
 
-def _param(params: dict[str, Any], dotted: str) -> Any:
-    """A parameter written `a.b.c: v` or nested (`a: {b: {c: v}}`)."""
-    if dotted in params:
-        return params[dotted]
-    node: Any = params
-    for part in dotted.split("."):
-        if not isinstance(node, dict) or part not in node:
-            return None
-        node = node[part]
-    return node
-
-
-def _ros2_controllers(g: ReaderBase, plugin: Any, el: Any) -> int:
+def _ros2_controllers(g: ReaderBase, plugin: Any, el: Any, remap: dict[str, str]) -> int:
     """The controllers of the ros2_control parameters file a `<parameters>` names; returns how many run."""
     path = Path((el.text or "").strip())
     if not path.is_absolute():
         base = g.where(el)[0]
         path = (base.parent if base else Path.cwd()) / path
     try:
-        return run_controllers(g, path, g.where(plugin))
+        return run_controllers(g, path, g.where(plugin), remap)
     except SourceError as e:
         g.note(el, f"{e}; its controllers are not run")
         return 0
@@ -172,52 +139,3 @@ def _controller_entries(doc: Any) -> tuple[list[tuple[str, str, dict[str, Any]]]
 
     walk(doc)
     return found, None
-
-
-def _diff_drive_controller(
-    g: ReaderBase, name: str, p: dict[str, Any], ros1: bool, where: Where
-) -> tuple[str, dict[str, Any]]:
-    """diff_drive_controller/DiffDriveController as it runs in Gazebo. ROS 1: `left_wheel`/`right_wheel`
-    (a joint or a list), `<name>/cmd_vel` (Twist); separation and radius from the URDF unless given. ROS 2
-    (Humble to Jazzy): `left_wheel_names`/`right_wheel_names`, `<name>/cmd_vel` (TwistStamped) or, with
-    `use_stamped_vel: false`, `<name>/cmd_vel_unstamped` (Twist). Both: `<name>/odom` at `publish_rate`,
-    `/tf` when `enable_odom_tf`, stopping `cmd_vel_timeout` (0.5 s) after the last command, multipliers."""
-
-    def names(*keys: str) -> list[str]:
-        for key in keys:
-            value = _param(p, key)
-            if value:
-                return [str(v) for v in value] if isinstance(value, list) else [str(value)]
-        return []
-
-    lefts, rights = names("left_wheel_names", "left_wheel"), names("right_wheel_names", "right_wheel")
-    sep, radius = _param(p, "wheel_separation"), _param(p, "wheel_radius")
-    stamped = False if ros1 else _param(p, "use_stamped_vel") is not False
-    if stamped:
-        g.notices.add(
-            f"ros2_control diff drive {name!r} takes geometry_msgs/TwistStamped on {name}/cmd_vel; here it "
-            "takes geometry_msgs/Twist there",
-            *where,
-            hint="set use_stamped_vel: false in the controllers file to have it as Gazebo then has it "
-            f"({name}/cmd_vel_unstamped, Twist)",
-        )
-    params: dict[str, Any] = {
-        "wheel_separation": float(sep) if sep else None,
-        "wheel_radius": float(radius) if radius else None,
-        "wheel_separation_multiplier": float(_param(p, "wheel_separation_multiplier") or 1.0),
-        "wheel_radius_multiplier": float(
-            _param(p, "wheel_radius_multiplier") or _param(p, "left_wheel_radius_multiplier") or 1.0
-        ),
-        "rate": float(_param(p, "publish_rate") or 50.0),
-        "cmd_topic": f"{name}/cmd_vel_unstamped" if not ros1 and not stamped else f"{name}/cmd_vel",
-        "odom_topic": f"{name}/odom",
-        "tf_topic": "tf",
-        "publish_tf": _param(p, "enable_odom_tf") is not False,
-        "odom_frame": _param(p, "odom_frame_id") or "odom",
-        "base_frame": g.frame(_param(p, "base_frame_id") or "base_link"),
-        "cmd_timeout": float(_param(p, "cmd_vel_timeout") or 0.5),
-    }
-    accel = _param(p, "linear.x.max_acceleration")
-    if accel and radius and _param(p, "linear.x.has_acceleration_limits"):
-        params["max_wheel_acceleration"] = float(accel) / float(radius)
-    return by_wheels(params, lefts, rights)

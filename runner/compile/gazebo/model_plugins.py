@@ -10,7 +10,8 @@ from typing import Any
 
 from runner.compile.gazebo import thirdparty
 from runner.compile.gazebo.base import ReaderBase
-from runner.compile.gazebo.controllers import by_wheels, ros_control
+from runner.compile.gazebo.control.drives import by_wheels
+from runner.compile.gazebo.controllers import ros_control
 from runner.compile.gazebo.tables import IGNORED_REASONS, NOOP_PLUGINS, PLUGIN_PARAMS
 from runner.compile.gazebo.tags import TagReader, floats, plugin_base, ros_topic
 

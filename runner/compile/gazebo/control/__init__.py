@@ -1,0 +1,106 @@
+"""The controllers of ros_control / ros2_control, as gazebo_ros_control (ROS 1), gazebo_ros2_control and
+gz_ros2_control (ROS 2) run them: each controller of a controllers file (`ControllerSpec`, read by
+runner.compile.gazebo.controllers) goes to the handler of its type, which adds the plugin(s) that run it.
+
+One module per family, each with `HANDLERS: {controller type: handler}`:
+- `.broadcasters`: joint_state_broadcaster (ROS 1 joint_state_controller), imu / force-torque broadcasters;
+- `.drives`: diff_drive_controller and the other mobile-base controllers;
+- `.forward`: forward_command_controller and its position/velocity/effort families (ROS 1's
+  `*_controllers/Joint*Controller`);
+- `.trajectory`: joint_trajectory_controller;
+- `.gripper`: gripper_action_controller, parallel_gripper_action_controller.
+
+A handler reads the controller's parameters as the controller does (defaults included), adds plugins with
+`ctx.add`, says what it does not run at the controller's own line (`ctx.say`), and returns whether it runs
+the controller. Any type without a handler is said with its type at its line.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from runner.compile.gazebo.base import ReaderBase
+from runner.compile.gazebo.info import DescribedPlugin, Where
+
+
+@dataclass
+class ControllerSpec:
+    """One controller of a controllers file."""
+
+    name: str  # the controller's name: its topics are `<name>/...`
+    type: str  # e.g. "joint_trajectory_controller/JointTrajectoryController"
+    params: dict[str, Any]  # its parameters (ROS 2: its `ros__parameters`; ROS 1: its block)
+    file: Path | None = None
+    line: int | None = None  # the line of its name (or its `type:`) in `file`
+    ros1: bool = False
+    update_rate: float | None = None  # the controller manager's update_rate (ROS 2)
+
+    @property
+    def where(self) -> Where:
+        return (self.file, self.line)
+
+
+@dataclass
+class ControlContext:
+    """What a controller handler works with: the Gazebo reader, the control plugin's location, and the
+    names the plugin's `<ros><remapping>` / `<ros><namespace>` give the controllers' topics."""
+
+    g: ReaderBase
+    plugin_where: Where
+    remap: dict[str, str] = field(default_factory=dict)  # `<name>/cmd_vel_unstamped` -> `cmd_vel`...
+
+    def topic(self, relative: str) -> str:
+        """A controller's topic (`<controller>/cmd_vel`, `joint_states`) as the control plugin's remappings
+        name it (a remapping names the topic relative to the robot's namespace, or absolute)."""
+        return self.remap.get(relative, relative)
+
+    def frame(self, name: str | None) -> str | None:
+        return self.g.frame(name)
+
+    def add(
+        self, spec: ControllerSpec, type_name: str, params: dict[str, Any], name: str | None = None
+    ) -> None:
+        """Run the controller (or part of it) as our plugin `type_name` with `params` (None: left out)."""
+        clean = {k: v for k, v in params.items() if v is not None}
+        self.g.info.plugins.append(
+            DescribedPlugin(type_name, self.g.unique(name or spec.name), clean, *spec.where)
+        )
+
+    def say(self, spec: ControllerSpec, message: str, hint: str | None = None) -> None:
+        """A notice at the controller's line in its controllers file."""
+        self.g.notices.add(message, *spec.where, hint)
+
+
+def param(params: dict[str, Any], dotted: str) -> Any:
+    """A parameter written `a.b.c: v` or nested (`a: {b: {c: v}}`), as ROS 2 parameter files allow both."""
+    if dotted in params:
+        return params[dotted]
+    node: Any = params
+    for part in dotted.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return None
+        node = node[part]
+    return node
+
+
+Handler = Callable[[ControlContext, ControllerSpec], bool]
+
+
+def handlers() -> dict[str, Handler]:
+    """Every controller type we run -> its handler."""
+    from runner.compile.gazebo.control import broadcasters, drives, forward, gripper, trajectory
+
+    out: dict[str, Handler] = {}
+    for module in (broadcasters, drives, forward, trajectory, gripper):
+        out.update(module.HANDLERS)
+    return out
+
+
+def handler_for(type_name: str) -> Handler | None:
+    """The handler of a controller type, by its full name (`pkg/Class`); ROS 1's `pkg::Class` too."""
+    found = handlers()
+    name = type_name.strip().replace("::", "/")
+    return found.get(name)
