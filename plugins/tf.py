@@ -13,6 +13,11 @@ Every link but the root is published relative to its parent link in the URDF tre
 The root link's own pose (odom -> base) is the drive's job (diff_drive publishes it on `tf` too; both
 plugins may publish on one topic). `include_root: true` adds `world` -> root: on `topic` for a mobile
 robot, on `static_topic` for a welded (`fixed`) one.
+
+A description whose root link is `world` (welded by it, as in Gazebo): that link is the frame `<ns>/world`,
+the robot's own, distinct from the scenario's `world`; the links below it are published relative to it,
+as robot_state_publisher publishes the URDF's `world` -> `base_link`, and `include_root` adds `world` ->
+`<ns>/world` (the robot's pose in the scenario).
 """
 
 from __future__ import annotations
@@ -28,6 +33,9 @@ from runner.wire import msgs
 
 TF_TYPE = "tf2_msgs/msg/TFMessage"
 WORLD_FRAME = "world"
+# the description's own root link `world` (MuJoCo's world body), named `<ns>/world` as the robot's links are
+WORLD_LINK = "world"
+_FROM_WORLD_LINK = -2  # an entry's parent: the description's world link
 
 
 class TfParams(RatedParams):
@@ -53,8 +61,13 @@ class Tf(Plugin):
         bodies = [b for b in ctx.spec.bodies if b.name and b.name != "world"]
         root = ctx.body(ctx.root)
         children = [b for b in bodies if b.name != root.name]
-        moving = any(_moves(b) for b in children) or (params.include_root and _moves(root))
-        fixed = any(not _moves(b) for b in children) or (params.include_root and not _moves(root))
+        with_root = params.include_root or ctx.world_link  # (the world link's children are URDF joints)
+        moving = any(_moves(b) for b in children) or (with_root and _moves(root))
+        fixed = (
+            any(not _moves(b) for b in children)
+            or (with_root and not _moves(root))
+            or (params.include_root and ctx.world_link)
+        )
         topics = []
         if moving:
             topics.append(Topic(params.topic, TF_TYPE, "pub", params.rate))
@@ -66,14 +79,20 @@ class Tf(Plugin):
     def setup(self) -> None:
         p = self.params
         r = self.ctx.robot
-        m, d = self.ctx.model, self.ctx.data
-        # (parent body or -1 for the world, child body, parent frame, child frame)
+        m = self.ctx.model
+        # (parent body, -1 for the world or _FROM_WORLD_LINK; child body, -1 for the world link itself;
+        # parent frame, child frame)
         self.moving: list[tuple[int, int, str, str]] = []
         self.fixed: list[tuple[int, int, str, str]] = []
+        world_link = r.world_link  # the description's `world` root link: pose in the scenario's world
+        if world_link is not None and p.include_root:
+            self.fixed.append((-1, -1, WORLD_FRAME, r.frame(WORLD_LINK)))
         for b in sorted(r.body_ids):
             link = m.body(b).name.removeprefix(r.prefix)
             moves = int(m.body_jntnum[b]) > 0
-            if b == r.root_body:
+            if world_link is not None and int(m.body_parentid[b]) == 0:
+                entry = (_FROM_WORLD_LINK, b, r.frame(WORLD_LINK), r.frame(link))
+            elif b == r.root_body:
                 if not p.include_root:
                     continue
                 entry = (-1, b, WORLD_FRAME, r.frame(link))
@@ -92,10 +111,12 @@ class Tf(Plugin):
         self.static_pub = self.ctx.publisher(p.static_topic, TF_TYPE) if self.fixed else None
         # A fixed link's pose in its parent is a constant of the model; the world -> welded root pose is
         # read once from the data (the robot's placement).
-        self.static_poses = [
-            (np.array(d.xpos[b]), np.array(d.xquat[b])) if parent < 0 else (m.body_pos[b], m.body_quat[b])
-            for parent, b, _pf, _cf in self.fixed
-        ]
+        self._world_link_inv: tuple[np.ndarray, np.ndarray] | None = None
+        if world_link is not None:
+            inv = (np.zeros(3), np.zeros(4))
+            mujoco.mju_negPose(inv[0], inv[1], *world_link)
+            self._world_link_inv = inv
+        self.static_poses = [self._static_pose(parent, b) for parent, b, _pf, _cf in self.fixed]
         self.static_period_ns = round(p.static_period * 1e9)
         self.next_static_ns: int | None = 0
         self._q = np.zeros(4)
@@ -123,7 +144,9 @@ class Tf(Plugin):
         if self.pub:
             d = self.ctx.data
             for (parent, b, _pf, _cf), out in zip(self.moving, self.out, strict=True):
-                if parent < 0:
+                if parent == _FROM_WORLD_LINK:
+                    pos, quat = self._from_world_link(d.xpos[b], d.xquat[b])
+                elif parent < 0:
                     pos, quat = d.xpos[b], d.xquat[b]
                 else:
                     pos, quat = self._relative(d, parent, b)
@@ -131,6 +154,30 @@ class Tf(Plugin):
                 out[3:6] = quat[1:]
                 out[6] = quat[0]
             self.pub.publish_cdr(self.layout.encode(*[now_ns] * len(self.out)), now_ns)
+
+    def _static_pose(self, parent: int, b: int) -> tuple[np.ndarray, np.ndarray]:
+        """A fixed entry's pose: the world link's in the world, a link's below the world link, a welded
+        root's in the world (the robot's placement, from the data), or a fixed link's in its parent."""
+        m, d = self.ctx.model, self.ctx.data
+        if b < 0:
+            assert self.ctx.robot.world_link is not None
+            pos, quat = self.ctx.robot.world_link
+            return np.array(pos), np.array(quat)
+        if parent == _FROM_WORLD_LINK:
+            pos, quat = self._from_world_link(m.body_pos[b], m.body_quat[b])
+            return np.array(pos), np.array(quat)
+        if parent < 0:
+            return np.array(d.xpos[b]), np.array(d.xquat[b])
+        return m.body_pos[b], m.body_quat[b]
+
+    def _from_world_link(self, pos: Any, quat: Any) -> tuple[np.ndarray, np.ndarray]:
+        """A pose in the scenario's world as one in the description's world link."""
+        assert self._world_link_inv is not None
+        out_pos, out_quat = np.zeros(3), np.zeros(4)
+        mujoco.mju_mulPose(
+            out_pos, out_quat, *self._world_link_inv, np.asarray(pos, float), np.asarray(quat, float)
+        )
+        return out_pos, out_quat
 
     def _relative(self, d: Any, parent: int, child: int) -> tuple[np.ndarray, np.ndarray]:
         """The child's pose in its parent's frame: p = R_pᵀ (x_c - x_p), q = q_p⁻¹ q_c."""

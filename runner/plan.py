@@ -52,6 +52,9 @@ class RobotPlan(BaseModel):
     plugins: list[PluginPlan]
     urdf: str = ""  # the description as URDF (xacro expanded): published on <ns>/robot_description
     gazebo: list[ParityLine] = []  # the robot as in Gazebo (scenario validate prints it)
+    # The description's root link is `world` (it welds the robot): `root` (its first child) in that link's
+    # frame, x y z qw qx qy qz. The link is the TF frame `<ns>/world` at the robot's pose.
+    world_origin: list[float] | None = None
 
 
 class TimelinePlan(BaseModel):

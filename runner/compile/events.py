@@ -63,7 +63,8 @@ class _World:
                     raise self.problem(
                         f"robot {name!r} is fixed to the world: it cannot be moved",
                         where,
-                        hint="move a robot without `fixed: true`, or a model that is not static",
+                        hint="move a robot without `fixed: true` (and whose description has no root link "
+                        "`world`), or a model that is not static",
                     )
                 return {"name": name, "body": body, "free": not r.fixed}
         for a in self.actors:

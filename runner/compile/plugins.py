@@ -84,7 +84,13 @@ def build_plugins(
 ) -> list[PluginPlan]:
     """The robot's plugins, built; each one's mistakes go to `problems` and it is left out."""
     plans: list[PluginPlan] = []
-    ctx = BuildContext(spec=model.spec, robot=robot.name, namespace=robot.ns, root=model.root)
+    ctx = BuildContext(
+        spec=model.spec,
+        robot=robot.name,
+        namespace=robot.ns,
+        root=model.root,
+        world_link=model.world is not None,
+    )
     names: set[str] = set()
     entries = _plugin_entries(robot, model)
     for entry in entries + _state_publisher(sc, entries):

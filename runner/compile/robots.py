@@ -21,7 +21,7 @@ from runner.compile.wheels import anisotropic_wheels, wheel_links
 from runner.compile.xacro_expand import expand
 from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError, missing_file_hint
 from runner.geometry import rpy_to_quat
-from runner.plan import RobotPlan
+from runner.plan import ParityLine, RobotPlan
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import PluginEntry, Robot, Scenario
 
@@ -70,6 +70,8 @@ def add_robot(
     model = robot_model(robot, i, doc, packages, notices, sc.world.physics.timestep)
     plugins = build_plugins(sc, robot, i, model, doc, problems)
     add_transmissions(model, notices)
+    if model.world is not None:
+        _welded_by_description(model, robot, i, doc, notices)
     parity = summarize(model, plugins, notices.items[before:], f"{sc.name}/{robot.ns}/")
     pos = robot.pose.xyz
     frame = world.worldbody.add_frame(pos=list(pos), quat=list(rpy_to_quat(robot.pose.rpy)))
@@ -85,14 +87,39 @@ def add_robot(
         namespace=robot.ns,
         prefix=prefix,
         root=model.root,
-        fixed=robot.fixed,
+        fixed=robot.fixed or model.world is not None,
         description_file=str(description_path(robot, doc.base_dir)),
         links=model.links,
         joints=model.joints,
         plugins=plugins,
         urdf=model.urdf,
         gazebo=parity,
+        world_origin=model.world.origin if model.world is not None else None,
     )
+
+
+def _welded_by_description(model: RobotModel, robot: Robot, i: int, doc: Document, notices: Notices) -> None:
+    """Say that the description welds the robot (validate's "as in Gazebo" lines), and warn where the
+    scenario says `fixed: false`: Gazebo welds such a robot whatever its spawner is told."""
+    world = model.world
+    assert world is not None
+    how = "welds" if world.joint_type == "fixed" else f"joins ({world.joint_type} joint)"
+    text = (
+        f"the description's root link `world` {how} {world.root!r} to the world at the robot's pose "
+        f"(joint {world.joint!r}), as Gazebo does: `fixed:` is not needed"
+    )
+    model.adjusted.append(
+        ParityLine(kind="base", text=text, file=str(world.file) if world.file else None, line=world.line)
+    )
+    if "fixed" in robot.model_fields_set and not robot.fixed:
+        where = doc.locate(("robots", i, "fixed"))
+        notices.add(
+            f"robot {robot.name!r}: `fixed: false`, but its description's root link `world` welds it to the "
+            "world (Gazebo welds it whatever the spawner says): welded",
+            where.file,
+            where.line,
+            hint="remove `fixed: false`; to have a free robot, load a description without the `world` link",
+        )
 
 
 def description_path(robot: Robot, base: Path) -> Path:

@@ -91,6 +91,8 @@ class BuildContext:
     robot: str
     namespace: str
     root: str
+    # the description's root link is `world` (MuJoCo's world body): `root` and its siblings hang from it
+    world_link: bool = False
 
     @property
     def links(self) -> list[str]:

@@ -37,6 +37,17 @@ class RobotHandle:
         )
         free = self._id(mujoco.mjtObj.mjOBJ_JOINT, "root", required=False)
         self.free_joint = free if free >= 0 else None
+        # The description's root link `world` (MuJoCo's world body): where it is in the scenario's world,
+        # from the root's placement (its pose in its parent, the world: joint positions play no part).
+        self.world_link: tuple[np.ndarray, np.ndarray] | None = None
+        origin = getattr(plan, "world_origin", None)
+        if origin is not None:
+            inv_pos, inv_quat = np.zeros(3), np.zeros(4)
+            mujoco.mju_negPose(inv_pos, inv_quat, np.array(origin[:3], float), np.array(origin[3:], float))
+            pos, quat = np.zeros(3), np.zeros(4)
+            b = self.root_body
+            mujoco.mju_mulPose(pos, quat, model.body_pos[b], model.body_quat[b], inv_pos, inv_quat)
+            self.world_link = (pos, quat)
 
     def _id(self, kind: mujoco.mjtObj, name: str, required: bool = True) -> int:
         i = mujoco.mj_name2id(self.model, kind, self.prefix + name)

@@ -200,6 +200,12 @@ class SceneFeed:
             elif not any(p.type == "tf" and p.params.get("include_root") for p in h.plan.plugins):
                 # nobody says where this robot is (its own `tf` plugin leaves the root out): world -> root
                 root = h.frame(h.root_link)
+                if h.world_link is not None:
+                    # the description's root link `world` is the robot's frame `<ns>/world` (its `tf`
+                    # publishes the links below it): world -> <ns>/world, the robot's pose
+                    pos, quat = h.world_link
+                    self.static.append((WORLD, h.frame(WORLD), np.array(pos), np.array(quat)))
+                    continue
                 if int(m.body_jntnum[h.root_body]) > 0:
                     self.moving.append(h.root_body)
                     self._frames.append(root)

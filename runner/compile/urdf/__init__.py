@@ -13,11 +13,12 @@
   and plugins;
 - `<transmission>` (ROS 1 style) and `<ros2_control>` joints are collected so the compiler can give them
   actuators;
-- a mobile robot's root link gets a free joint (`<gazebo><static>true` or `fixed: true` welds it).
+- a mobile robot's root link gets a free joint (`<gazebo><static>true` or `fixed: true` welds it); a root
+  link named `world` welds the robot as Gazebo does (`world_link`).
 
 Where things live: `reader` (`urdf_to_model`, `RobotModel`), `checks` (structure, numbers, empty shapes;
 `DescriptionError`), `inertia` (masses and inertias repaired), `mesh_files` (mesh URIs and files),
-`link_props` (Gazebo link properties and self-collision on the MuJoCo spec), `transmissions`.
+`link_props` (Gazebo link properties and self-collision on the MuJoCo spec), `transmissions`, `world_link`.
 """
 
 from runner.compile.urdf.checks import DescriptionError

@@ -122,3 +122,51 @@ def _repaired_inertia(el: Any, mass: float, moving: bool) -> tuple[tuple[float, 
         return "(" + ", ".join(f"{x:.4g}" for x in sorted(v)) + ")"
 
     return tuple(float(v) for v in values), shown(moments), shown(new), nudged_only
+
+
+def weigh_massless_links(root: Any, where: Any, notices: Notices, adjusted: list[ParityLine]) -> None:
+    """A moving link with no `<inertial>` and nothing to weigh (no `<collision>`, on itself or on the links
+    fixed joints weld to it: a gripper finger with only a visual mesh) is refused by MuJoCo ("mass and
+    inertia of moving bodies must be larger than mjMINVAL"). Gazebo's URDF import leaves such a link out,
+    with its joint and what hangs from it ("link[...] has no <inertial> block defined ... is not modeled in
+    sdf": sdformat `parser_urdf.cc` `CreateSDF`). It is kept here, as every link without `<inertial>` is
+    (MuJoCo weighs those by their collisions), with `MIN_MASS` and a small solid sphere's inertia, so that
+    its joint exists for the controllers that name it; a warning at the link's line says so. Runs after the
+    shapes that cannot load are left out (a visual-only Collada finger is the case seen)."""
+    moving = {
+        j.find("child").get("link")
+        for j in root.findall("joint")
+        if j.get("type") in ("revolute", "continuous", "prismatic", "floating", "planar")
+    }
+    welded: dict[str, list[str]] = {}  # link -> the links fixed joints hang from it
+    for j in root.findall("joint"):
+        if j.get("type") == "fixed":
+            welded.setdefault(j.find("parent").get("link"), []).append(j.find("child").get("link"))
+    links = {el.get("name"): el for el in root.findall("link")}
+
+    def weighs(name: str) -> bool:
+        el = links.get(name)
+        if el is None:
+            return False
+        inertial = el.find("inertial")
+        if el.find("collision") is not None or inertial is not None:
+            return True  # (a given <inertial>'s mass has been repaired by repair_inertias)
+        return any(weighs(child) for child in welded.get(name, []))
+
+    for name in sorted(moving, key=list(links).index):
+        if weighs(name):
+            continue
+        link = links[name]
+        inertial = etree.SubElement(link, "inertial")
+        etree.SubElement(inertial, "mass", value=repr(MIN_MASS))
+        moment = repr(0.4 * MIN_MASS * 0.01**2)  # a solid sphere of 1 cm radius
+        etree.SubElement(inertial, "inertia", ixx=moment, iyy=moment, izz=moment, ixy="0", ixz="0", iyz="0")
+        at = where(link)
+        message = (
+            f"link {name!r} moves but has no <inertial> and no <collision> to weigh: given {MIN_MASS:g} kg "
+            "(Gazebo's URDF import leaves such a link and its joint out of the model; here its joint stays, "
+            "for the controllers that name it)"
+        )
+        notices.add(message, *at, hint="give the link an <inertial> with its real mass to silence this")
+        file, line = at
+        adjusted.append(ParityLine(kind="changed", text=message, file=str(file) if file else None, line=line))

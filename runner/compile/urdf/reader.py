@@ -18,10 +18,11 @@ from runner.compile.gazebo import GazeboInfo, parse, read_gazebo
 from runner.compile.locate import Locator
 from runner.compile.packages import PackageMap
 from runner.compile.urdf.checks import DescriptionError, check_numbers, check_structure, drop_empty_shapes
-from runner.compile.urdf.inertia import repair_inertias
+from runner.compile.urdf.inertia import repair_inertias, weigh_massless_links
 from runner.compile.urdf.link_props import apply_link_props, self_collision
 from runner.compile.urdf.mesh_files import rewrite_mesh
 from runner.compile.urdf.transmissions import Transmission, read_transmissions
+from runner.compile.urdf.world_link import WorldLink, world_root
 from runner.errors import Notices
 from runner.plan import ParityLine
 
@@ -41,6 +42,7 @@ class RobotModel:
     transmissions: list[Transmission] = field(default_factory=list)
     adjusted: list[ParityLine] = field(default_factory=list)  # what was changed or left out to load it
     self_collision: list[str] = field(default_factory=list)  # links that collide with the robot's others
+    world: WorldLink | None = None  # the description's root link is `world`: it welds the robot (`root`)
 
 
 def urdf_to_model(
@@ -64,6 +66,7 @@ def urdf_to_model(
     root_link = check_structure(root, where)
     check_numbers(root, where)
     adjusted: list[ParityLine] = []
+    world = world_root(root, root_link, where, notices, adjusted)
     repair_inertias(root, where, notices, adjusted)
     drop_empty_shapes(root, where, notices, adjusted)
 
@@ -71,6 +74,7 @@ def urdf_to_model(
     meshes = [m for m in root.iter("mesh") if m.getparent() is not None and m.getparent().tag == "geometry"]
     for mesh in meshes:  # a list: a mesh that cannot be had takes its <visual> out of the tree
         rewrite_mesh(mesh, packages, base_dir, where, notices, shell)
+    weigh_massless_links(root, where, notices, adjusted)
 
     gazebo = read_gazebo(
         root,
@@ -85,15 +89,19 @@ def urdf_to_model(
     transmissions = read_transmissions(root, where, notices)
     spec = _load(root, where, file, shell)
     apply_link_props(spec, gazebo, timestep)
-    collide = self_collision(root, spec, gazebo, root_welded=fixed or gazebo.static, where=where)
-    body = spec.body(root_link)
-    if not (fixed or gazebo.static):
-        body.add_freejoint(name="root")
+    # A root link named `world` is MuJoCo's world body: what hangs from it is welded (or jointed) to the
+    # world, whatever `fixed:` says, as in Gazebo (.world_link); the robot's root is its first child.
+    welded = fixed or gazebo.static or world is not None
+    collide = self_collision(root, spec, gazebo, root_welded=welded, where=where)
+    if world is not None:
+        root_link = world.root
+    elif not welded:
+        spec.body(root_link).add_freejoint(name="root")
     links = [b.name for b in spec.bodies if b.name and b.name != "world"]
     joints = [j.name for j in spec.joints if j.name and j.name != "root"]
     for message, (src, line) in gazebo.dropped:
         adjusted.append(ParityLine(kind="dropped", text=message, file=str(src) if src else None, line=line))
-    return RobotModel(spec, root_link, urdf, links, joints, gazebo, transmissions, adjusted, collide)
+    return RobotModel(spec, root_link, urdf, links, joints, gazebo, transmissions, adjusted, collide, world)
 
 
 def _parse(urdf: str, file: Path | None, expanded: bool, where: Any) -> Any:

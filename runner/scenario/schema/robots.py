@@ -43,7 +43,9 @@ class Robot(Strict):
     )
     pose: Pose = Field(default_factory=Pose, description="Spawn pose of the robot's root link.")
     fixed: bool = Field(
-        False, description="Weld the root link to the world (an arm on a table) instead of a free base."
+        False,
+        description="Weld the root link to the world (an arm on a table) instead of a free base. A "
+        "description whose root link is `world` is welded by it, as in Gazebo, without this.",
     )
     plugins: list[PluginEntry] = Field(
         default_factory=list,
