@@ -579,8 +579,7 @@ def test_a_ros2_control_diff_drive_runs_from_its_controllers_file(tmp_path: Path
     assert topics["base_controller"] == ["base_controller/cmd_vel_unstamped", "base_controller/odom", "tf"]
     assert topics["joint_state_broadcaster"] == ["joint_states"]
     assert (
-        "ros_control controller 'gripper_controller' (position_controllers/GripperActionController) is not run"
-        in text
+        "gripper_controller: a gripper controller needs `joint` (one joint name); not run" in text
     )
     _, bus = simulate(path)
     t, pose, _ = _truth(bus)
