@@ -360,12 +360,14 @@ def test_unknown_and_unrun_parameters_are_said_at_the_controllers_file(tmp_path:
     path = _arm(
         tmp_path,
         [],
-        arm_extra="    bogus_param: 3\n    speed_scaling: {initial_scaling_factor: 0.5}\n",
+        arm_extra="    bogus_param: 3\n    speed_scaling: {initial_scaling_factor: 0.5}\n"
+        "    gains:\n      elbow: {p: 1.0, kp: 2.0}\n",
         gripper_extra="    stall_timeot: 2.0\n",
     )
     plan, said = compile_with_notices(path)
     assert "arm_controller: 'bogus_param' is not a parameter of joint_trajectory_controller; ignored" in said
     assert "arm_controller: speed_scaling speed scaling is not run" in said
+    assert "arm_controller: gains.elbow.kp is not a parameter of the controller; ignored" in said
     assert "gripper_controller: 'stall_timeot' is not a parameter of the gripper controller" in said
     assert "our topic 'gripper_controller/gripper_cmd' (control_msgs/msg/GripperCommand)" in said
     types = [p.type for p in plan.robots[0].plugins]

@@ -120,6 +120,17 @@ def _gains(ctx: ControlContext, spec: ControllerSpec, joints: list[str]) -> dict
                 ctx.say(spec, f"{spec.name}: gains.{j}.{k} is not run (error taken as desired - measured)")
         if g:
             out[j] = g
+    block = param(p, "gains")
+    if isinstance(block, dict):
+        for j, entry in block.items():
+            if j not in joints:
+                ctx.say(spec, f"{spec.name}: gains.{j}: {j!r} is not one of its joints; ignored")
+            elif isinstance(entry, dict):
+                for k in entry:
+                    if k not in (*_GAIN_KEYS, *_GAIN_SAID):
+                        ctx.say(
+                            spec, f"{spec.name}: gains.{j}.{k} is not a parameter of the controller; ignored"
+                        )
     return out
 
 
@@ -185,6 +196,14 @@ def joint_trajectory_controller(ctx: ControlContext, spec: ControllerSpec) -> bo
             spec,
             f"{spec.name}: the follow_joint_trajectory action is not served yet; trajectories go to "
             f"{params['command_topic']!r}",
+        )
+    interfaces = params.get("command_interfaces") or ["position"]
+    closed_loop = len(interfaces) == 1 and interfaces[0] in ("velocity", "effort")
+    if params["gains"] and not closed_loop:
+        ctx.say(
+            spec,
+            f"{spec.name}: gains are not used with command interfaces {interfaces} (ros2_controllers uses "
+            "them for a velocity-only or effort-only command); ignored",
         )
     ctx.add(spec, "joint_trajectory_controller", params)
     return True
