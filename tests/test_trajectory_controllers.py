@@ -277,6 +277,21 @@ def test_goals_through_the_internal_api_report_success_path_violation_and_preemp
     assert 15 <= len(feedback) <= 30  # 20 Hz action_monitor_rate for about a second
     assert feedback[-1].joint_names == ["shoulder", "elbow"]
 
+    # canceled half-way (from a feedback callback, in the sim loop): the arm holds where it was
+    world = World(plan_of(path), MemoryBus())
+    jtc = _controller(world, "JointTrajectoryController")
+    handles: list[Any] = []
+
+    def cancel_late(f: Any) -> None:
+        if f.stamp_ns >= 500_000_000:
+            handles[0].cancel()
+
+    handles.append(jtc.submit_goal(trajectory, on_feedback=cancel_late, on_result=results.append))
+    world.run()
+    assert handles[0].status == "canceled" and results[-1].error_code == 0
+    q = world.data.qpos[jtc.qadr]
+    assert 0.1 < q[0] < 0.5, q  # stopped on the way to 0.6
+
     class Tol:
         def __init__(self, name: str) -> None:
             self.name, self.position, self.velocity, self.acceleration = name, 0.001, 0.0, 0.0
@@ -477,3 +492,37 @@ def test_a_trajectory_published_through_zenoh_moves_the_arm(tmp_path: Path) -> N
             proc.communicate(timeout=20)
         finally:
             proc.kill()
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("interface", ["velocity", "effort"])
+def test_velocity_and_effort_interfaces_follow_through_the_pid_of_gains_and_not_without(
+    tmp_path: Path, interface: str
+) -> None:
+    """A velocity- or effort-only command interface runs ros2_controllers' PID adapter: the sampled
+    velocity × ff_velocity_scale plus a PID of `gains.<joint>` on the error. With gains the arm follows;
+    without (all 0, the default) nothing drives it and the shoulder stays where it was."""
+    data = _traj(["shoulder", "elbow"], [([0.6, 0.3], 1.0)])
+    # gains a 100 Hz loop keeps stable on these small inertias (shoulder 0.0013 kg m², elbow 0.007)
+    gains = {
+        "velocity": ("{p: 20.0, i: 5.0, ff_velocity_scale: 1.0}",) * 2,
+        "effort": ("{p: 1.0, i: 1.0, d: 0.03}", "{p: 5.0, i: 5.0, d: 0.15}"),
+    }[interface]
+    extra = f"    gains:\n      shoulder: {gains[0]}\n      elbow: {gains[1]}\n"
+    control = CONTROL.replace("command_interfaces: [position]", f"command_interfaces: [{interface}]")
+    for with_gains, name in ((True, "pid"), (False, "none")):
+        path = _arm(tmp_path, [_trajectory_at(0.2, data)], duration=2.5, name=name)
+        (tmp_path / "control.yaml").write_text(
+            control.format(
+                gripper_type="position_controllers/GripperActionController",
+                arm_extra=extra if with_gains else "",
+                gripper_extra="",
+            )
+        )
+        _, bus = _run(path)
+        final = _states(bus)[-1][1]
+        error = np.abs(np.asarray(final.feedback.positions) - [0.6, 0.3])
+        if with_gains:
+            assert error.max() <= 0.01, (interface, error)
+        else:
+            assert abs(final.feedback.positions[0]) < 0.01, final.feedback.positions  # not driven
