@@ -142,7 +142,7 @@ def joint_trajectory_controller(ctx: ControlContext, spec: ControllerSpec) -> bo
         return False
     params: dict[str, Any] = {"joints": joints, "constraints": _constraints(ctx, spec, joints)}
     params["gains"] = _gains(ctx, spec, joints)
-    rate = _float(param(p, "update_rate")) or (float(spec.update_rate) if spec.update_rate else None)
+    rate = _float(param(p, "update_rate")) or _float(spec.update_rate)
     params["update_rate"] = rate
     if spec.ros1:
         family = spec.type.replace("::", "/").split("/")[0]
