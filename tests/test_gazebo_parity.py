@@ -578,10 +578,7 @@ def test_a_ros2_control_diff_drive_runs_from_its_controllers_file(tmp_path: Path
     topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in declared(plan.robots[0])}
     assert topics["base_controller"] == ["base_controller/cmd_vel_unstamped", "base_controller/odom", "tf"]
     assert topics["joint_state_broadcaster"] == ["joint_states"]
-    assert (
-        "ros_control controller 'gripper_controller' (position_controllers/GripperActionController) is not run"
-        in text
-    )
+    assert "gripper_controller: a gripper controller needs `joint` (one joint name); not run" in text
     _, bus = simulate(path)
     t, pose, _ = _truth(bus)
     # commands from 0.5 s to 5.5 s, then none: it stops 0.5 s later (cmd_vel_timeout), having gone ~1.1 m

@@ -102,6 +102,8 @@ def test_builtins_are_registered_through_the_entry_point_group():
         "skid_steer",
         "planar_move",
         "joint_controller",
+        "joint_trajectory_controller",
+        "gripper_action_controller",
         "lidar",
         "camera",
         "depth_camera",

@@ -241,7 +241,12 @@ def test_every_installed_plugin_has_its_params_rule_and_its_defaults_pass() -> N
     assert names == sorted(name for name, _ in installed_params())
     assert {"lidar", "imu", "diff_drive", "camera", "joint_controller"} <= set(names)
     validator = Draft202012Validator(schema)
-    samples = {"contact": {"link": "base_link"}, "joint_controller": {"joints": ["lift"]}}
+    samples = {
+        "contact": {"link": "base_link"},
+        "joint_controller": {"joints": ["lift"]},
+        "joint_trajectory_controller": {"joints": ["shoulder"]},
+        "gripper_action_controller": {"joint": "finger"},
+    }
     for name, model in installed_params():
         params = model.model_validate(samples.get(name, {})).model_dump(mode="json")
         entry = {"type": name, "params": params}
