@@ -40,6 +40,19 @@ class ParityLine(BaseModel):
     line: int | None = None
 
 
+class HardwareJoint(BaseModel):
+    """A joint of the robot's ros2_control / ros_control hardware, as the world sets it up before any plugin:
+    start state, servo gains from the inertia it moves, velocity limit (runner.sim.hardware)."""
+
+    joint: str  # un-prefixed
+    actuators: dict[str, str] = {}  # command interface -> actuator name (un-prefixed)
+    loop_gain: float | None = None  # position: 1/s from error to velocity setpoint; None: Gazebo sets it
+    pid: dict[str, float] | None = None  # position: {p, i, d} given by the description / controllers file
+    velocity_limit: float | None = None  # rad/s or m/s (URDF <limit velocity>)
+    initial_position: float | None = None
+    initial_velocity: float | None = None
+
+
 class RobotPlan(BaseModel):
     name: str
     namespace: str
@@ -52,6 +65,8 @@ class RobotPlan(BaseModel):
     plugins: list[PluginPlan]
     urdf: str = ""  # the description as URDF (xacro expanded): published on <ns>/robot_description
     gazebo: list[ParityLine] = []  # the robot as in Gazebo (scenario validate prints it)
+    hardware: list[HardwareJoint] = []  # <ros2_control> / <transmission> joints
+    hardware_rate: float = 100.0  # the controller manager's update rate (Hz)
 
 
 class TimelinePlan(BaseModel):

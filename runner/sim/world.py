@@ -38,6 +38,7 @@ from runner.plan import RunPlan
 from runner.plugin import Plugin, RobotHandle, RuntimeContext, overrides
 from runner.plugin.registry import load
 from runner.sim.contacts import ContactWatch
+from runner.sim.hardware import Hardware
 from runner.sim.links import Lockstep, RemoteRender
 from runner.sim.pubsub import PubSub
 from runner.sim.schedule import Hook, next_due, sleep_until
@@ -99,6 +100,8 @@ class World(PubSub):
         self._init_pubsub()
         self._lockstep: Lockstep | None = None
         self.robots = [RobotHandle(self.model, r) for r in plan.robots]
+        # the hardware's start state and gains come before any plugin (a controller reads its start there)
+        self.hardware = Hardware(self.model, self.data, plan.robots)
         self.plugins: list[Plugin] = []
         self._plugin_index: dict[int, Plugin] = {}  # by place in the plan (events change their parameters)
         self._hooks_of: dict[int, list[Hook]] = {}
@@ -109,6 +112,8 @@ class World(PubSub):
         self.remote_renders: dict[int, RemoteRender] = {}  # plugin index -> its renderer link
         self.render_plugins: dict[int, Plugin] = {}  # in a renderer: plugin index -> plugin
         self._load_plugins(remote=role == "world" and plan.renderers == "process" and session is not None)
+        for fn, period in self.hardware.hooks():  # last: it sees the controls the controllers wrote
+            self._before.append(Hook(fn, period))
         if role == "world" and plan.foxglove.scene:
             from runner.sim.scene import SceneFeed
 

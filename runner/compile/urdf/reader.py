@@ -21,7 +21,7 @@ from runner.compile.urdf.checks import DescriptionError, check_numbers, check_st
 from runner.compile.urdf.inertia import repair_inertias
 from runner.compile.urdf.link_props import apply_link_props, self_collision
 from runner.compile.urdf.mesh_files import rewrite_mesh
-from runner.compile.urdf.transmissions import Transmission, read_transmissions
+from runner.compile.urdf.transmissions import Transmission, read_transmissions, velocity_limits
 from runner.errors import Notices
 from runner.plan import ParityLine
 
@@ -41,6 +41,7 @@ class RobotModel:
     transmissions: list[Transmission] = field(default_factory=list)
     adjusted: list[ParityLine] = field(default_factory=list)  # what was changed or left out to load it
     self_collision: list[str] = field(default_factory=list)  # links that collide with the robot's others
+    velocity_limits: dict[str, float] = field(default_factory=dict)  # joint -> URDF <limit velocity>
 
 
 def urdf_to_model(
@@ -82,7 +83,8 @@ def urdf_to_model(
         notices=notices,
         controllers=controllers,
     )
-    transmissions = read_transmissions(root, where, notices)
+    transmissions = read_transmissions(root, where, notices, controllers)
+    vlimits = velocity_limits(root)
     spec = _load(root, where, file, shell)
     apply_link_props(spec, gazebo, timestep)
     collide = self_collision(root, spec, gazebo, root_welded=fixed or gazebo.static, where=where)
@@ -93,7 +95,7 @@ def urdf_to_model(
     joints = [j.name for j in spec.joints if j.name and j.name != "root"]
     for message, (src, line) in gazebo.dropped:
         adjusted.append(ParityLine(kind="dropped", text=message, file=str(src) if src else None, line=line))
-    return RobotModel(spec, root_link, urdf, links, joints, gazebo, transmissions, adjusted, collide)
+    return RobotModel(spec, root_link, urdf, links, joints, gazebo, transmissions, adjusted, collide, vlimits)
 
 
 def _parse(urdf: str, file: Path | None, expanded: bool, where: Any) -> Any:
