@@ -101,6 +101,7 @@ SECTIONS = (
     "actors",
     "ray",
     "limits",
+    "hardware",
 )
 
 
@@ -803,6 +804,12 @@ def limits(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     return bl.run(args.quick)
 
 
+def hardware(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
+    from bench import hardware as bh
+
+    return bh.run(args.quick)
+
+
 RUNNERS = {
     "two_robots": two_robots,
     "scaling": scaling,
@@ -817,6 +824,7 @@ RUNNERS = {
     "actors": actors,
     "ray": ray,
     "limits": limits,
+    "hardware": hardware,
 }
 
 

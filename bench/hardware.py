@@ -5,7 +5,7 @@ no controller: the hardware holds the start pose as Gazebo's servo does. Printed
 largest drift of any joint over 10 s against the issue's 0.005 rad, and the peak joint speed after a 2 rad
 step command against the URDF velocity limit of π rad/s (DART clips the servo there).
 
-Run: `python -m bench hardware` (or `python bench/hardware.py`). The arm generator is used by
+Run: `python -m bench --only hardware` (or `python -m bench.hardware`). The arm generator is used by
 tests/test_hardware.py too."""
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -81,46 +82,114 @@ def arm_urdf(
 
 
 def arm_scenario(
-    folder: Path, urdf: str, *, duration: float, timestep: float = 0.001, timeline: str = ""
+    folder: Path,
+    urdf: str,
+    *,
+    duration: float,
+    timestep: float = 0.001,
+    timeline: str = "",
+    plugins: str = "[]",
+    controllers: str | None = None,
 ) -> Path:
+    """`urdf` as arm.urdf and a scenario arm.yaml that runs it fixed to the world 1.5 m up (with `plugins`,
+    and `controllers` written as controllers.yaml and named by the robot's `controllers:`)."""
+    if controllers is not None:
+        (folder / "controllers.yaml").write_text(controllers)
     (folder / "arm.urdf").write_text(urdf)
     path = folder / "arm.yaml"
     path.write_text(
         f"name: arm\nduration: {duration}\nrate: max\nseed: 1\n"
         f"world:\n  physics: {{timestep: {timestep}}}\n"
         "robots:\n  - name: arm\n    description: arm.urdf\n    fixed: true\n    pose: {xyz: [0, 0, 1.5]}\n"
+        f"    plugins: {plugins}\n"
+        + ("    controllers: [controllers.yaml]\n" if controllers is not None else "")
         + (f"timeline:\n{timeline}" if timeline else "")
     )
     return path
 
 
-def main() -> int:
+def run(quick: bool = False) -> tuple[dict[str, Any], str]:
+    """The figures, as a table and a document (bench/__main__.py's `hardware` section)."""
+    from bench.common import table
+
+    seconds = 2.0 if quick else 10.0
+    rows: list[list[Any]] = []
+    doc: dict[str, Any] = {"seconds": seconds, "drift": {}, "targets": {}}
+    with tempfile.TemporaryDirectory() as tmp_name:
+        tmp = Path(tmp_name)
+        ok = True
+        for dt in (0.001, 0.002, 0.004):
+            path = arm_scenario(tmp, arm_urdf(), duration=seconds, timestep=dt)
+            drift, rate = hold_drift(path, seconds)
+            doc["drift"][f"{dt * 1000:g} ms"] = drift
+            ok &= drift <= DRIFT_LIMIT
+            rows.append(
+                [
+                    f"holds its start pose, timestep {dt * 1000:g} ms",
+                    f"{drift:.1e} rad",
+                    f"{drift / DRIFT_LIMIT:.3f}",
+                    f"{rate:,.0f}",
+                ]
+            )
+        doc["targets"][f"drift <= {DRIFT_LIMIT} rad over {seconds:g} s"] = ok
+        path = arm_scenario(tmp, arm_urdf(), duration=seconds, timestep=0.001)
+        drift, _ = hold_drift(path, seconds, load=40.0)
+        doc["drift"]["40 N at the tip"] = drift
+        rows.append(
+            [
+                "  + 40 N pulling down at the tip (an outside load: the servo alone)",
+                f"{drift:.1e} rad",
+                f"{drift / DRIFT_LIMIT:.3f}",
+                "",
+            ]
+        )
+        drift, _ = hold_drift(path, seconds, gravcomp=False)
+        doc["drift"]["servo alone"] = drift
+        rows.append(
+            [
+                "  the servo alone (the weight not routed through the actuators)",
+                f"{drift:.1e} rad",
+                f"{drift / DRIFT_LIMIT:.3f}",
+                "",
+            ]
+        )
+        path = arm_scenario(tmp, arm_urdf(effort=60.0), duration=seconds, timestep=0.001)
+        drift, _ = hold_drift(path, 1.0)
+        doc["drift"]["effort 60 N m"] = drift
+        rows.append(
+            [
+                "  effort limit 60 N·m, below the ~200 N·m its weight takes: falls, as in Gazebo",
+                f"{drift:.2f} rad in 1 s",
+                "",
+                "",
+            ]
+        )
+        path = arm_scenario(tmp, arm_urdf(), duration=2.0, timestep=0.001)
+        peak = step_peak_speed(path, 2.0)
+        doc["step_peak_speed"] = peak
+        doc["targets"]["step command within the velocity limit"] = peak <= VELOCITY_LIMIT * 1.01
+        rows.append(
+            [
+                "2 rad step command on j2: peak speed (limit: URDF velocity pi)",
+                f"{peak:.3f} rad/s",
+                f"{peak / VELOCITY_LIMIT:.3f}",
+                "",
+            ]
+        )
     from runner.sim.hardware import SERVO_STEPS
 
-    print(
-        f"heavy 3-link arm (10/8/5 kg, 0.5 m links), gz_ros2_control position, default gains; "
-        f"kv = {SERVO_STEPS:g} x inertia / timestep"
+    title = (
+        f"hardware: a heavy 3-link arm (10/8/5 kg, 0.5 m links) on gz_ros2_control's position interface, "
+        f"default gains, {seconds:g} s (kv = {SERVO_STEPS:g} x inertia / timestep)"
     )
-    ok = True
-    with tempfile.TemporaryDirectory() as tmp:
-        for dt in (0.001, 0.002, 0.004):
-            path = arm_scenario(Path(tmp), arm_urdf(), duration=10.0, timestep=dt)
-            t0 = time.perf_counter()
-            drift = hold_drift(path, 10.0)
-            wall = time.perf_counter() - t0
-            ratio = drift / DRIFT_LIMIT
-            ok &= ratio <= 1
-            print(
-                f"  dt {dt * 1000:g} ms: drift over 10 s {drift:.2e} rad = {ratio:.3f} x limit "
-                f"({DRIFT_LIMIT} rad); {wall:.1f} s wall"
-            )
-        urdf = arm_urdf()
-        path = arm_scenario(Path(tmp), urdf, duration=2.0, timestep=0.001)
-        peak = step_peak_speed(path, 2.0)
-        ratio = peak / VELOCITY_LIMIT
-        ok &= ratio <= 1.01
-        print(f"  2 rad step on j2: peak speed {peak:.3f} rad/s = {ratio:.3f} x the URDF limit (pi)")
-    return 0 if ok else 1
+    text = table(title, ["case", "measured", "x limit", "steps/s"], rows)
+    return doc, text
+
+
+def main() -> int:
+    doc, text = run("--quick" in sys.argv)
+    print(text)
+    return 0 if all(doc["targets"].values()) else 1
 
 
 def _world(path: Path):  # type: ignore[no-untyped-def]
@@ -135,22 +204,28 @@ def _world(path: Path):  # type: ignore[no-untyped-def]
     return World(plan, MemoryBus()), plan
 
 
-def hold_drift(path: Path, seconds: float) -> float:
+def hold_drift(path: Path, seconds: float, load: float = 0.0, gravcomp: bool = True) -> tuple[float, float]:
     """The largest |q - q_start| of any hinge joint of the scenario's world over `seconds`, sampled every
-    step (the world's own loop, stepped here)."""
+    step (its hardware hooks run before each step, as in the world's loop), with `load` N pulling the last
+    link down; and the steps per second."""
     import mujoco
 
     world, _plan = _world(path)
     m, d = world.model, world.data
+    if not gravcomp:
+        m.body_gravcomp[:] = 0
     hinges = [int(m.jnt_qposadr[j]) for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE]
+    d.xfrc_applied[m.nbody - 1, 2] = -load
     start = d.qpos[hinges].copy()
     worst = 0.0
-    for _ in range(round(seconds / m.opt.timestep)):
+    steps = round(seconds / m.opt.timestep)
+    t0 = time.perf_counter()
+    for _ in range(steps):
         for h in world._before:
             h.fn(0)
         mujoco.mj_step(m, d)
         worst = max(worst, float(np.max(np.abs(d.qpos[hinges] - start))))
-    return worst
+    return worst, steps / (time.perf_counter() - t0)
 
 
 def step_peak_speed(path: Path, seconds: float, joint: str = "j2", step: float = 2.0) -> float:

@@ -148,15 +148,18 @@ def _mimic(spec: mujoco.MjSpec, tr: Transmission, notices: Notices) -> None:
 
 
 def release_hardware(spec: mujoco.MjSpec, hardware: list[HardwareJoint]) -> None:
-    """A joint a plugin drives with an actuator of its own (a diff drive's wheels) is the plugin's: the
-    hardware's actuators on it are disabled, as a claimed interface excludes the others."""
+    """A joint a description's plugin drives with an actuator of its own (a gazebo_ros_diff_drive's
+    wheels, beside their ROS 1 transmissions) is the plugin's, as before there was a hardware layer: the
+    hardware's actuators on it are taken out. Then the links the hardware's servos hold get their weight
+    routed through them (`_gravity`)."""
     ours = {name for hj in hardware for name in hj.actuators.values()}
     for hj in hardware:
         acts = [a for a in spec.actuators if a.trntype == mujoco.mjtTrn.mjTRN_JOINT and a.target == hj.joint]
         if any(a.name not in ours and a.gear[0] != 0 for a in acts):
             for a in acts:
                 if a.name in ours:
-                    a.gear = [0.0] * 6
+                    spec.delete(a)
+            hj.actuators = {}
     _gravity(spec, {hj.joint for hj in hardware})
 
 
