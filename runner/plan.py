@@ -51,6 +51,7 @@ class HardwareJoint(BaseModel):
     velocity_limit: float | None = None  # rad/s or m/s (URDF <limit velocity>)
     initial_position: float | None = None
     initial_velocity: float | None = None
+    initial_effort: float | None = None  # the effort command until a controller sends one
 
 
 class RobotPlan(BaseModel):

@@ -51,6 +51,7 @@ def add_hardware(
             continue
         hj = HardwareJoint(joint=tr.joint, velocity_limit=model.velocity_limits.get(tr.joint))
         hj.initial_position, hj.initial_velocity = _initial(tr, joint, notices)
+        hj.initial_effort = tr.initial.get("effort")
         if tr.mimic is not None and tr.mimic.joint:
             _mimic(spec, tr, notices)
             out.append(hj)  # its start state still counts; no actuator of its own
@@ -160,7 +161,8 @@ def release_hardware(spec: mujoco.MjSpec, hardware: list[HardwareJoint]) -> None
                 if a.name in ours:
                     spec.delete(a)
             hj.actuators = {}
-    _gravity(spec, {hj.joint for hj in hardware})
+    # a PID without an integral term sags in Gazebo as it does here: its links carry their own weight
+    _gravity(spec, {hj.joint for hj in hardware if hj.pid is None or hj.pid.get("i", 0.0) > 0})
 
 
 def _gravity(spec: mujoco.MjSpec, hardware: set[str]) -> None:

@@ -100,6 +100,8 @@ class Hardware:
                         m.actuator_gainprm[a, 0] = gain
                         m.actuator_biasprm[a, 2] = -gain
                     d.ctrl[a] = hj.initial_velocity or 0.0
+                elif mode == "effort":
+                    d.ctrl[a] = hj.initial_effort or 0.0  # gz_system.cpp: joint_effort_cmd = initial_value
         self._limited = limited
         self._target = np.array([d.ctrl[a] for a, *_ in limited])
         self._written = self._target.copy()

@@ -113,7 +113,7 @@ class _Settings:
     update_rate: float = UPDATE_RATE
     hold: bool = True
     pid: dict[str, dict[str, float]] = field(default_factory=dict)  # ROS 1: joint -> {p, i, d, ...}
-    where_gain: tuple[Path | None, int | None] = (None, None)
+    where_hold: tuple[Path | None, int | None] = (None, None)
 
 
 def _walk(doc: Any, out: _Settings, path: tuple[str, ...] = ()) -> None:
@@ -125,8 +125,8 @@ def _walk(doc: Any, out: _Settings, path: tuple[str, ...] = ()) -> None:
             out.update_rate = float(value)
         elif k == "position_proportional_gain" and _number(str(value)) is not None:
             out.position_gain = float(value)
-        elif k == "hold_joints" and isinstance(value, bool):
-            out.hold = value
+        elif k == "hold_joints" and value is False:
+            out.hold = False
         elif k == "pid_gains" and path and path[-1] == "gazebo_ros_control" and isinstance(value, dict):
             for joint, gains in value.items():
                 if isinstance(gains, dict):
@@ -155,6 +155,7 @@ def _settings(root: Any, where: Any, controllers: list[Path]) -> _Settings:
         hold = plugin.find("hold_joints")
         if hold is not None and (hold.text or "").strip().lower() in ("false", "0"):
             out.hold = False
+            out.where_hold = where(hold)
         for p in plugin.findall("parameters"):
             text = (p.text or "").strip()
             if text.endswith((".yaml", ".yml")):
@@ -177,6 +178,13 @@ def read_transmissions(
 ) -> list[Transmission]:
     """The hardware's joints, from `<ros2_control>` blocks, else ROS 1 `<transmission>`s."""
     settings = _settings(root, where, list(controllers or []))
+    if not settings.hold:
+        notices.add(
+            "hold_joints false: Gazebo leaves a joint no controller has claimed free; here the hardware "
+            "holds it until a controller commands it (which interfaces a controller claims is known only to "
+            "it)",
+            *settings.where_hold,
+        )
     out: list[Transmission] = []
     seen: set[str] = set()
     for rc in root.findall("ros2_control"):
