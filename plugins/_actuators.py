@@ -43,6 +43,10 @@ def spec_kind(act: Any) -> str | None:
     return kind(act.gaintype, act.biastype, act.dyntype, act.gainprm[0], act.biasprm)
 
 
+def _kind_of(act: Any) -> str | None:
+    return kind(act.gaintype, act.biastype, act.dyntype, act.gainprm[0], act.biasprm)
+
+
 def claim_actuator(
     spec: mujoco.MjSpec,
     name: str,
@@ -60,6 +64,12 @@ def claim_actuator(
     jname = joint.name
     existing = [a for a in spec.actuators if a.trntype == mujoco.mjtTrn.mjTRN_JOINT and a.target == jname]
     act = next((a for a in existing if spec_kind(a) == mode), None)
+    if act is None:
+        # the hardware's actuator of this kind, disabled until claimed (a joint with position and velocity
+        # command interfaces is held by the position one): claiming the interface enables it
+        act = next((a for a in existing if a.gear[0] == 0 and _kind_of(a) == mode), None)
+        if act is not None:
+            act.gear = [1.0, 0, 0, 0, 0, 0]
     for other in existing:
         if other is not act and other.gear[0] != 0:
             other.gear = [0.0] * 6  # another kind of actuator on this joint would fight ours

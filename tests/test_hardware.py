@@ -216,3 +216,29 @@ def test_a_controller_claims_the_hardware_actuator(tmp_path: Path) -> None:
     assert names == ["arm/j0/position", "arm/j1/position", "arm/j2/position"]
     world.run()
     assert abs(float(d.qpos[m.jnt_qposadr[m.joint("arm/j2").id]]) - 0.5) < 0.01
+
+
+def test_a_joint_with_two_command_interfaces_is_held_by_its_position_one_until_claimed(
+    tmp_path: Path,
+) -> None:
+    """ros2_control lets a controller claim one of a joint's command interfaces: the hardware's velocity
+    actuator waits disabled (its position one holds the joint) and is the one a velocity controller gets."""
+    urdf = arm_urdf().replace(
+        '<joint name="j2"><command_interface name="position"/>',
+        '<joint name="j2"><command_interface name="velocity"/><command_interface name="position"/>',
+    )
+    plugins = "[{type: joint_controller, name: spin, params: {joints: [j2], mode: velocity}}]"
+    timeline = "  - {t: 0.1, topic: arm/spin/command, type: std_msgs/msg/Float64, data: {data: 0.5}}\n"
+    path = arm_scenario(tmp_path, urdf, duration=1.1, plugins=plugins, timeline=timeline)
+    world = World(plan_of(path), MemoryBus())
+    m, d = world.model, world.data
+    gears = {m.actuator(a).name: float(m.actuator_gear[a, 0]) for a in range(m.nu)}
+    assert gears == {
+        "arm/j0/position": 1.0,
+        "arm/j1/position": 1.0,
+        "arm/j2/velocity": 1.0,
+        "arm/j2/position": 0.0,
+    }
+    world.run()
+    dof = m.jnt_dofadr[m.joint("arm/j2").id]
+    assert abs(float(d.qvel[dof]) - 0.5) < 0.01

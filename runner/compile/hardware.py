@@ -70,7 +70,7 @@ def add_hardware(
             )
             hj.loop_gain = 1.0 / timestep
         hj.pid = tr.pid
-        for k, mode in enumerate(tr.interfaces):
+        for mode in tr.interfaces:
             act = spec.add_actuator(
                 name=f"{tr.joint}/{mode}", target=tr.joint, trntype=mujoco.mjtTrn.mjTRN_JOINT
             )
@@ -94,7 +94,7 @@ def add_hardware(
             if lo is not None or hi is not None:
                 act.ctrllimited = True
                 act.ctrlrange = [lo if lo is not None else -1e30, hi if hi is not None else 1e30]
-            if mode == "velocity" and "position" in tr.interfaces[:k]:
+            if mode == "velocity" and "position" in tr.interfaces:
                 act.gear = [0.0] * 6  # two servos would fight: the position one holds until one is claimed
             hj.actuators[mode] = f"{tr.joint}/{mode}"
         out.append(hj)
