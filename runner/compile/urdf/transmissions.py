@@ -197,8 +197,14 @@ def read_transmissions(
             seen.add(tr.joint)
             out.append(tr)
     for tr in _ros1(root, where, notices, settings):
-        if tr.joint in seen:
-            continue  # a <ros2_control> block has it: gz_ros2_control ignores <transmission>
+        if tr.joint in seen:  # gz_ros2_control / gazebo_ros2_control read <ros2_control> only
+            notices.add(
+                f"transmission of joint {tr.joint!r}: a <ros2_control> block has the joint, which Gazebo's "
+                "ROS 2 plugin uses; the ROS 1 transmission is ignored",
+                tr.file,
+                tr.line,
+            )
+            continue
         seen.add(tr.joint)
         out.append(tr)
     mimicked = {j.get("name"): j.find("mimic") for j in root.findall("joint") if j.find("mimic") is not None}
