@@ -137,6 +137,11 @@ def test_a_forked_hardware_plugin_runs_as_its_parent(tmp_path: Path) -> None:
     assert "'franka_ign_ros2_control/IgnitionSystem' is run as gz_ros2_control/GazeboSimSystem" in text
     hw = {h.joint: h for h in plan.robots[0].hardware}
     assert hw["j0"].initial_position == 0.4 and hw["j0"].actuators == {"position": "j0/position"}
+    lines = [p.text for p in plan.robots[0].gazebo if p.kind == "hardware"]
+    assert lines == [
+        "gz_ros2_control: j0 (position), j1 (position), j2 (position); 3 start at their "
+        "initial_value; position loop 10/s"
+    ]
 
 
 def test_a_hardware_plugin_gazebo_cannot_load_is_said_at_its_line(tmp_path: Path) -> None:

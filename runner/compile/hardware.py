@@ -23,7 +23,7 @@ import mujoco
 from runner.compile.urdf import RobotModel
 from runner.compile.urdf.transmissions import Transmission
 from runner.errors import Notices
-from runner.plan import HardwareJoint
+from runner.plan import HardwareJoint, ParityLine
 
 # placeholder servo gains: the world replaces them at start from the inertia each joint moves, unless a
 # controller's build set its own (runner.sim.hardware)
@@ -194,3 +194,29 @@ def _gravity(spec: mujoco.MjSpec, hardware: set[str]) -> None:
             body.gravcomp = 1.0
             for j in path:
                 j.actgravcomp = True
+
+
+_FAMILIES = {"gz": "gz_ros2_control", "classic": "gazebo_ros2_control", "ros1": "gazebo_ros_control"}
+
+
+def summary(model: RobotModel, hardware: list[HardwareJoint]) -> list[ParityLine]:
+    """The robot's hardware in its "as in Gazebo" summary: which system runs which joints, and how."""
+    if not hardware:
+        return []
+    by = {tr.joint: tr for tr in model.transmissions}
+    first = by.get(hardware[0].joint)
+    family = _FAMILIES.get(first.family, "") if first else ""
+    kinds = []
+    for hj in hardware:
+        tr = by.get(hj.joint)
+        how = "/".join(hj.actuators) or ("mimics " + tr.mimic.joint if tr and tr.mimic else "state only")
+        kinds.append(f"{hj.joint} ({how})")
+    starts = sum(hj.initial_position is not None for hj in hardware)
+    text = f"{family}: {', '.join(kinds)}"
+    if starts:
+        text += f"; {starts} start at their initial_value"
+    gains = {hj.loop_gain for hj in hardware if hj.loop_gain is not None}
+    if gains:
+        text += f"; position loop {', '.join(f'{g:g}' for g in sorted(gains))}/s"
+    where = (str(first.file) if first and first.file else None, first.line if first else None)
+    return [ParityLine(kind="hardware", text=text, file=where[0], line=where[1])]

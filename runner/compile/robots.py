@@ -13,7 +13,7 @@ from runner.checks import truth_robots
 from runner.checks.judge import TRUTH_RATE, TRUTH_TOPIC
 from runner.compile.filesize import HINT as SIZE_HINT
 from runner.compile.filesize import too_large
-from runner.compile.hardware import add_hardware, release_hardware
+from runner.compile.hardware import add_hardware, release_hardware, summary
 from runner.compile.packages import PackageMap
 from runner.compile.parity import summarize
 from runner.compile.plugins import build_plugins
@@ -73,7 +73,9 @@ def add_robot(
     hardware, rate = add_hardware(model, notices, sc.world.physics.timestep)
     plugins = build_plugins(sc, robot, i, model, doc, problems)
     release_hardware(model.spec, hardware)
-    parity = summarize(model, plugins, notices.items[before:], f"{sc.name}/{robot.ns}/")
+    parity = summary(model, hardware) + summarize(
+        model, plugins, notices.items[before:], f"{sc.name}/{robot.ns}/"
+    )
     pos = robot.pose.xyz
     frame = world.worldbody.add_frame(pos=list(pos), quat=list(rpy_to_quat(robot.pose.rpy)))
     prefix = f"{robot.ns}/"
