@@ -192,12 +192,15 @@ def test_gains_come_from_the_description_and_the_controllers_file(tmp_path: Path
         '<transmission name="t1"><type>transmission_interface/SimpleTransmission</type>'
         '<joint name="j1"><hardwareInterface>hardware_interface/PositionJointInterface</hardwareInterface>'
         '</joint><actuator name="m1"><mechanicalReduction>50</mechanicalReduction></actuator></transmission>'
+        '<gazebo><plugin name="gazebo_ros_control" filename="libgazebo_ros_control.so">'
+        "<robotSimType>vendor_hw/VendorRobotHWSim</robotSimType></plugin></gazebo>"
         "</robot>"
     )
     controllers = "arm:\n  gazebo_ros_control:\n    pid_gains:\n      j1: {p: 3000.0, i: 0.0, d: 40.0}\n"
     path = arm_scenario(tmp_path, ros1, duration=0.1, controllers=controllers)
     plan, text = compile_with_notices(path)
     assert "mechanicalReduction 50 is not applied" in text
+    assert "robotSimType 'vendor_hw/VendorRobotHWSim' is run as gazebo_ros_control/DefaultRobotHWSim" in text
     world = World(plan, MemoryBus())
     m = world.model
     a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "arm/j1/position")

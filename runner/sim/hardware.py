@@ -91,8 +91,15 @@ class Hardware:
                         m.actuator_biasprm[a, 2] = -damp
                     # hold the start position (hold_joints) until a controller commands it
                     d.ctrl[a] = d.qpos[m.jnt_qposadr[jid]]
-                    if hj.velocity_limit is not None and m.actuator_gear[a, 0] != 0 and hj.pid is None:
-                        gain = float(m.actuator_gainprm[a, 0] / max(-m.actuator_biasprm[a, 2], 1e-12))
+                    damping = -float(m.actuator_biasprm[a, 2])
+                    # a servo without damping (a controller's pure P) is no velocity loop: nothing to clip
+                    if (
+                        hj.velocity_limit is not None
+                        and m.actuator_gear[a, 0] != 0
+                        and hj.pid is None
+                        and damping > 0
+                    ):
+                        gain = float(m.actuator_gainprm[a, 0]) / damping
                         limited.append((a, int(m.jnt_qposadr[jid]), gain, hj.velocity_limit))
                 elif mode == "velocity":
                     if placeholder:

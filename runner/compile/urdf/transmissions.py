@@ -136,7 +136,7 @@ def _walk(doc: Any, out: _Settings, path: tuple[str, ...] = ()) -> None:
             _walk(value, out, (*path, k))
 
 
-def _settings(root: Any, where: Any, controllers: list[Path]) -> _Settings:
+def _settings(root: Any, where: Any, controllers: list[Path], notices: Notices) -> _Settings:
     """The gz_ros2_control plugin's `<position_proportional_gain>`/`<hold_joints>` and its `<parameters>`
     files, with the scenario's controllers files: their gains and the controller manager's update rate."""
     import yaml
@@ -152,6 +152,17 @@ def _settings(root: Any, where: Any, controllers: list[Path]) -> _Settings:
         gain = plugin.find("position_proportional_gain")
         if gain is not None and _number(gain.text) is not None:
             out.position_gain = float(gain.text)
+        sim_type = plugin.find("robotSimType")
+        if sim_type is not None and (sim_type.text or "").strip() not in (
+            "",
+            "gazebo_ros_control/DefaultRobotHWSim",
+        ):
+            # a vendor's RobotHWSim (ROS 1) is its own code: the default one's semantics stand in for it
+            notices.add(
+                f"robotSimType {(sim_type.text or '').strip()!r} is run as "
+                "gazebo_ros_control/DefaultRobotHWSim",
+                *where(sim_type),
+            )
         hold = plugin.find("hold_joints")
         if hold is not None and (hold.text or "").strip().lower() in ("false", "0"):
             out.hold = False
@@ -177,7 +188,7 @@ def read_transmissions(
     root: Any, where: Any, notices: Notices, controllers: list[Path] | None = None
 ) -> list[Transmission]:
     """The hardware's joints, from `<ros2_control>` blocks, else ROS 1 `<transmission>`s."""
-    settings = _settings(root, where, list(controllers or []))
+    settings = _settings(root, where, list(controllers or []), notices)
     if not settings.hold:
         notices.add(
             "hold_joints false: Gazebo leaves a joint no controller has claimed free; here the hardware "
