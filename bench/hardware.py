@@ -153,6 +153,17 @@ def run(quick: bool = False) -> tuple[dict[str, Any], str]:
                 "",
             ]
         )
+        path = arm_scenario(tmp, arm_urdf(effort=None), duration=seconds, timestep=0.001)
+        drift, _ = hold_drift(path, seconds, gravcomp=False)
+        doc["drift"]["servo alone, no effort limit"] = drift
+        rows.append(
+            [
+                "  the servo alone, joints without an effort limit (50x the damping: nothing saturates)",
+                f"{drift:.1e} rad",
+                f"{drift / DRIFT_LIMIT:.3f}",
+                "",
+            ]
+        )
         path = arm_scenario(tmp, arm_urdf(effort=60.0), duration=seconds, timestep=0.001)
         drift, _ = hold_drift(path, 1.0)
         doc["drift"]["effort 60 N m"] = drift
@@ -176,11 +187,12 @@ def run(quick: bool = False) -> tuple[dict[str, Any], str]:
                 "",
             ]
         )
-    from runner.sim.hardware import SERVO_STEPS
+    from runner.sim.hardware import SERVO_STEPS, SERVO_STEPS_UNLIMITED
 
     title = (
         f"hardware: a heavy 3-link arm (10/8/5 kg, 0.5 m links) on gz_ros2_control's position interface, "
-        f"default gains, {seconds:g} s (kv = {SERVO_STEPS:g} x inertia / timestep)"
+        f"default gains, {seconds:g} s (kv = {SERVO_STEPS:g} x inertia / timestep with an effort limit, "
+        f"{SERVO_STEPS_UNLIMITED:g} x without)"
     )
     text = table(title, ["case", "measured", "x limit", "steps/s"], rows)
     return doc, text

@@ -5,11 +5,12 @@ per-step hook that keeps position commands within the joint's velocity limit.
 
 Gains. Gazebo's servo is a velocity constraint (DART): the joint reaches the commanded velocity within one
 step unless that takes more than the effort limit, so an arm holds its pose against gravity with no sag. The
-MuJoCo stand-in is a servo whose damping is `SERVO_STEPS` times the joint's inertia per timestep: with the
-implicitfast integrator that damping is integrated implicitly, so it is stable however high; the position
-servo's stiffness is `loop_gain * kv`, the same velocity loop on the position error (gz_system.cpp write():
-`-position_proportional_gain * update_rate * error`), stable while `loop_gain * dt < 2`. The sag left is
-`torque / kp`: bench/hardware.py measures it.
+MuJoCo stand-in is a servo whose damping is `SERVO_STEPS` times, per timestep, the inertia the joint meets
+with the others free (`1 / (M^-1)_ii` at the start pose): with the implicitfast integrator that damping is
+integrated implicitly; the position servo's stiffness is `loop_gain * kv`, the same velocity loop on the
+position error (gz_system.cpp write(): `-position_proportional_gain * update_rate * error`), stable while
+`loop_gain * dt < 2`. The weight of the links the servos hold goes through them (runner.compile.hardware's
+`_gravity`); the sag left under other loads is `torque / kp`: bench/hardware.py measures both.
 """
 
 from __future__ import annotations
@@ -21,9 +22,12 @@ import numpy as np
 
 from runner.plan import HardwareJoint, RobotPlan
 
-SERVO_STEPS = (
-    1.0  # kv = SERVO_STEPS * inertia / timestep (bench/hardware.py)  # kv = SERVO_STEPS * inertia / timestep
-)
+# kv = SERVO_STEPS * inertia / timestep (bench/hardware.py). With an effort limit, a servo pushed to it
+# overshoots by up to limit * timestep / inertia in a step; past 1 its correction hits the opposite limit and
+# it chatters (measured: 28 rad/s against a 3.14 limit at 10). Without one nothing saturates and the
+# implicit damping is stable however high: 50 leaves 1/50 of the sag.
+SERVO_STEPS = 1.0
+SERVO_STEPS_UNLIMITED = 50.0
 PLACEHOLDER = 1e-9  # runner.compile.hardware's placeholder gains
 
 
@@ -74,11 +78,12 @@ class Hardware:
             mujoco.mj_solveM(m, d, column.reshape(1, -1), unit.reshape(1, -1))
             unit[dof] = 0.0
             inertia = 1.0 / float(column[dof])
-            kv = SERVO_STEPS * inertia / dt
             for mode, name in hj.actuators.items():
                 a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, rp.prefix + name)
                 if a < 0:
                     continue
+                capped = bool(m.actuator_forcelimited[a]) or bool(m.jnt_actfrclimited[jid])
+                kv = (SERVO_STEPS if capped else SERVO_STEPS_UNLIMITED) * inertia / dt
                 placeholder = m.actuator_gainprm[a, 0] == PLACEHOLDER
                 if mode == "position":
                     if placeholder:
