@@ -110,8 +110,16 @@ GRIPPER = """<?xml version="1.0"?>
 """
 
 
-def test_a_mimic_finger_follows_its_twin_and_has_no_actuator(tmp_path: Path) -> None:
-    (tmp_path / "grip.urdf").write_text(GRIPPER)
+@pytest.mark.parametrize("urdf_mimic", [True, False], ids=["urdf-mimic", "ros2_control-param-only"])
+def test_a_mimic_finger_follows_its_twin_and_has_no_actuator(tmp_path: Path, urdf_mimic: bool) -> None:
+    """A URDF `<mimic>` or ign_system's `<param name="mimic">` (with `multiplier`): the follower moves with its
+    twin through an equality and has no actuator of its own, even with a command interface."""
+    urdf = (
+        GRIPPER
+        if urdf_mimic
+        else GRIPPER.replace('<mimic joint="finger_left" multiplier="-1" offset="0"/>', "")
+    )
+    (tmp_path / "grip.urdf").write_text(urdf)
     path = tmp_path / "grip.yaml"
     path.write_text(
         "name: g\nduration: 1.0\nrate: max\nseed: 1\nworld:\n  physics: {timestep: 0.001}\n"

@@ -140,12 +140,9 @@ def _mimic(spec: mujoco.MjSpec, tr: Transmission, notices: Notices) -> None:
     for eq in spec.equalities:
         if eq.type == mujoco.mjtEq.mjEQ_JOINT and eq.name1 == tr.joint:
             return
-    spec.add_equality(
-        type=mujoco.mjtEq.mjEQ_JOINT,
-        name1=tr.joint,
-        name2=mimic.joint,
-        data=[mimic.offset, mimic.multiplier, 0, 0, 0, 0, 0, 0, 0, 0, 0],
-    )
+    data = [0.0] * mujoco.mjNEQDATA
+    data[0], data[1] = mimic.offset, mimic.multiplier  # q1 = offset + multiplier * q2
+    spec.add_equality(type=mujoco.mjtEq.mjEQ_JOINT, name1=tr.joint, name2=mimic.joint, data=data)
 
 
 def release_hardware(spec: mujoco.MjSpec, hardware: list[HardwareJoint]) -> None:
