@@ -258,3 +258,35 @@ def test_a_joint_with_two_command_interfaces_is_held_by_its_position_one_until_c
     world.run()
     dof = m.jnt_dofadr[m.joint("arm/j2").id]
     assert abs(float(d.qvel[dof]) - 0.5) < 0.01
+
+
+def test_mistakes_in_a_ros2_control_block_are_said_at_their_lines_and_the_rest_runs(tmp_path: Path) -> None:
+    urdf = arm_urdf(initial=None).replace(
+        '<joint name="j0"><command_interface name="position"/>',
+        '<joint name="j0"><param name="mimic">nothere</param>'
+        '<command_interface name="position"><param name="min">abc</param></command_interface>'
+        '<state_interface name="position"><param name="initial_value">abc</param></state_interface>',
+    )
+    urdf = urdf.replace(
+        '<joint name="j1"><command_interface name="position"/>',
+        '<joint name="j1"><command_interface name="foo"/><command_interface name="position"/>',
+    )
+    plan, text = compile_with_notices(arm_scenario(tmp_path, urdf, duration=0.2))
+    j0, j1 = (
+        _line(urdf, '<joint name="j0"><param'),
+        _line(urdf, '<joint name="j1"><command_interface name="foo"'),
+    )
+    for said in (
+        f"arm.urdf:{j0}: joint 'j0': position <param name='min'> 'abc' is not a number; ignored",
+        f"arm.urdf:{j0}: joint 'j0': initial_value 'abc' of 'position' is not a number; ignored",
+        f"arm.urdf:{j0}: joint 'j0' mimics 'nothere', which the robot does not have",
+        f"arm.urdf:{j1}: joint 'j1': command interface 'foo' is not one Gazebo's system has",
+    ):
+        assert said in text, text
+    hw = {h.joint: h.actuators for h in plan.robots[0].hardware}
+    assert hw == {
+        "j0": {"position": "j0/position"},
+        "j1": {"position": "j1/position"},
+        "j2": {"position": "j2/position"},
+    }
+    World(plan, MemoryBus()).run()

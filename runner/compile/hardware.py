@@ -52,8 +52,7 @@ def add_hardware(
         hj = HardwareJoint(joint=tr.joint, velocity_limit=model.velocity_limits.get(tr.joint))
         hj.initial_position, hj.initial_velocity = _initial(tr, joint, notices)
         hj.initial_effort = tr.initial.get("effort")
-        if tr.mimic is not None and tr.mimic.joint:
-            _mimic(spec, tr, notices)
+        if tr.mimic is not None and tr.mimic.joint and _mimic(spec, tr, notices):
             out.append(hj)  # its start state still counts; no actuator of its own
             continue
         if any(a.target == tr.joint for a in spec.actuators):
@@ -125,24 +124,28 @@ def _initial(tr: Transmission, joint: mujoco.MjsJoint, notices: Notices) -> tupl
     return pos, vel
 
 
-def _mimic(spec: mujoco.MjSpec, tr: Transmission, notices: Notices) -> None:
+def _mimic(spec: mujoco.MjSpec, tr: Transmission, notices: Notices) -> bool:
     """A mimic joint follows its joint through an equality (MuJoCo's URDF import makes one for `<mimic>`),
-    as gz_system.cpp's write() drives it to `multiplier * position` every update."""
+    as gz_system.cpp's write() drives it to `multiplier * position` every update. False when the joint it
+    names is not there."""
     mimic = tr.mimic
     assert mimic is not None
     if spec.joint(mimic.joint) is None:
+        # ign_system.cpp throws "Mimicked joint ... not found": Gazebo does not load the robot's hardware
         notices.add(
-            f"joint {tr.joint!r} mimics {mimic.joint!r}, which the robot does not have; it moves freely",
+            f"joint {tr.joint!r} mimics {mimic.joint!r}, which the robot does not have (Gazebo's system "
+            "refuses the hardware); it is driven by its own command interfaces",
             tr.file,
             tr.line,
         )
-        return
+        return False
     for eq in spec.equalities:
         if eq.type == mujoco.mjtEq.mjEQ_JOINT and eq.name1 == tr.joint:
-            return
+            return True
     data = [0.0] * mujoco.mjNEQDATA
     data[0], data[1] = mimic.offset, mimic.multiplier  # q1 = offset + multiplier * q2
     spec.add_equality(type=mujoco.mjtEq.mjEQ_JOINT, name1=tr.joint, name2=mimic.joint, data=data)
+    return True
 
 
 def release_hardware(spec: mujoco.MjSpec, hardware: list[HardwareJoint]) -> None:

@@ -310,8 +310,16 @@ def _joint(joint: Any, family: Family, where: Any, notices: Notices, s: _Setting
         if mode in tr.interfaces:
             continue
         tr.interfaces.append(mode)
-        cparams = {p.get("name"): p.text for p in ci.findall("param")}
-        lo, hi = _number(cparams.get("min")), _number(cparams.get("max"))
+        cparams = {p.get("name"): p for p in ci.findall("param")}
+        for key in ("min", "max"):
+            if key in cparams and _number(cparams[key].text) is None:
+                notices.add(
+                    f"joint {jname!r}: {raw} <param name={key!r}> {cparams[key].text!r} is not a number; "
+                    "ignored",
+                    *where(cparams[key]),
+                )
+        lo = _number(cparams["min"].text) if "min" in cparams else None
+        hi = _number(cparams["max"].text) if "max" in cparams else None
         if lo is not None or hi is not None:
             tr.limits[mode] = (lo, hi)
     for si in joint.findall("state_interface"):
