@@ -12,6 +12,11 @@ import numpy as np
 import pytest
 
 from bench.hardware import arm_scenario, arm_urdf, hold_drift, step_peak_speed
+from plugins._actuators import spec_velocity_limit, velocity_limit
+from runner.compile.hardware import add_hardware
+from runner.compile.packages import PackageMap
+from runner.compile.urdf import urdf_to_model
+from runner.errors import Notices
 from runner.sim.world import World
 from runner.wire.transport import MemoryBus
 from tests.helpers import compile_with_notices, messages, plan_of
@@ -255,6 +260,9 @@ def test_a_joint_with_two_command_interfaces_is_held_by_its_position_one_until_c
         "arm/j2/velocity": 1.0,
         "arm/j2/position": 0.0,
     }
+    # the URDF velocity limit, as a drive reads it (plugins/_actuators.py)
+    assert velocity_limit(m, m.joint("arm/j2").id) == pytest.approx(math.pi)
+    assert velocity_limit(m, m.joint("arm/j1").id) is None  # a position interface only: not carried
     world.run()
     dof = m.jnt_dofadr[m.joint("arm/j2").id]
     assert abs(float(d.qvel[dof]) - 0.5) < 0.01
@@ -290,3 +298,13 @@ def test_mistakes_in_a_ros2_control_block_are_said_at_their_lines_and_the_rest_r
         "j2": {"position": "j2/position"},
     }
     World(plan, MemoryBus()).run()
+
+
+def test_a_drive_reads_the_velocity_limit_from_the_hardware_at_build_time(tmp_path: Path) -> None:
+    """A controller's `build` sees the robot's MjSpec only: the hardware's velocity actuator carries the URDF
+    velocity limit there (its control range), for `spec_velocity_limit`."""
+    urdf = arm_urdf(interface="velocity", velocity=2.5)
+    model = urdf_to_model(urdf, None, PackageMap.for_scenario(tmp_path, {}))
+    add_hardware(model, Notices(), 0.001)
+    assert spec_velocity_limit(model.spec, "j1") == 2.5
+    assert spec_velocity_limit(model.spec, "l1") is None
