@@ -218,8 +218,8 @@ def _world(path: Path):  # type: ignore[no-untyped-def]
 
 def hold_drift(path: Path, seconds: float, load: float = 0.0, gravcomp: bool = True) -> tuple[float, float]:
     """The largest |q - q_start| of any hinge joint of the scenario's world over `seconds`, sampled every
-    step (its hardware hooks run before each step, as in the world's loop), with `load` N pulling the last
-    link down; and the steps per second."""
+    step (its hardware's boundary runs before each step, as in the world's loop at its busiest), with `load`
+    N pulling the last link down; and the steps per second."""
     import mujoco
 
     world, _plan = _world(path)
@@ -235,6 +235,7 @@ def hold_drift(path: Path, seconds: float, load: float = 0.0, gravcomp: bool = T
     for _ in range(steps):
         for h in world._before:
             h.fn(0)
+        world.hardware.boundary(0)
         mujoco.mj_step(m, d)
         worst = max(worst, float(np.max(np.abs(d.qpos[hinges] - start))))
     return worst, steps / (time.perf_counter() - t0)
@@ -254,6 +255,7 @@ def step_peak_speed(path: Path, seconds: float, joint: str = "j2", step: float =
     for _ in range(round(seconds / m.opt.timestep)):
         for h in world._before:
             h.fn(0)
+        world.hardware.boundary(0)
         mujoco.mj_step(m, d)
         peak = max(peak, abs(float(d.qvel[m.jnt_dofadr[jid]])))
     return peak

@@ -85,7 +85,22 @@ def test_the_effort_limit_bounds_what_holds_the_arm(tmp_path: Path) -> None:
 
 
 def test_a_step_command_stays_within_the_velocity_limit(tmp_path: Path) -> None:
-    """DART clips a servo's velocity setpoint to the joint's URDF velocity limit (π here)."""
+    """DART clips a servo's velocity setpoint to the joint's URDF velocity limit (π here): a 2 rad step
+    sent to a controller that claims the position interface is followed at π rad/s, no faster (in the
+    world's own loop), and reaches its target."""
+    plugins = (
+        "[{type: joint_controller, name: ctl, params: {joints: [j2], mode: position}},"
+        " {type: joint_states, params: {rate: 500}}]"
+    )
+    timeline = "  - {t: 0.1, topic: arm/ctl/command, type: std_msgs/msg/Float64, data: {data: 2.0}}\n"
+    path = arm_scenario(tmp_path, arm_urdf(), duration=1.5, plugins=plugins, timeline=timeline)
+    bus = MemoryBus()
+    World(plan_of(path), bus).run()
+    states = [msg for _t, msg in messages(bus, "arm/joint_states")]
+    speed = max(abs(float(m.velocity[2])) for m in states)
+    assert 0.9 * math.pi < speed <= 1.02 * math.pi, speed
+    assert abs(float(states[-1].position[2]) - 2.0) < 0.01
+    # and with the bench's own loop, stepping the hardware every step
     peak = step_peak_speed(arm_scenario(tmp_path, arm_urdf(), duration=1.0), 1.0)
     assert 0.9 * math.pi < peak <= 1.02 * math.pi, peak
 

@@ -1,7 +1,7 @@
 """The robots' ros2_control / ros_control hardware at the start of a run, before any plugin's setup
 (runner.compile.hardware built its actuators): the joints put at their `initial_value`s, the servo gains set
-from the inertia each joint moves, each servo holding the start state until a controller commands it, and a
-per-step hook that keeps position commands within the joint's velocity limit.
+from the inertia each joint moves, each servo holding the start state until a controller commands it; and at
+each boundary, position commands kept within the joint's velocity limit (every step while one is held back).
 
 Gains. Gazebo's servo is a velocity constraint (DART): the joint reaches the commanded velocity within one
 step unless that takes more than the effort limit, so an arm holds its pose against gravity with no sag. The
@@ -14,8 +14,6 @@ position error (gz_system.cpp write(): `-position_proportional_gain * update_rat
 """
 
 from __future__ import annotations
-
-from collections.abc import Callable
 
 import mujoco
 import numpy as np
@@ -37,6 +35,7 @@ class Hardware:
         self._limited: list[tuple[int, int, float, float]] = []  # (actuator, qpos adr, loop gain, vmax)
         self._target: np.ndarray = np.zeros(0)
         self._written: np.ndarray = np.zeros(0)
+        self.active = False  # a position setpoint is held back by a velocity limit
         joints: list[tuple[RobotPlan, HardwareJoint, int]] = []
         for rp in robots:
             for hj in rp.hardware:
@@ -115,24 +114,30 @@ class Hardware:
                 elif mode == "effort":
                     d.ctrl[a] = hj.initial_effort or 0.0  # gz_system.cpp: joint_effort_cmd = initial_value
         self._limited = limited
-        self._target = np.array([d.ctrl[a] for a, *_ in limited])
+        self._acts = np.array([a for a, *_ in limited], dtype=int)
+        self._adr = np.array([adr for _a, adr, _g, _v in limited], dtype=int)
+        self._window = np.array([v / g if g > 0 else np.inf for _a, _adr, g, v in limited])
+        self._target = d.ctrl[self._acts].copy()
         self._written = self._target.copy()
 
-    def hooks(self) -> list[tuple[Callable[[int], None], int]]:
-        """(fn, period ns) run before the physics step: the velocity limit of position commands."""
-        return [(self._limit_velocity, 0)] if self._limited else []
+    def boundary(self, _now: int) -> None:
+        """At every boundary, after the controllers' hooks (controls change only there): DART clips a servo's
+        velocity setpoint to the joint's velocity limits, so a position servo's setpoint is kept within
+        `vmax / loop_gain` of the joint and never asks for more. A control that differs from what this wrote
+        last is a controller's new command. While a setpoint is held back, every step is a boundary."""
+        if not self._limited:
+            return
+        d, acts = self.d, self._acts
+        c = d.ctrl[acts]
+        new = c != self._written
+        self._target[new] = c[new]
+        q = d.qpos[self._adr]
+        err = self._target - q
+        sp = q + np.clip(err, -self._window, self._window)
+        d.ctrl[acts] = sp
+        self._written = d.ctrl[acts]  # as stored (a control range may have clamped it)
+        self.active = bool(np.any(np.abs(err) > self._window))
 
-    def _limit_velocity(self, _now: int) -> None:
-        """DART clips a servo's velocity setpoint to the joint's velocity limits: the position servo's
-        setpoint is moved no further from the joint than `vmax / loop_gain`, so it never asks for more. A
-        control that differs from what this wrote last is a controller's new command."""
-        d = self.d
-        for k, (a, adr, gain, vmax) in enumerate(self._limited):
-            c = d.ctrl[a]
-            if c != self._written[k]:
-                self._target[k] = c
-            q = d.qpos[adr]
-            step = vmax / gain if gain > 0 else np.inf
-            sp = q + min(max(self._target[k] - q, -step), step)
-            d.ctrl[a] = sp
-            self._written[k] = sp
+    def next_ns(self, now: int) -> int:
+        """When the next boundary is needed: the next step while a setpoint is held back, else none."""
+        return now + 1 if self.active else 1 << 62

@@ -112,8 +112,6 @@ class World(PubSub):
         self.remote_renders: dict[int, RemoteRender] = {}  # plugin index -> its renderer link
         self.render_plugins: dict[int, Plugin] = {}  # in a renderer: plugin index -> plugin
         self._load_plugins(remote=role == "world" and plan.renderers == "process" and session is not None)
-        for fn, period in self.hardware.hooks():  # last: it sees the controls the controllers wrote
-            self._before.append(Hook(fn, period))
         if role == "world" and plan.foxglove.scene:
             from runner.sim.scene import SceneFeed
 
@@ -220,6 +218,7 @@ class World(PubSub):
             if now >= h.next_ns:
                 h.fn(now)
                 h.next_ns = next_due(h, now)
+        self.hardware.boundary(now)  # last: it sees the controls the controllers wrote
         clock = self._clock_hook
         if now >= clock.next_ns:
             clock.fn(now)
@@ -310,7 +309,7 @@ class World(PubSub):
             nxt = min(nxt, self._timeline[self._timeline_i][0])
         if self._events is not None:
             nxt = min(nxt, self._events.next_ns)
-        return nxt
+        return min(nxt, self.hardware.next_ns(self.now_ns))
 
     def run(
         self,
