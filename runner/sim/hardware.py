@@ -135,7 +135,7 @@ class Hardware:
         err = self._target - q
         sp = q + np.clip(err, -self._window, self._window)
         d.ctrl[acts] = sp
-        self._written = d.ctrl[acts]  # as stored (a control range may have clamped it)
+        self._written = sp
         self.active = bool(np.any(np.abs(err) > self._window))
 
     def next_ns(self, now: int) -> int:
