@@ -41,6 +41,10 @@ Sections (in order):
   a 5 M-triangle mesh (a sphere, random triangles: binary STL; a sphere as OBJ), each `scenario validate` in
   its own process: wall time and peak memory against 60 s and 2 GB, and whether it validated or was
   refused with a located error.
+- hardware: a heavy 3-link arm on gz_ros2_control's position interface (bench/hardware.py): the drift from
+  its initial values over 10 s at three timesteps (target: <= 0.005 rad), the sag under an outside load and
+  with the servo alone, an effort limit below its weight, the peak speed of a step command against the URDF
+  velocity limit, and the world's loop with and without velocity limits.
 
 Results go to bench/results/<section>.json (with machine info); `--readme` also writes the tables into
 README.md between the `bench:begin`/`bench:end` markers.
@@ -101,6 +105,7 @@ SECTIONS = (
     "actors",
     "ray",
     "limits",
+    "hardware",
 )
 
 
@@ -803,6 +808,12 @@ def limits(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     return bl.run(args.quick)
 
 
+def hardware(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
+    from bench import hardware as bh
+
+    return bh.run(args.quick)
+
+
 RUNNERS = {
     "two_robots": two_robots,
     "scaling": scaling,
@@ -817,6 +828,7 @@ RUNNERS = {
     "actors": actors,
     "ray": ray,
     "limits": limits,
+    "hardware": hardware,
 }
 
 

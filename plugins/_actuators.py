@@ -43,6 +43,10 @@ def spec_kind(act: Any) -> str | None:
     return kind(act.gaintype, act.biastype, act.dyntype, act.gainprm[0], act.biasprm)
 
 
+def _kind_of(act: Any) -> str | None:
+    return kind(act.gaintype, act.biastype, act.dyntype, act.gainprm[0], act.biasprm)
+
+
 def claim_actuator(
     spec: mujoco.MjSpec,
     name: str,
@@ -60,6 +64,12 @@ def claim_actuator(
     jname = joint.name
     existing = [a for a in spec.actuators if a.trntype == mujoco.mjtTrn.mjTRN_JOINT and a.target == jname]
     act = next((a for a in existing if spec_kind(a) == mode), None)
+    if act is None:
+        # the hardware's actuator of this kind, disabled until claimed (a joint with position and velocity
+        # command interfaces is held by the position one): claiming the interface enables it
+        act = next((a for a in existing if a.gear[0] == 0 and _kind_of(a) == mode), None)
+        if act is not None:
+            act.gear = [1.0, 0, 0, 0, 0, 0]
     for other in existing:
         if other is not act and other.gear[0] != 0:
             other.gear = [0.0] * 6  # another kind of actuator on this joint would fight ours
@@ -135,3 +145,29 @@ def auto_gains(
         gain = inertia / (VELOCITY_STEPS * dt)
         m.actuator_gainprm[a, 0] = gain
         m.actuator_biasprm[a, 2] = -gain
+
+
+def velocity_limit(m: mujoco.MjModel, jid: int) -> float | None:
+    """The joint's URDF `<limit velocity>` as the hardware carries it (runner.compile.hardware: the control
+    range of its velocity actuator, enabled or not), at run time; None when it has none."""
+    for a in range(m.nu):
+        if int(m.actuator_trntype[a]) != int(mujoco.mjtTrn.mjTRN_JOINT) or int(m.actuator_trnid[a, 0]) != jid:
+            continue
+        bias = m.actuator_biasprm[a]
+        velocity = (
+            int(m.actuator_biastype[a]) == int(mujoco.mjtBias.mjBIAS_AFFINE) and bias[1] == 0 and bias[2] != 0
+        )
+        if velocity and m.actuator_ctrllimited[a]:
+            return float(min(-m.actuator_ctrlrange[a, 0], m.actuator_ctrlrange[a, 1]))
+    return None
+
+
+def spec_velocity_limit(spec: mujoco.MjSpec, joint: str) -> float | None:
+    """`velocity_limit` at build time, from the robot's MjSpec."""
+    for a in spec.actuators:
+        if a.trntype != mujoco.mjtTrn.mjTRN_JOINT or a.target != joint:
+            continue
+        velocity = a.biastype == mujoco.mjtBias.mjBIAS_AFFINE and a.biasprm[1] == 0 and a.biasprm[2] != 0
+        if velocity and a.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE:
+            return float(min(-a.ctrlrange[0], a.ctrlrange[1]))
+    return None

@@ -40,6 +40,20 @@ class ParityLine(BaseModel):
     line: int | None = None
 
 
+class HardwareJoint(BaseModel):
+    """A joint of the robot's ros2_control / ros_control hardware, as the world sets it up before any plugin:
+    start state, servo gains from the inertia it moves, velocity limit (runner.sim.hardware)."""
+
+    joint: str  # un-prefixed
+    actuators: dict[str, str] = {}  # command interface -> actuator name (un-prefixed)
+    loop_gain: float | None = None  # position: 1/s from error to velocity setpoint; None: Gazebo sets it
+    pid: dict[str, float] | None = None  # position: {p, i, d} given by the description / controllers file
+    velocity_limit: float | None = None  # rad/s or m/s (URDF <limit velocity>)
+    initial_position: float | None = None
+    initial_velocity: float | None = None
+    initial_effort: float | None = None  # the effort command until a controller sends one
+
+
 class RobotPlan(BaseModel):
     name: str
     namespace: str
@@ -55,6 +69,8 @@ class RobotPlan(BaseModel):
     # The description's root link is `world` (it welds the robot): `root` (its first child) in that link's
     # frame, x y z qw qx qy qz. The link is the TF frame `<ns>/world` at the robot's pose.
     world_origin: list[float] | None = None
+    hardware: list[HardwareJoint] = []  # <ros2_control> / <transmission> joints
+    hardware_rate: float = 100.0  # the controller manager's update rate (Hz)
 
 
 class TimelinePlan(BaseModel):

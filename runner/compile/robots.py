@@ -1,6 +1,6 @@
 """A robot's description into the world: the URDF or xacro file found and read (`runner.compile.urdf`),
-its plugins built, `<transmission>`s given actuators, its Gazebo parity summed up, and the model attached
-under the robot's namespace at its pose."""
+its hardware (`<ros2_control>` / `<transmission>`) given actuators, its plugins built, its Gazebo parity
+summed up, and the model attached under the robot's namespace at its pose."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ from runner.checks import truth_robots
 from runner.checks.judge import TRUTH_RATE, TRUTH_TOPIC
 from runner.compile.filesize import HINT as SIZE_HINT
 from runner.compile.filesize import too_large
+from runner.compile.hardware import add_hardware, release_hardware, summary
 from runner.compile.packages import PackageMap
 from runner.compile.parity import summarize
 from runner.compile.plugins import build_plugins
@@ -68,11 +69,15 @@ def add_robot(
     attached to `world` under `<ns>/` at its pose."""
     before = len(notices)
     model = robot_model(robot, i, doc, packages, notices, sc.world.physics.timestep)
+    # the hardware first: a controller's build claims the actuators it made (plugins/_actuators.py)
+    hardware, rate = add_hardware(model, notices, sc.world.physics.timestep)
     plugins = build_plugins(sc, robot, i, model, doc, problems)
-    add_transmissions(model, notices)
+    release_hardware(model.spec, hardware)
     if model.world is not None:
         _welded_by_description(model, robot, i, doc, notices)
-    parity = summarize(model, plugins, notices.items[before:], f"{sc.name}/{robot.ns}/")
+    parity = summary(model, hardware) + summarize(
+        model, plugins, notices.items[before:], f"{sc.name}/{robot.ns}/"
+    )
     pos = robot.pose.xyz
     frame = world.worldbody.add_frame(pos=list(pos), quat=list(rpy_to_quat(robot.pose.rpy)))
     prefix = f"{robot.ns}/"
@@ -95,6 +100,8 @@ def add_robot(
         urdf=model.urdf,
         gazebo=parity,
         world_origin=model.world.origin if model.world is not None else None,
+        hardware=hardware,
+        hardware_rate=rate,
     )
 
 
@@ -226,33 +233,3 @@ def _xacro_str(v: Any) -> str:
     if isinstance(v, bool):
         return "true" if v else "false"
     return str(v)
-
-
-def add_transmissions(model: RobotModel, notices: Notices) -> None:
-    """`<transmission>` joints get an actuator, unless a plugin already drives them (a diff_drive's
-    wheels, a joint_controller's lift). Velocity -> velocity servo, position -> position servo,
-    effort -> motor; the mechanical reduction is the gear."""
-    spec = model.spec
-    driven = {a.target for a in spec.actuators}
-    for tr in model.transmissions:
-        joint = spec.joint(tr.joint)
-        if joint is None:
-            notices.add(f"a transmission names joint {tr.joint!r}, which the robot does not have")
-            continue
-        if tr.joint in driven:
-            continue
-        act = spec.add_actuator(
-            name=f"{tr.joint}/{tr.interface}", target=tr.joint, trntype=mujoco.mjtTrn.mjTRN_JOINT
-        )
-        if tr.interface == "velocity":
-            act.set_to_velocity(kv=1.0)
-        elif tr.interface == "position":
-            act.set_to_position(kp=100.0, kv=10.0)
-        else:
-            act.set_to_motor()
-        act.gear = [tr.reduction, 0, 0, 0, 0, 0]
-        frc = list(joint.actfrcrange)
-        if frc[1] > frc[0]:
-            act.forcelimited = True
-            act.forcerange = frc
-        driven.add(tr.joint)

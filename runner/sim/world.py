@@ -38,6 +38,7 @@ from runner.plan import RunPlan
 from runner.plugin import Plugin, RobotHandle, RuntimeContext, overrides
 from runner.plugin.registry import load
 from runner.sim.contacts import ContactWatch
+from runner.sim.hardware import Hardware
 from runner.sim.links import Lockstep, RemoteRender
 from runner.sim.pubsub import PubSub
 from runner.sim.schedule import Hook, next_due, sleep_until
@@ -99,6 +100,8 @@ class World(PubSub):
         self._init_pubsub()
         self._lockstep: Lockstep | None = None
         self.robots = [RobotHandle(self.model, r) for r in plan.robots]
+        # the hardware's start state and gains come before any plugin (a controller reads its start there)
+        self.hardware = Hardware(self.model, self.data, plan.robots)
         self.plugins: list[Plugin] = []
         self._plugin_index: dict[int, Plugin] = {}  # by place in the plan (events change their parameters)
         self._hooks_of: dict[int, list[Hook]] = {}
@@ -215,6 +218,7 @@ class World(PubSub):
             if now >= h.next_ns:
                 h.fn(now)
                 h.next_ns = next_due(h, now)
+        self.hardware.boundary(now)  # last: it sees the controls the controllers wrote
         clock = self._clock_hook
         if now >= clock.next_ns:
             clock.fn(now)
@@ -305,7 +309,7 @@ class World(PubSub):
             nxt = min(nxt, self._timeline[self._timeline_i][0])
         if self._events is not None:
             nxt = min(nxt, self._events.next_ns)
-        return nxt
+        return min(nxt, self.hardware.next_ns(self.now_ns))
 
     def run(
         self,

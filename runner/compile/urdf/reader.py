@@ -21,7 +21,7 @@ from runner.compile.urdf.checks import DescriptionError, check_numbers, check_st
 from runner.compile.urdf.inertia import repair_inertias, weigh_massless_links
 from runner.compile.urdf.link_props import apply_link_props, self_collision
 from runner.compile.urdf.mesh_files import rewrite_mesh
-from runner.compile.urdf.transmissions import Transmission, read_transmissions
+from runner.compile.urdf.transmissions import Transmission, read_transmissions, velocity_limits
 from runner.compile.urdf.world_link import WorldLink, world_root
 from runner.errors import Notices
 from runner.plan import ParityLine
@@ -43,6 +43,7 @@ class RobotModel:
     adjusted: list[ParityLine] = field(default_factory=list)  # what was changed or left out to load it
     self_collision: list[str] = field(default_factory=list)  # links that collide with the robot's others
     world: WorldLink | None = None  # the description's root link is `world`: it welds the robot (`root`)
+    velocity_limits: dict[str, float] = field(default_factory=dict)  # joint -> URDF <limit velocity>
 
 
 def urdf_to_model(
@@ -86,7 +87,8 @@ def urdf_to_model(
         notices=notices,
         controllers=controllers,
     )
-    transmissions = read_transmissions(root, where, notices)
+    transmissions = read_transmissions(root, where, notices, controllers)
+    vlimits = velocity_limits(root)
     spec = _load(root, where, file, shell)
     apply_link_props(spec, gazebo, timestep)
     # A root link named `world` is MuJoCo's world body: what hangs from it is welded (or jointed) to the
@@ -101,7 +103,9 @@ def urdf_to_model(
     joints = [j.name for j in spec.joints if j.name and j.name != "root"]
     for message, (src, line) in gazebo.dropped:
         adjusted.append(ParityLine(kind="dropped", text=message, file=str(src) if src else None, line=line))
-    return RobotModel(spec, root_link, urdf, links, joints, gazebo, transmissions, adjusted, collide, world)
+    return RobotModel(
+        spec, root_link, urdf, links, joints, gazebo, transmissions, adjusted, collide, world, vlimits
+    )
 
 
 def _parse(urdf: str, file: Path | None, expanded: bool, where: Any) -> Any:
