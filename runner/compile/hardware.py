@@ -179,6 +179,21 @@ def _gravity(spec: mujoco.MjSpec, hardware: set[str]) -> None:
         and a.gear[0] != 0
         and a.biastype == mujoco.mjtBias.mjBIAS_AFFINE
     }
+    # a mimic joint (a joint equality on a held leader) is held by its leader's servo through the equality,
+    # as Gazebo's mimic constraint holds it: a gripper's twin finger must not load the wrist it hangs from
+    # (its 50 g sagged a light wrist 0.023 rad, the servo alone being soft against loads; see _servo)
+    followers = [
+        (e.name1, e.name2)
+        for e in spec.equalities
+        if e.type == mujoco.mjtEq.mjEQ_JOINT and e.name1 and e.name2
+    ]
+    grew = True
+    while grew:
+        grew = False
+        for follower, leader in followers:
+            if leader in held and follower not in held:
+                held.add(follower)
+                grew = True
     for body in spec.bodies:
         path, ok, b = [], True, body
         while b is not None and b.name != "world" and ok:
