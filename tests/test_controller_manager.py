@@ -450,3 +450,46 @@ def test_a_ros1_pid_position_controller_is_driven_over_zenoh(tmp_path: Path) -> 
         runner.communicate(timeout=30)
     commands = [m for topic, _, _, m in read_mcap(mcap) if topic == "cm/r1/elbow_controller/command"]
     assert commands and commands[0].data == 0.6
+
+
+SENSORS = """
+controller_manager:
+  ros__parameters:
+    update_rate: 50
+    arm_controller: {type: position_controllers/JointGroupPositionController}
+    imu_broadcaster: {type: imu_sensor_broadcaster/IMUSensorBroadcaster}
+    ft_broadcaster: {type: force_torque_sensor_broadcaster/ForceTorqueSensorBroadcaster}
+arm_controller:
+  ros__parameters: {joints: [shoulder, elbow]}
+imu_broadcaster:
+  ros__parameters: {sensor_name: forearm_imu, frame_id: fore}
+ft_broadcaster:
+  ros__parameters: {sensor_name: elbow_ft, frame_id: fore}
+"""
+GAZEBO_SENSORS = """
+  <gazebo reference="fore"><sensor name="forearm_imu" type="imu"><update_rate>50</update_rate></sensor></gazebo>
+  <gazebo reference="elbow"><sensor name="elbow_ft" type="force_torque"><update_rate>50</update_rate></sensor></gazebo>
+"""
+
+
+@pytest.mark.timeout(60)
+def test_imu_and_force_torque_broadcasters_publish_their_sensors(tmp_path: Path) -> None:
+    """imu_sensor_broadcaster publishes `<name>/imu` from the IMU its sensor_name names, and
+    force_torque_sensor_broadcaster `<name>/wrench` from the force/torque sensor at the elbow: the held
+    forearm (0.3 kg, its centre 0.1 m out) weighs 2.94 N and pulls 0.294 N·m about the elbow."""
+    path = _write(tmp_path, {"control.yaml": SENSORS}, duration=1.0)
+    (tmp_path / "arm.urdf").write_text(
+        (tmp_path / "arm.urdf").read_text().replace("</robot>", GAZEBO_SENSORS + "</robot>")
+    )
+    plugins, said = _plugins(path)
+    assert _topics(plugins["imu_broadcaster"]) == ["imu_broadcaster/imu"], said
+    assert _topics(plugins["ft_broadcaster"]) == ["ft_broadcaster/wrench"], said
+    _, bus = simulate(path)
+    imu = messages(bus, "r1/imu_broadcaster/imu")
+    assert 49 <= len(imu) <= 51 and imu[-1][1].header.frame_id == "r1/fore"
+    assert abs(imu[-1][1].linear_acceleration.z - 9.81) < 0.2  # held still: the accelerometer reads g
+    wrench = messages(bus, "r1/ft_broadcaster/wrench")
+    assert 49 <= len(wrench) <= 51 and wrench[-1][1].header.frame_id == "r1/fore"
+    w = wrench[-1][1].wrench
+    assert abs(abs(w.force.z) - 0.3 * 9.81) < 0.1, w
+    assert abs(abs(w.torque.y) - 0.3 * 9.81 * 0.1) < 0.02, w
