@@ -147,6 +147,7 @@ WILDCARD_PATHS = """
 robot1/*:
   ros__parameters:
     update_rate: 200
+    publish_frequency: 30.0
 /**/arm_controller:
   ros__parameters: {joints: [shoulder, elbow], interface_name: position}
 """
@@ -194,6 +195,8 @@ def test_each_controllers_file_layout_yields_its_controllers_at_their_lines(
     path = _write(tmp_path, {"control.yaml": text})
     plugins, said = _plugins(path)
     assert "yields no controller" not in said, said
+    # a wildcard node's parameters go to every node: not said as unknown to each controller's type
+    assert "is not one of its parameters" not in said, said
     assert set(plugins) == {broadcaster, "arm_controller"}, said
     arm, js = plugins["arm_controller"], plugins[broadcaster]
     assert arm.type == "joint_controller" and arm.params["joints"] == ["shoulder", "elbow"]  # type: ignore[attr-defined]
@@ -493,3 +496,34 @@ def test_imu_and_force_torque_broadcasters_publish_their_sensors(tmp_path: Path)
     w = wrench[-1][1].wrench
     assert abs(abs(w.force.z) - 0.3 * 9.81) < 0.1, w
     assert abs(abs(w.torque.y) - 0.3 * 9.81 * 0.1) < 0.02, w
+
+
+@pytest.mark.timeout(60)
+def test_several_files_are_read_together_the_later_value_winning(tmp_path: Path) -> None:
+    """The description's `<parameters>` file lists the controllers; the scenario's `controllers:` file (what
+    the launch's spawner loads) gives one of them its parameters and overrides another's, as a later
+    parameter file does."""
+    description = """
+    controller_manager:
+      ros__parameters:
+        update_rate: 100
+        joint_state_broadcaster: {type: joint_state_broadcaster/JointStateBroadcaster}
+        arm_controller: {type: forward_command_controller/ForwardCommandController}
+    arm_controller:
+      ros__parameters: {joints: [shoulder, elbow], interface_name: position}
+    """
+    launch = """
+    /**:
+      controller_manager:
+        ros__parameters:
+          update_rate: 25
+      arm_controller:
+        ros__parameters: {interface_name: velocity}
+    """
+    path = _write(tmp_path, {"control.yaml": description, "launch.yaml": launch}, controllers="[launch.yaml]")
+    plugins, said = _plugins(path)
+    assert set(plugins) == {"joint_state_broadcaster", "arm_controller"}, said
+    assert plugins["arm_controller"].params["mode"] == "velocity"  # type: ignore[attr-defined]
+    assert plugins["arm_controller"].params["joints"] == ["shoulder", "elbow"]  # type: ignore[attr-defined]
+    assert plugins["joint_state_broadcaster"].params["rate"] == 25  # type: ignore[attr-defined]
+    assert "yields no controller" not in said and "no controller is loaded" not in said, said

@@ -241,12 +241,13 @@ def _ros2_specs(g: ReaderBase, files: list[_File], manager: str) -> tuple[list[C
             _merge(own.setdefault(n.name, Block()), _copy(n.params))
             first.setdefault(n.name, n)
     cm = _merge(_copy(shared), own.get(manager, Block()))
+    cm.inherited = {k for k in shared if k not in own.get(manager, Block())}
     cm_node = first.get(manager)
     rate = _manager_rate(g, cm, cm_node)
     listed = _manager_entries(g, cm, nodes, manager)
     used: set[Path] = set()
     specs: list[ControllerSpec] = []
-    for name, n in first.items():
+    for name in first:
         if name == manager:
             continue
         kind = own[name].get("type")
@@ -255,16 +256,20 @@ def _ros2_specs(g: ReaderBase, files: list[_File], manager: str) -> tuple[list[C
                 g.notices.add(
                     f"controller {name!r} is listed as {listed[name][0]} but its parameters say type {kind}: "
                     "the spawner sets the type from its parameters, and so do we",
-                    n.file,
-                    n.params.lines.get("type", n.line),
+                    *listed[name][1:],
                 )
-            listed[name] = (kind, n.file, n.params.lines.get("type", n.line))
+            typed = [m for m in nodes if m.name == name and "type" in m.params][-1]  # the last one wins
+            listed[name] = (kind, typed.file, typed.params.lines.get("type", typed.line))
     for name, (kind, file, line) in listed.items():
-        params = _merge(_copy(shared), own.get(name, Block()))
+        mine = own.get(name, Block())
+        params = _merge(_copy(shared), mine)
+        params.inherited = {k for k in shared if k not in mine}  # a wildcard block's: not checked per type
         own_rate = params.get("update_rate")
         spec_rate = rate
         if isinstance(own_rate, (int, float)) and 0 < own_rate < rate:
-            spec_rate = float(own_rate)  # controller_manager.cpp: a controller may run slower, never faster
+            # controller_manager.cpp:1669 (Jazzy): a controller may run slower than the manager, not faster
+            # (:3433 runs one asking more at the manager's rate)
+            spec_rate = float(own_rate)
         specs.append(ControllerSpec(name, kind, params, file, line, False, spec_rate))
         if file:
             used.add(file)
@@ -279,8 +284,8 @@ def _ros2_specs(g: ReaderBase, files: list[_File], manager: str) -> tuple[list[C
                 n.line,
                 hint=f"list it under {manager}: ros__parameters: {name}: {{type: ...}}, or give it a `type:`",
             )
-    if cm_node is not None:
-        used.add(cm_node.file)
+    # a file is used when it gives the manager's parameters or a listed controller's
+    used |= {n.file for n in nodes if n.name == manager or n.name in listed}
     for n in nodes:
         if n.name in _WILDCARDS and isinstance(n.params.get("type"), str):
             g.notices.add(
@@ -305,6 +310,8 @@ def _manager_entries(
             listed[str(key)] = (value["type"], *where)
         elif isinstance(key, str) and key.endswith(".type") and isinstance(value, str):
             listed[key[: -len(".type")]] = (value, *_where_of(nodes, manager, key))
+        elif key in cm.inherited:  # a wildcard node's parameter: every node gets it, few read it
+            pass
         elif key in _MANAGER_SAID:
             if _MANAGER_SAID[str(key)]:
                 g.notices.add(
@@ -375,18 +382,18 @@ def _ros1_specs(f: _File) -> list[ControllerSpec]:
 
 
 def read_controllers(
-    g: ReaderBase, paths: list[Path], manager: str = MANAGER, on_error: Any = None
+    g: ReaderBase, paths: list[Path], manager: str = MANAGER, on_error: dict[Path, Any] | None = None
 ) -> list[ControllerSpec]:
     """The controllers of these files, read together as the controller manager reads them. A file that
-    cannot be read raises SourceError, unless `on_error(path, error)` takes it."""
+    cannot be read raises SourceError, unless `on_error` has a callback `(error) -> None` for its path."""
     files: list[_File] = []
     for path in paths:
         try:
             files.append(_load(g, path))
         except SourceError as e:
-            if on_error is None:
+            if on_error is None or path not in on_error:
                 raise
-            on_error(path, e)
+            on_error[path](e)
     for f in files:
         _say_duplicates(g, f)
     specs, used = _ros2_specs(g, files, manager)
@@ -453,15 +460,15 @@ def run_controller_files(g: ReaderBase) -> None:
     if not plugins:
         plugins = [ControlPlugin((scenario_files[0], None), "")]
     for k, plugin in enumerate(plugins):
-        elements = {path: el for path, el in plugin.files}
 
-        def unreadable(path: Path, e: SourceError, elements: dict[Path, Any] = elements) -> None:
-            g.note(elements[path], f"{e}; its controllers are not run")
+        def unreadable(el: Any) -> Any:
+            return lambda e: g.note(el, f"{e}; its controllers are not run")
 
-        specs = read_controllers(g, [p for p, _ in plugin.files], plugin.manager, unreadable)
-        if k == 0 and scenario_files:
-            specs = _combine(specs, read_controllers(g, scenario_files, plugin.manager))
-        ctx = ControlContext(g, plugin.where, dict(plugin.remap), plugin.rules, plugin.namespace)
+        paths = [p for p, _ in plugin.files] + (scenario_files if k == 0 else [])
+        on_error = {path: unreadable(el) for path, el in plugin.files}
+        specs = read_controllers(g, paths, plugin.manager, on_error)
+        # the rules as written (`~/` kept) replace the plugin's remap table, which has lost the `~/`
+        ctx = ControlContext(g, plugin.where, {}, plugin.rules, plugin.namespace)
         ran = dispatch(ctx, specs)
         if ran or plugin.el is None:
             continue
@@ -473,18 +480,6 @@ def run_controller_files(g: ReaderBase) -> None:
             hint="name the controllers file the robot's launch loads in the scenario (`controllers:`), or "
             "command joints with a `joint_controller` plugin",
         )
-
-
-def _combine(first: list[ControllerSpec], later: list[ControllerSpec]) -> list[ControllerSpec]:
-    """The description's controllers, then the scenario's: a controller both name takes the later one's
-    type and parameters over the earlier's (a later parameter file wins)."""
-    out = {s.name: s for s in first}
-    for s in later:
-        old = out.get(s.name)
-        if old is not None and isinstance(old.params, Block) and isinstance(s.params, Block):
-            s.params = _merge(_copy(old.params), s.params)
-        out[s.name] = s
-    return list(out.values())
 
 
 def _ros_rules(r: TagReader) -> tuple[list[Remap], str]:

@@ -19,10 +19,12 @@ class Block(dict):  # type: ignore[type-arg]
     """A YAML mapping of a controllers file, with the 1-based line of each key (`lines`)."""
 
     lines: dict[Any, int]
+    inherited: set[Any]  # keys a wildcard node's block gave it (every node gets them)
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.lines = {}
+        self.inherited = set()
 
 
 def line_of(params: Any, dotted: str) -> int | None:
@@ -44,7 +46,10 @@ def flat(params: Any, prefix: str = "") -> Iterator[tuple[str, int | None]]:
     if not isinstance(params, dict):
         return
     lines = getattr(params, "lines", {})
+    inherited = getattr(params, "inherited", set())
     for key, value in params.items():
+        if key in inherited:
+            continue
         name = f"{prefix}{key}"
         if isinstance(value, dict) and value:
             yield from flat(value, name + ".")
