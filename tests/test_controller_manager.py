@@ -233,6 +233,7 @@ DUPLICATE = """
         type: forward_command_controller/ForwardCommandController
   arm_controller:
     ros__parameters:
+      <<: {joints: [elbow], interface_name: effort}
       joints: [shoulder]
       interface_name: velocity
 """
@@ -241,12 +242,15 @@ DUPLICATE = """
 @pytest.mark.timeout(60)
 def test_a_repeated_wildcard_key_is_said_with_both_lines_and_keeps_every_controller(tmp_path: Path) -> None:
     """PyYAML keeps only the last of two `/**:` keys; ROS 2's parameter parser merges them: both
-    controllers run, the broadcaster at the first block's update_rate, and the repeat is said."""
+    controllers run, the broadcaster at the first block's update_rate, and the repeat is said (and a key
+    overriding a YAML merge key's is not a repeat)."""
     path = _write(tmp_path, {"control.yaml": DUPLICATE})
     plugins, said = _plugins(path)
     assert set(plugins) == {"joint_state_broadcaster", "arm_controller"}, said
     assert plugins["joint_state_broadcaster"].params["rate"] == 50  # type: ignore[attr-defined]
     assert plugins["arm_controller"].params["mode"] == "velocity"  # type: ignore[attr-defined]
+    assert plugins["arm_controller"].params["joints"] == ["shoulder"]  # type: ignore[attr-defined]
+    assert "key 'joints'" not in said  # a key overriding a `<<:` merge key's is no repeat
     assert "key '/**' at line 7 repeats the one at line 1" in said, said
     assert "rcl_yaml_param_parser" in said and "control.yaml:7" in said, said
 

@@ -85,6 +85,7 @@ def _construct_block(loader: _LineLoader, node: yaml.MappingNode) -> Any:
     explicit = sum(1 for k, _ in node.value if k.tag != "tag:yaml.org,2002:merge")
     loader.flatten_mapping(node)  # `<<:` merge keys first, as SafeConstructor does
     merged = len(node.value) - explicit
+    written: set[Any] = set()  # keys written in this mapping itself (a merged-in key may be overridden)
     for i, (key_node, value_node) in enumerate(node.value):
         key = loader.construct_object(key_node, deep=True)
         try:
@@ -95,7 +96,7 @@ def _construct_block(loader: _LineLoader, node: yaml.MappingNode) -> Any:
             ) from None
         value = loader.construct_object(value_node, deep=True)
         line = key_node.start_mark.line + 1
-        if key in data and i >= merged:
+        if i >= merged and key in written:
             loader.duplicates.append((key, data.lines.get(key, 0), line))
             old = data[key]
             if loader.merge and isinstance(old, Block) and isinstance(value, Block):
@@ -103,6 +104,8 @@ def _construct_block(loader: _LineLoader, node: yaml.MappingNode) -> Any:
                 continue
         data[key] = value
         data.lines[key] = line
+        if i >= merged:
+            written.add(key)
 
 
 _LineLoader.add_constructor("tag:yaml.org,2002:map", _construct_block)  # type: ignore[arg-type]
