@@ -531,3 +531,43 @@ def test_several_files_are_read_together_the_later_value_winning(tmp_path: Path)
     assert plugins["arm_controller"].params["joints"] == ["shoulder", "elbow"]  # type: ignore[attr-defined]
     assert plugins["joint_state_broadcaster"].params["rate"] == 25  # type: ignore[attr-defined]
     assert "yields no controller" not in said and "no controller is loaded" not in said, said
+
+
+@pytest.mark.parametrize(
+    ("rule", "namespace", "topic", "expected"),
+    [
+        ("rosbot_base_controller/cmd_vel_unstamped:=cmd_vel", "", "~/cmd_vel_unstamped", "cmd_vel"),
+        ("~/cmd_vel_unstamped:=cmd_vel", "", "rosbot_base_controller/cmd_vel_unstamped", "cmd_vel"),
+        (
+            "/rosbot/rosbot_base_controller/cmd_vel_unstamped:=/rosbot/cmd_vel",
+            "/rosbot",
+            "~/cmd_vel_unstamped",
+            "cmd_vel",
+        ),
+        ("rosbot_base_controller:~/odom:=~/odometry", "", "~/odom", "rosbot_base_controller/odometry"),
+        ("other_controller:~/odom:=odometry", "", "~/odom", "rosbot_base_controller/odom"),
+        ("--ros-args -r /tf:=tf_base", "", "/tf", "tf_base"),
+        ("cmd_vel:=x", "", "rosbot_base_controller/cmd_vel", "rosbot_base_controller/cmd_vel"),
+    ],
+)
+def test_a_remapping_names_a_controller_topic_as_rcl_expands_it(
+    rule: str, namespace: str, topic: str, expected: str
+) -> None:
+    """Both sides of a rule are expanded for the controller node using the name (`~` is its own
+    namespace), under the plugin's namespace; a `node:` rule is that node's only."""
+    from lxml import etree
+
+    from runner.compile.gazebo.base import ReaderBase
+    from runner.compile.gazebo.control import ControlContext
+    from runner.compile.gazebo.controllers import _ros_rules
+    from runner.compile.gazebo.tags import TagReader
+    from runner.errors import Notices
+
+    tag = "argument" if rule.startswith("--") else "remapping"
+    plugin = etree.fromstring(
+        f"<plugin><ros><namespace>{namespace}</namespace><{tag}>{rule}</{tag}></ros></plugin>".encode()
+    )
+    rules, ns = _ros_rules(TagReader(plugin))
+    g = ReaderBase(etree.fromstring(b"<robot/>"), None, [], False, "r1", Notices())
+    ctx = ControlContext(g, (None, None), {}, rules, ns, node="rosbot_base_controller")
+    assert ctx.topic(topic) == expected
