@@ -259,7 +259,7 @@ def test_a_repeated_wildcard_key_is_said_with_both_lines_and_keeps_every_control
 def test_a_file_without_controllers_and_an_unknown_type_are_said_where_they_are(tmp_path: Path) -> None:
     """A file yielding no controller says so at its path (not that it lacks a broadcaster); a type we do
     not run is said with its type at its own line; a parameter its type lacks at its line; the controller
-    manager's parameters are read or said."""
+    manager's parameters are read or said; so are the control plugin's tags."""
     odd = """
     controller_manager:
       ros__parameters:
@@ -277,7 +277,11 @@ def test_a_file_without_controllers_and_an_unknown_type_are_said_where_they_are(
         publish_frequency: 30.0
     """
     path = _write(
-        tmp_path, {"control.yaml": odd, "empty.yaml": empty}, controllers="[empty.yaml]", duration=0.1
+        tmp_path,
+        {"control.yaml": odd, "empty.yaml": empty},
+        controllers="[empty.yaml]",
+        duration=0.1,
+        ros="<hold_joints>true</hold_joints><no_such_tag>1</no_such_tag>",
     )
     plugins, said = _plugins(path)
     assert set(plugins) == {"joint_state_broadcaster"}
@@ -289,6 +293,9 @@ def test_a_file_without_controllers_and_an_unknown_type_are_said_where_they_are(
     assert "'enforce_command_limits' is not used" in said
     assert f"controllers file {str(tmp_path / 'empty.yaml')!r} yields no controller" in said, said
     assert "broadcaster" not in said.split("yields no controller")[1].split("\n")[0]
+    # the control plugin's own tags: known ones read, any other said
+    assert "<no_such_tag> in <plugin filename='gz_ros2_control-system'> is ignored" in said, said
+    assert "hold_joints" not in said
 
 
 REMAPPED = """

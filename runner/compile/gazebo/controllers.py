@@ -510,7 +510,25 @@ def ros_control(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> None:
     """gazebo_ros_control (ROS 1): its controllers come from parameters a launch file loads (the scenario's
     `controllers:`). gz_ros2_control / gazebo_ros2_control (ROS 2) and their forks: `<parameters>` names the
     controllers files. Read when every block is (`run_controller_files`), with the plugin's `<ros>`."""
-    r.mark(*[c.tag for c in r.el if isinstance(c.tag, str)])
+    # read here: the files, the `<ros>` block, the manager's name; read by the hardware layer (gains, holding
+    # joints, the description's parameter): marked; gazebo_ros_control's (ROS 1) said where they change
+    # something; any other tag is said by the caller (`ignored`)
+    r.mark("parameters", "ros", "controller_manager_name", "robot_param", "robot_param_node", "robotParam")
+    r.mark("hold_joints", "position_proportional_gain", "controller_manager_prefix_node_name")
+    r.mark("robotNamespace", "legacyModeNS", "controlPeriod")
+    sim_type = r.text("robotSimType")
+    if sim_type and sim_type != "gazebo_ros_control/DefaultRobotHWSim":
+        g.note(
+            r.child("robotSimType"),
+            f"<robotSimType> {sim_type!r}: a custom hardware interface is not loaded; the joints get the "
+            "default one's (gazebo_ros_control/DefaultRobotHWSim) position, velocity and effort interfaces",
+        )
+    estop = r.child("eStopTopic")
+    if estop is not None:
+        g.note(
+            estop,
+            "<eStopTopic> is not subscribed: no emergency stop (gazebo_ros_control stops controllers on it)",
+        )
     files = []
     for e in r.children("parameters"):
         text = (e.text or "").strip()
