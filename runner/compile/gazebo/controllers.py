@@ -515,7 +515,14 @@ def ros_control(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> None:
     # something; any other tag is said by the caller (`ignored`)
     r.mark("parameters", "ros", "controller_manager_name", "robot_param", "robot_param_node", "robotParam")
     r.mark("hold_joints", "position_proportional_gain", "controller_manager_prefix_node_name")
-    r.mark("robotNamespace", "legacyModeNS", "controlPeriod")
+    r.mark("robotNamespace", "legacyModeNS")
+    period = r.child("controlPeriod")
+    if period is not None:
+        g.note(
+            period,
+            f"<controlPeriod> {(period.text or '').strip()!r} is not used: ROS 1 controllers act at every "
+            "physics step here (a joint servo inside the step), joint_state_controller at its publish_rate",
+        )
     sim_type = r.text("robotSimType")
     if sim_type and sim_type != "gazebo_ros_control/DefaultRobotHWSim":
         g.note(
