@@ -371,23 +371,24 @@ def test_a_forward_position_controller_moves_the_joints_and_states_are_broadcast
     states = messages(bus, "r1/joint_states")
     assert 195 <= len(states) <= 201, len(states)
     first, last = states[0][1], states[-1][1]
-    assert list(last.name) == ["shoulder", "elbow", "gripper_dummy"]
+    # the joints by name, as the controller manager hands them over; the extra joint last
+    assert list(last.name) == ["elbow", "shoulder", "gripper_dummy"]
     assert np.allclose(first.position[:2], [0.0, 0.0], atol=0.01)
     # the shoulder carries no gravity load; the elbow sags 0.012 rad under its forearm with the hardware's
     # default servo gains (measured; gains are the hardware layer's)
-    assert abs(last.position[0] - 0.8) < 0.005 and abs(last.position[1] + 0.5) < 0.02, last.position
+    assert abs(last.position[1] - 0.8) < 0.005 and abs(last.position[0] + 0.5) < 0.02, last.position
     assert last.position[2] == 0.0
-    assert np.isnan(last.effort[0]) and np.isfinite(last.effort[1]) and last.effort[2] == 0.0
+    assert np.isnan(last.effort[1]) and np.isfinite(last.effort[0]) and last.effort[2] == 0.0
     dynamic = messages(bus, "r1/dynamic_joint_states")
     assert len(dynamic) == len(states)
     msg = dynamic[-1][1]
-    assert list(msg.joint_names) == ["shoulder", "elbow", "gripper_dummy"]
+    assert list(msg.joint_names) == ["elbow", "shoulder", "gripper_dummy"]
     assert [list(v.interface_names) for v in msg.interface_values] == [
+        ["position", "velocity", "effort"],
         ["position", "velocity"],
         ["position", "velocity", "effort"],
-        ["position", "velocity", "effort"],
     ]
-    assert abs(msg.interface_values[0].values[0] - 0.8) < 0.01
+    assert abs(msg.interface_values[1].values[0] - 0.8) < 0.01
 
 
 CLIENT = textwrap.dedent(
@@ -417,11 +418,11 @@ CLIENT = textwrap.dedent(
             pub.put(msgs.encode(msgs.from_data(kind, {"data": 0.6}), kind))
             time.sleep(0.05)
             js = msgs.decode(last[-1], "sensor_msgs/msg/JointState")
-            if abs(js.position[1] - 0.6) < 0.01:
+            if abs(js.position[0] - 0.6) < 0.01:
                 break
         sub.undeclare()
         pub.undeclare()
-    print(f"elbow={js.position[1]:.4f} names={','.join(js.name)}")
+    print(f"elbow={js.position[0]:.4f} names={','.join(js.name)}")
     """
 )
 
@@ -457,7 +458,7 @@ def test_a_ros1_pid_position_controller_is_driven_over_zenoh(tmp_path: Path) -> 
             [sys.executable, "-c", CLIENT, endpoint], capture_output=True, text=True, timeout=60
         )
         assert client.returncode == 0, client.stderr
-        assert "names=shoulder,elbow" in client.stdout
+        assert "names=elbow,shoulder" in client.stdout  # by name, as ROS 1's hardware interface lists them
         assert abs(float(client.stdout.split("elbow=")[1].split()[0]) - 0.6) < 0.01
     finally:
         runner.terminate()

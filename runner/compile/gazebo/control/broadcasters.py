@@ -38,6 +38,13 @@ def _hardware_joints(ctx: ControlContext) -> list[tuple[str, list[str]]]:
     return out
 
 
+def _moving(ctx: ControlContext) -> list[str]:
+    """A description with no `<ros2_control>` or `<transmission>`: its revolute, continuous and prismatic
+    joints, by name (gz_ros2_control would give the broadcaster none; here it publishes them all)."""
+    kinds = ("revolute", "continuous", "prismatic")
+    return sorted(str(j.get("name")) for j in ctx.g.root.findall("joint") if j.get("type") in kinds)
+
+
 def _joint_state_controller(ctx: ControlContext, spec: ControllerSpec, p: dict[str, Any]) -> bool:
     """ROS 1 joint_state_controller (ros_controllers, Noetic): every joint, at `publish_rate`."""
     rate = p.get("publish_rate")
@@ -50,7 +57,8 @@ def _joint_state_controller(ctx: ControlContext, spec: ControllerSpec, p: dict[s
             hint="publish_rate: 50",
         )
         rate = 50.0
-    hardware = _hardware_joints(ctx)
+    # hardware_interface's resource map hands the joints over sorted by name
+    hardware = sorted(_hardware_joints(ctx)) or [(j, []) for j in _moving(ctx)]
     ctx.add(
         spec,
         "joint_states",
@@ -115,7 +123,12 @@ def joint_state_broadcaster(ctx: ControlContext, spec: ControllerSpec) -> bool:
                 line_of(spec.params, "interfaces") or spec.line,
             )
     else:
-        selected = hardware
+        # every state interface: the controller manager hands them over sorted by name (its interface map),
+        # and on Jazzy `use_urdf_to_filter` orders the joints as urdf::Model's map does: by name as well
+        selected = sorted(hardware) if hardware else [(j, list(_STANDARD)) for j in _moving(ctx)]
+    # a joint with none of position, velocity and effort is not in joint_states (joint_state_broadcaster.cpp
+    # names a joint there only for a standard interface, :263 on Jazzy)
+    selected = [(j, i) for j, i in selected if i]
     _say_mapped(ctx, spec, p)
     local = p["use_local_topics"] is True
     prefix = "~/" if local else ""
