@@ -531,6 +531,8 @@ def test_several_files_are_read_together_the_later_value_winning(tmp_path: Path)
           update_rate: 25
       arm_controller:
         ros__parameters: {interface_name: velocity}
+      joint_state_broadcaster:
+        ros__parameters: {use_urdf_to_filter: false}
     """
     path = _write(tmp_path, {"control.yaml": description, "launch.yaml": launch}, controllers="[launch.yaml]")
     plugins, said = _plugins(path)
@@ -538,6 +540,8 @@ def test_several_files_are_read_together_the_later_value_winning(tmp_path: Path)
     assert plugins["arm_controller"].params["mode"] == "velocity"  # type: ignore[attr-defined]
     assert plugins["arm_controller"].params["joints"] == ["shoulder", "elbow"]  # type: ignore[attr-defined]
     assert plugins["joint_state_broadcaster"].params["rate"] == 25  # type: ignore[attr-defined]
+    # without the URDF filter (Jazzy) the joints keep the order the hardware exports them (as on Humble)
+    assert plugins["joint_state_broadcaster"].params["joints"] == ["shoulder", "elbow"]  # type: ignore[attr-defined]
     assert "yields no controller" not in said and "no controller is loaded" not in said, said
 
 

@@ -123,9 +123,12 @@ def joint_state_broadcaster(ctx: ControlContext, spec: ControllerSpec) -> bool:
                 line_of(spec.params, "interfaces") or spec.line,
             )
     else:
-        # every state interface: the controller manager hands them over sorted by name (its interface map),
-        # and on Jazzy `use_urdf_to_filter` orders the joints as urdf::Model's map does: by name as well
-        selected = sorted(hardware) if hardware else [(j, list(_STANDARD)) for j in _moving(ctx)]
+        # every state interface, in the order the hardware exports them (the description's: the resource
+        # manager's available_state_interfaces); on Jazzy `use_urdf_to_filter` (default true) then orders the
+        # joints as urdf::Model's joint map does, by name (joint_state_broadcaster.cpp:280); Humble has not
+        # that filter and keeps the description's order, as `use_urdf_to_filter: false` does
+        by_name = p["use_urdf_to_filter"] is not False
+        selected = (sorted(hardware) if by_name else hardware) or [(j, list(_STANDARD)) for j in _moving(ctx)]
     # a joint with none of position, velocity and effort is not in joint_states (joint_state_broadcaster.cpp
     # names a joint there only for a standard interface, :263 on Jazzy)
     selected = [(j, i) for j, i in selected if i]
