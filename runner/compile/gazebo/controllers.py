@@ -446,12 +446,6 @@ def _types() -> list[str]:
     return list(handlers())
 
 
-def run_controllers(g: ReaderBase, path: Path, where: Where, remap: dict[str, str] | None = None) -> int:
-    """Run the controllers of one controllers file (no control plugin's remappings but `remap`)."""
-    ctx = ControlContext(g, where, dict(remap or {}))
-    return dispatch(ctx, read_controllers(g, [path]))
-
-
 def run_controller_files(g: ReaderBase) -> None:
     """Once every `<gazebo>` block is read: the controllers of each control plugin (its `<parameters>`
     files, then the scenario's `controllers:` for the first plugin), with the plugin's remappings and
