@@ -577,7 +577,7 @@ def test_a_ros2_control_diff_drive_runs_from_its_controllers_file(tmp_path: Path
     plan, text = compile_with_notices(path)
     topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in declared(plan.robots[0])}
     assert topics["base_controller"] == ["base_controller/cmd_vel_unstamped", "base_controller/odom", "tf"]
-    assert topics["joint_state_broadcaster"] == ["joint_states"]
+    assert topics["joint_state_broadcaster"] == ["dynamic_joint_states", "joint_states"]
     assert "gripper_controller: a gripper controller needs `joint` (one joint name); not run" in text
     _, bus = simulate(path)
     t, pose, _ = _truth(bus)

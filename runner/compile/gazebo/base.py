@@ -35,6 +35,7 @@ class ReaderBase:
         self.namespace = namespace
         self.model = model or namespace  # the model's name in Gazebo: the robot's name in the scenario
         self.controller_files: list[Path] = []
+        self.control_plugins: list[Any] = []  # the ros_control plugins (runner.compile.gazebo.controllers)
         self.notices = notices
         self.info = GazeboInfo()
         self._names: set[str] = set()

@@ -6,6 +6,7 @@ defaults included; gz-sim systems our world always runs are no-ops, any other pl
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 from runner.compile.gazebo import thirdparty
@@ -24,6 +25,11 @@ def read_model_plugin(g: ReaderBase, p: Any, link: str | None) -> None:
     r = TagReader(p)
     context = f"<plugin filename={filename!r}>"
     handler = _MODEL_PLUGINS.get(base)
+    if handler is None and _CONTROL_FORK.search(base):
+        # a vendor's fork of the control plugin (franka's `franka_ign_ros2_control-system`...) loads the
+        # controller manager as its parent does: read as the parent, said
+        handler = ros_control
+        g.note(p, f"plugin {filename!r} is read as the ros2_control / ros_control plugin it forks")
     if handler is None:
         if base in NOOP_PLUGINS:
             return
@@ -282,3 +288,5 @@ _MODEL_PLUGINS = {
     "ign_ros2_control-system": ros_control,
 }
 _MODEL_PLUGINS.update(thirdparty.MODEL_PLUGINS)  # hector_gazebo_plugins (.thirdparty)
+# forks of gz_ros2_control / ign_ros2_control / gazebo_ros2_control / gazebo_ros_control keep the name's tail
+_CONTROL_FORK = re.compile(r"(^|[_-])(gz|ign|gazebo)_ros2?_control(-system|_plugin)?$")

@@ -16,7 +16,7 @@ from typing import Any
 from lxml import etree
 
 from runner.compile.gazebo.base import ReaderBase
-from runner.compile.gazebo.controllers import run_controllers
+from runner.compile.gazebo.controllers import run_controller_files
 from runner.compile.gazebo.info import DescribedPlugin, GazeboInfo, LinkProps
 from runner.compile.gazebo.model_plugins import read_model_plugin
 from runner.compile.gazebo.sensors import read_sensor
@@ -49,8 +49,8 @@ class GazeboReader(ReaderBase):
                     self._model(gz)
             except (ValueError, OverflowError) as e:  # float("many"), int(float("inf")) in a tag's text
                 raise self._not_a_number(gz, e) from None
-        for path in self.controller_files:  # the scenario's `controllers:` (what a launch file would load)
-            run_controllers(self, path, (path, None))
+        # the control plugin's files and the scenario's `controllers:` (what a launch file would load)
+        run_controller_files(self)
         self._drop_shadowed()
         self._drop_missing_targets()
         return self.info

@@ -44,6 +44,16 @@ class ControllerSpec:
 
 
 @dataclass
+class Remap:
+    """One `<ros><remapping>` rule of the control plugin: `from:=to`, or `node:from:=to` for one node only
+    (rcl's remap rules, which the controller manager and every controller node it loads are given)."""
+
+    src: str
+    dst: str
+    node: str | None = None
+
+
+@dataclass
 class ControlContext:
     """What a controller handler works with: the Gazebo reader, the control plugin's location, and the
     names the plugin's `<ros><remapping>` / `<ros><namespace>` give the controllers' topics."""
@@ -51,11 +61,39 @@ class ControlContext:
     g: ReaderBase
     plugin_where: Where
     remap: dict[str, str] = field(default_factory=dict)  # `<name>/cmd_vel_unstamped` -> `cmd_vel`...
+    rules: list[Remap] = field(default_factory=list)  # the plugin's remappings as written (`~/`, `/`...)
+    namespace: str = ""  # the plugin's `<ros><namespace>` (the robot's namespace stands for it)
+    node: str | None = None  # the controller being read: `~` in a name is this node's own namespace
+
+    def expand(self, name: str, node: str | None = None) -> str:
+        """A ROS name as rcl expands it for a controller node (`~/x` -> `<node>/x`, `x` -> `x`, `/x` -> `x`),
+        relative to the robot's namespace, which stands for the plugin's (an absolute name under the
+        plugin's `<namespace>` loses that prefix: the scenario places every robot's topics under its own)."""
+        name = name.strip()
+        node = node or self.node
+        if name.startswith("~"):
+            rest = name[1:].lstrip("/")
+            name = f"{node}/{rest}" if node else rest
+        elif name.startswith("/"):
+            name = name.strip("/")
+            ns = self.namespace.strip("/")
+            if ns and (name == ns or name.startswith(ns + "/")):
+                name = name[len(ns) :]
+        return "/".join(part for part in name.split("/") if part)
 
     def topic(self, relative: str) -> str:
-        """A controller's topic (`<controller>/cmd_vel`, `joint_states`) as the control plugin's remappings
-        name it (a remapping names the topic relative to the robot's namespace, or absolute)."""
-        return self.remap.get(relative, relative)
+        """A controller's topic (`<controller>/cmd_vel`, `joint_states`, or as the controller names it:
+        `~/cmd_vel`) as the control plugin's remappings name it. As rcl does, both
+        sides of a rule are expanded for the node that uses the name (`~/x:=y` applies to every
+        controller's own `x`), and the first rule that matches wins (rcl_remap_first_match, remap.c:104 on
+        Humble; the replacement expanded, :215)."""
+        name = self.expand(relative)
+        for rule in self.rules:
+            if rule.node is not None and rule.node != self.node:
+                continue
+            if self.expand(rule.src) == name:
+                return self.expand(rule.dst)
+        return self.remap.get(name, name)
 
     def frame(self, name: str | None) -> str | None:
         return self.g.frame(name)
