@@ -429,3 +429,143 @@ def test_a_diff_drive_controller_through_zenoh_drives_limited_and_reports_encode
     # encoders over-report the turn by what the wheels slip (measured: 0.12 rad of 1.74, 5.5 cm)
     assert np.linalg.norm(true_xy - [end_odom.position.x, end_odom.position.y]) < 0.1
     assert 0 < _yaw(end_odom.orientation) - _yaw(end_truth.orientation) < 0.2
+
+
+ROS1_LIMITED = """
+base_controller:
+  type: diff_drive_controller/DiffDriveController
+  left_wheel: left_wheel_joint
+  right_wheel: right_wheel_joint
+  publish_cmd: true
+  velocity_rolling_window_size: 4
+  open_loop: true
+  linear:
+    x: {has_velocity_limits: true, max_velocity: 1.0, has_acceleration_limits: true, max_acceleration: 0.8,
+        min_acceleration: -0.4}
+  angular:
+    z: {max_velocity: 2.0}
+  wheel_bumpiness: 3
+  publish_wheel_joint_controller_state: true
+"""
+
+ROS1_CONTROL = '\n  <gazebo><plugin name="gazebo_ros_control" filename="libgazebo_ros_control.so"/></gazebo>'
+
+
+def _compiled(tmp_path: Path, urdf: str, controllers: str, ros1: bool = False) -> tuple[dict[str, Any], str]:
+    """The plugin a controllers file's mobile-base controller compiles to (its type and params), and what
+    validate says."""
+    path = _write(tmp_path, urdf, controllers, 1.0, "  []")
+    if ros1:
+        text = path.read_text().replace("    plugins: [", "    controllers: [control.yaml]\n    plugins: [")
+        path.write_text(text)
+    plan, said = compile_with_notices(path)
+    mine = [p for p in declared(plan.robots[0]) if p.type not in ("ground_truth", "joint_states")]
+    assert len(mine) == 1, [p.type for p in mine]
+    return {"type": mine[0].type, "topics": sorted(t.key.removeprefix("t/r1/") for t in mine[0].topics),
+            **mine[0].params}, said  # fmt: skip
+
+
+def _given(limits: dict[str, Any]) -> dict[str, Any]:
+    return {k: v for k, v in limits.items() if v is not None}
+
+
+def test_ros1_diff_drive_limits_publish_cmd_and_what_it_does_not_run_are_read_as_noetic(tmp_path: Path):
+    """ROS 1 (ros_controllers Noetic): `publish_cmd` publishes `cmd_vel_out`; a limit counts only with its
+    `has_*_limits: true` (angular.z's max_velocity without it is none), min_acceleration bounds every
+    decrease; open_loop odometry; a parameter the controller does not have, and one we do not run, are
+    said at the file's line."""
+    params, said = _compiled(tmp_path, diffbot(ROS1_CONTROL), ROS1_LIMITED, ros1=True)
+    assert params["topics"] == [
+        "base_controller/cmd_vel",
+        "base_controller/cmd_vel_out",
+        "base_controller/odom",
+        "tf",
+    ]
+    assert params["cmd_type"] == "twist" and params["odometry_source"] == "command"
+    assert params["velocity_rolling_window_size"] == 4 and params["max_wheel_torque"] == "joint"
+    assert _given(params["linear_limits"]) == {
+        "max_velocity": 1.0, "max_acceleration": 0.8, "max_deceleration": -0.4,
+        "max_acceleration_reverse": -0.4, "max_deceleration_reverse": 0.8,
+    }  # fmt: skip
+    assert params["angular_limits"] is None
+    assert "`wheel_bumpiness` is not one of its parameters; ignored" in said, said
+    assert "`publish_wheel_joint_controller_state` is not run" in said
+
+
+JAZZY_OR_HUMBLE = """
+controller_manager:
+  ros__parameters:
+    update_rate: 50
+    base: {type: diff_drive_controller/DiffDriveController}
+base:
+  ros__parameters:
+    left_wheel_names: [left_wheel_joint]
+    right_wheel_names: [right_wheel_joint]
+    wheel_separation: 0.34
+    wheel_radius: 0.05
+    linear.x.max_velocity: 0.5
+    tf_frame_prefix: /robot_a
+    position_feedback: false
+    twist_covariance_diagonal: [1, 2, 3, 4, 5, 6]
+"""
+
+
+def test_a_ros2_diff_drive_file_is_read_as_jazzy_unless_it_gives_humbles_use_stamped_vel(tmp_path: Path):
+    """Jazzy: TwistStamped on `<name>/cmd_vel`, limits on where given (linear.x.max_velocity), frames
+    with tf_frame_prefix, odometry from the wheels' velocities (position_feedback: false), control at the
+    manager's update_rate. The same file with Humble's `use_stamped_vel: false`: Twist on
+    `<name>/cmd_vel_unstamped`, and no limit without `has_velocity_limits: true` (Humble's default)."""
+    jazzy, said = _compiled(tmp_path, diffbot(_control("CONTROL_YAML")), JAZZY_OR_HUMBLE)
+    assert jazzy["topics"] == ["base/cmd_vel", "base/odom", "tf"] and jazzy["cmd_type"] == "twist_stamped"
+    assert _given(jazzy["linear_limits"]) == {"max_velocity": 0.5} and jazzy["control_rate"] == 50
+    assert jazzy["frame_prefix"] == "robot_a/" and jazzy["odometry_source"] == "velocity"
+    assert jazzy["twist_covariance_diagonal"] == [1, 2, 3, 4, 5, 6]
+    assert "ignored" not in said and "not run" not in said, said
+    humble, _ = _compiled(
+        tmp_path, diffbot(_control("CONTROL_YAML")), JAZZY_OR_HUMBLE + "    use_stamped_vel: false\n"
+    )
+    assert humble["topics"] == ["base/cmd_vel_unstamped", "base/odom", "tf"] and humble["cmd_type"] == "twist"
+    assert humble["linear_limits"] is None
+
+
+HUMBLE_BICYCLE = """
+controller_manager:
+  ros__parameters:
+    steer: {type: bicycle_steering_controller/BicycleSteeringController}
+    four: {type: four_wheel_steering_controller/FourWheelSteeringController}
+steer:
+  ros__parameters:
+    front_steering: true
+    rear_wheels_names: [rear_right_wheel_joint]
+    front_wheels_names: [front_right_steer_joint]
+    wheelbase: 0.4
+    rear_wheel_radius: 0.08
+    use_stamped_vel: false
+"""
+
+
+def test_humble_steering_names_map_as_the_library_maps_them_and_a_four_wheel_steering_is_said(tmp_path: Path):
+    """Humble's bicycle_steering_controller names (front_steering, rear_wheels_names for traction,
+    front_wheels_names for steering, rear_wheel_radius) become Jazzy's; `use_stamped_vel: false` takes
+    Twist on `<name>/reference_unstamped`; ROS 1's four_wheel_steering_controller is said with its type."""
+    params, said = _compiled(tmp_path, ackermann_car(_control("CONTROL_YAML")), HUMBLE_BICYCLE)
+    assert params["type"] == "steering_drive" and params["kinematics"] == "bicycle"
+    assert params["traction_joints_names"] == ["rear_right_wheel_joint"]
+    assert params["steering_joints_names"] == ["front_right_steer_joint"]
+    assert params["traction_wheels_radius"] == 0.08 and params["reference_type"] == "twist"
+    assert "steer/reference_unstamped" in params["topics"]
+    assert "'four' (four_wheel_steering_controller/FourWheelSteeringController) is not run" in said, said
+
+
+def test_the_speed_limiter_bounds_jerk_then_acceleration_then_velocity():
+    """speed_limiter (control_toolbox RateLimiter): from rest toward 1.0 at dt 0.1 with max_jerk 10,
+    max_acceleration 2, max_velocity 0.5: the first step is held by jerk (10·2·dt² = 0.2), the next ones by
+    acceleration (0.2 a step), then by velocity; going back, max_deceleration -1 gives 0.1 a step."""
+    from plugins._mobile import AxisLimits, SpeedLimiter
+
+    lim = SpeedLimiter(
+        AxisLimits(max_velocity=0.5, max_acceleration=2.0, max_deceleration=-1.0, max_jerk=10.0)
+    )
+    out = [round(lim.limit(1.0, 0.1), 6) for _ in range(4)]
+    assert out == [0.2, 0.4, 0.5, 0.5], out
+    assert round(lim.limit(0.0, 0.1), 6) == 0.4
