@@ -42,6 +42,10 @@ Sections (in order):
   its own process: wall time and peak memory against 60 s and 2 GB, and whether it validated or was
   refused with a located error.
 
+- mobile: mobile-base controllers from controllers files, what the physics gives them (bench/mobile.py): a
+  56 kg skid steer's turn with its wheels' torque unlimited (as gz_ros2_control without <limit effort>) and
+  held to 20 N·m, an Ackermann car's turning radius, a mecanum robot's strafe.
+
 Results go to bench/results/<section>.json (with machine info); `--readme` also writes the tables into
 README.md between the `bench:begin`/`bench:end` markers.
 """
@@ -101,6 +105,7 @@ SECTIONS = (
     "actors",
     "ray",
     "limits",
+    "mobile",
 )
 
 
@@ -803,6 +808,12 @@ def limits(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     return bl.run(args.quick)
 
 
+def mobile(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
+    from bench import mobile as bm
+
+    return bm.run(args.quick)
+
+
 RUNNERS = {
     "two_robots": two_robots,
     "scaling": scaling,
@@ -817,6 +828,7 @@ RUNNERS = {
     "actors": actors,
     "ray": ray,
     "limits": limits,
+    "mobile": mobile,
 }
 
 
