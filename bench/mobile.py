@@ -205,12 +205,15 @@ def steered(name: str, xyz: str, radius: float) -> str:
   </joint>"""
 
 
-def ackermann_car(control: str) -> str:
-    """A 12 kg car: rear traction wheels 0.3 m apart, front wheels steered, 0.4 m wheelbase."""
+def ackermann_car(control: str, tricycle: bool = False) -> str:
+    """A 12 kg car: rear traction wheels 0.3 m apart, front wheels steered, 0.4 m wheelbase (`tricycle`:
+    one steered front wheel, `front`, in the middle)."""
     rear = wheel("rear_left_wheel", "-0.2 0.15 -0.04", 0.08, 0.5) + wheel(
         "rear_right_wheel", "-0.2 -0.15 -0.04", 0.08, 0.5
     )
     front = steered("front_left", "0.2 0.15 -0.04", 0.08) + steered("front_right", "0.2 -0.15 -0.04", 0.08)
+    if tricycle:
+        front = steered("front", "0.2 0 -0.04", 0.08)
     return f'<?xml version="1.0"?>\n<robot name="car">{base(10.0, "0.5 0.25 0.08")}{rear}{front}{control}\n</robot>\n'
 
 

@@ -66,6 +66,11 @@ class SteeringDriveParams(ReferenceParams):
         False, description="Slow the traction wheels while the steering is far from its target."
     )
     velocity_rolling_window_size: int = Field(10, ge=1, description="Odometry twist: mean of this many.")
+    angular_is_steering_angle: bool = Field(
+        False,
+        description="The reference's angular.z is the steering angle itself, and a stale reference steers "
+        "straight (ROS 1 ackermann_steering_controller, a bicycle).",
+    )
 
 
 class SteeringDrive(Plugin):
@@ -246,6 +251,8 @@ class SteeringDrive(Plugin):
         """get_commands of steering_kinematics.cpp: traction wheel speeds and steering angles."""
         p = self.params
         L = self.wheelbase
+        if p.angular_is_steering_angle:  # ackermann_steering_controller.cpp (Noetic) update()
+            return [v / self.radius], [w]
         phi = math.atan(w * L / v) if v != 0 else 0.0
         if not math.isfinite(phi):
             phi = 0.0
@@ -281,6 +288,8 @@ class SteeringDrive(Plugin):
             self._odometry((now_ns - last) / 1e9, v, w)
         if usable:
             self.traction_cmd, self.steering_cmd = self._commands(v, w)
+        elif p.angular_is_steering_angle:  # ROS 1: a stale command is zero, steering straight
+            self.traction_cmd, self.steering_cmd = [0.0] * len(self.t_act), [0.0] * len(self.s_act)
         else:  # no reference: the traction wheels stop, the steering stays where it was sent
             self.traction_cmd = [0.0] * len(self.t_act)
         for a, c in zip(self.t_act, self.traction_cmd, strict=True):

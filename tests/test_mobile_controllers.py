@@ -5,6 +5,7 @@ steering controllers' kinematics; in process on real MuJoCo, and through a real 
 
 from __future__ import annotations
 
+import math
 import subprocess
 import threading
 import time
@@ -25,10 +26,12 @@ from bench.mobile import (
     mecanum_strafe,
     odom,
     skid_turn,
+    stream,
     truth,
     write,
     yaw,
 )
+from bench.mobile import simulate as simulate_bus
 from tests.helpers import compile_with_notices, declared, messages
 
 
@@ -312,3 +315,39 @@ def test_the_speed_limiter_bounds_jerk_then_acceleration_then_velocity():
     out = [round(lim.limit(1.0, 0.1), 6) for _ in range(4)]
     assert out == [0.2, 0.4, 0.5, 0.5], out
     assert round(lim.limit(0.0, 0.1), 6) == 0.4
+
+
+ROS1_ACKERMANN = """
+steer_controller:
+  type: ackermann_steering_controller/AckermannSteeringController
+  rear_wheel: rear_right_wheel_joint
+  front_steer: front_steer_joint
+  wheel_separation_h: 0.4
+  wheel_radius: 0.08
+  publish_rate: 25
+  steer_pos_multiplier: 1.0
+"""
+
+
+@pytest.mark.timeout(120)
+def test_ros1_ackermann_steering_controller_steers_by_the_angle_cmd_vel_gives(tmp_path: Path):
+    """ROS 1's ackermann_steering_controller (the same type name as ROS 2's): `cmd_vel` (Twist) whose
+    angular.z its update() sends to the steering joint as an angle: 0.3 m/s with angular.z 0.2 drives on a
+    radius of wheelbase / tan(0.2) = 1.97 m; `odom` at its publish_rate; a multiplier it has is said."""
+    timeline = stream(0.5, 6.5, "steer_controller/cmd_vel", lin=0.3, ang=0.2)
+    urdf = ackermann_car(ROS1_CONTROL, tricycle=True)
+    path = write(tmp_path, urdf, ROS1_ACKERMANN, 7.0, timeline, z=0.1)
+    path.write_text(
+        path.read_text().replace("    plugins: [", "    controllers: [control.yaml]\n    plugins: [")
+    )
+    plan, said = compile_with_notices(path)
+    topics = {p.name: sorted(t.key.removeprefix("t/r1/") for t in p.topics) for p in declared(plan.robots[0])}
+    assert topics["steer_controller"] == ["steer_controller/cmd_vel", "steer_controller/odom", "tf"], topics
+    assert "`steer_pos_multiplier` is not run: taken as 1" in said, said
+    bus = simulate_bus(path)
+    t, pose = truth(bus)
+    a, b = np.searchsorted(t, 1.5), np.searchsorted(t, 6.5)
+    steps = np.linalg.norm(np.diff(pose[a:b, :2], axis=0), axis=1)
+    radius = float(steps.sum() / (pose[b, 2] - pose[a, 2]))
+    assert abs(radius - 0.4 / math.tan(0.2)) < 0.2, radius  # measured: 2.08 (one rear wheel driven)
+    assert 6.5 * 25 <= len(messages(bus, "r1/steer_controller/odom")) <= 7 * 25 + 1

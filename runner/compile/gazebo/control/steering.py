@@ -238,7 +238,8 @@ def _steering(kinematics: str) -> Handler:
 def _ros1_ackermann(ctx: ControlContext, spec: ControllerSpec) -> bool:
     """ROS 1's ackermann_steering_controller (ros_controllers, same type name as ROS 2's): one rear
     traction joint (`rear_wheel`) and one steering joint (`front_steer`), a bicycle; `<name>/cmd_vel`
-    (Twist) in, `<name>/odom` out at `publish_rate`, `/tf` when `enable_odom_tf`."""
+    (Twist: linear.x the speed, angular.z the steering angle itself, as its update() sends it) in,
+    `<name>/odom` out at `publish_rate`, `/tf` when `enable_odom_tf`."""
     p, name = spec.params, spec.name
     rear, steer = param(p, "rear_wheel"), param(p, "front_steer")
     if not rear or not steer:
@@ -258,7 +259,7 @@ def _ros1_ackermann(ctx: ControlContext, spec: ControllerSpec) -> bool:
         "reference_type": "twist",
         "odometry_topic": ctx.topic(f"{name}/odom"),
         "tf_topic": ctx.topic("tf"),
-        "state_topic": None,
+        "state_topic": "",  # ROS 1 publishes no state
         "enable_odom_tf": param(p, "enable_odom_tf") is not False,
         "odom_frame_id": ctx.frame(str(param(p, "odom_frame_id") or "odom")),
         "base_frame_id": ctx.frame(str(param(p, "base_frame_id") or "base_link")),
@@ -267,6 +268,7 @@ def _ros1_ackermann(ctx: ControlContext, spec: ControllerSpec) -> bool:
         "open_loop": bool(param(p, "open_loop")),
         "position_feedback": True,
         "publish_rate": rate,
+        "angular_is_steering_angle": True,  # its update() sends cmd_vel's angular.z to the steering joint
     }
     known = {
         "rear_wheel",
@@ -290,6 +292,7 @@ def _ros1_ackermann(ctx: ControlContext, spec: ControllerSpec) -> bool:
     said["wheel_separation_h_multiplier"] = "taken as 1"
     said["wheel_radius_multiplier"] = "taken as 1"
     said["steer_pos_multiplier"] = "taken as 1"
+    said["allow_multiple_cmd_vel_publishers"] = "every publisher's commands are taken, as with true"
     unknown(ctx, spec, known, said)
     ctx.add(spec, "steering_drive", params)
     return True
