@@ -107,7 +107,14 @@ def _quat_z_to(direction: np.ndarray) -> list[float]:
 
 def _add_rollers(ctx: BuildContext, name: str, joints: list[Any]) -> None:
     """A ring of passive rollers on each wheel, their axes at the controller's 45° at the ground."""
-    model = ctx.spec.compile()  # the robot as described: where each wheel is, and how it is turned
+    try:  # the robot as described: where each wheel is, and how it is turned
+        model = ctx.spec.compile()
+    except ValueError as e:
+        raise PluginConfigError(
+            f"cannot place rollers on the wheels: the robot does not compile on its own ({e})",
+            "rollers",
+            hint="set rollers: false to drive the wheels as described",
+        ) from None
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
     root = model.body(ctx.root).id
@@ -133,7 +140,12 @@ def _add_rollers(ctx: BuildContext, name: str, joints: list[Any]) -> None:
         angle = math.radians(_ROLLER_ANGLE[wheel])
         ground_axis = rot.T @ (base_rot @ np.array([math.cos(angle), math.sin(angle), 0.0]))
         size = _ROLLER_SIZE * radius
-        mass = max(float(model.body_mass[b]) * 0.02, 0.005)
+        # the rollers take a fifth of the wheel's mass from it: the robot weighs what it is described to
+        mass = float(model.body_mass[b]) * 0.2 / _ROLLERS
+        if mass <= 0:
+            mass = 0.001
+        elif body.mass > _ROLLERS * mass:
+            body.mass = float(body.mass) - _ROLLERS * mass
         inertia = 0.4 * mass * size * size
         conaffinity = 1
         for geom in body.geoms:

@@ -351,3 +351,33 @@ def test_ros1_ackermann_steering_controller_steers_by_the_angle_cmd_vel_gives(tm
     radius = float(steps.sum() / (pose[b, 2] - pose[a, 2]))
     assert abs(radius - 0.4 / math.tan(0.2)) < 0.2, radius  # measured: 2.08 (one rear wheel driven)
     assert 6.5 * 25 <= len(messages(bus, "r1/steer_controller/odom")) <= 7 * 25 + 1
+
+
+def test_a_controller_drive_reuses_the_hardwares_wheel_actuator_and_keeps_each_joints_own_limit():
+    """The contract with the hardware layer (plugins/_actuators.py): a wheel whose ros2_control hardware
+    already made a velocity actuator (here, with a 7 N·m limit) is driven through it, limit kept; a wheel
+    without one gets an actuator of the drive's with the joint's URDF <limit effort> (3 N·m); a drive
+    declared with a torque (gazebo_ros_diff_drive's) puts its own on both."""
+    import mujoco
+
+    from plugins.diff_drive import DiffDrive, DiffDriveParams
+    from runner.plugin import BuildContext
+
+    urdf = diffbot("").replace(
+        '<joint name="right_wheel_joint" type="continuous">',
+        '<joint name="right_wheel_joint" type="continuous"><limit effort="3" velocity="10"/>',
+    )
+
+    def built(torque: Any) -> dict[str, tuple[float, float]]:
+        spec = mujoco.MjSpec.from_string(urdf)
+        hw = spec.add_actuator(name="hw/left", target="left_wheel_joint", trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        hw.set_to_velocity(kv=5.0)
+        hw.forcelimited, hw.forcerange = True, [-7.0, 7.0]
+        params = DiffDriveParams(
+            left_joint="left_wheel_joint", right_joint="right_wheel_joint", max_wheel_torque=torque
+        )
+        DiffDrive.build(params, BuildContext(spec, "r1", "r1", "base_link"), "base")
+        return {a.name: tuple(a.forcerange) for a in spec.actuators if a.gear[0] != 0}
+
+    assert built("joint") == {"hw/left": (-7.0, 7.0), "base/right": (-3.0, 3.0)}
+    assert built(20.0) == {"hw/left": (-20.0, 20.0), "base/right": (-20.0, 20.0)}
