@@ -45,6 +45,9 @@ Sections (in order):
   its initial values over 10 s at three timesteps (target: <= 0.005 rad), the sag under an outside load and
   with the servo alone, an effort limit below its weight, the peak speed of a step command against the URDF
   velocity limit, and the world's loop with and without velocity limits.
+- mobile: mobile-base controllers from controllers files, what the physics gives them (bench/mobile.py): a
+  56 kg skid steer's turn with its wheels' torque unlimited (as gz_ros2_control without <limit effort>) and
+  held to 20 N·m, an Ackermann car's turning radius, a mecanum robot's strafe.
 
 Results go to bench/results/<section>.json (with machine info); `--readme` also writes the tables into
 README.md between the `bench:begin`/`bench:end` markers.
@@ -106,6 +109,7 @@ SECTIONS = (
     "ray",
     "limits",
     "hardware",
+    "mobile",
 )
 
 
@@ -814,6 +818,12 @@ def hardware(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
     return bh.run(args.quick)
 
 
+def mobile(args: argparse.Namespace, tmp: Path) -> tuple[dict[str, Any], str]:
+    from bench import mobile as bm
+
+    return bm.run(args.quick)
+
+
 RUNNERS = {
     "two_robots": two_robots,
     "scaling": scaling,
@@ -829,6 +839,7 @@ RUNNERS = {
     "ray": ray,
     "limits": limits,
     "hardware": hardware,
+    "mobile": mobile,
 }
 
 

@@ -57,8 +57,11 @@ def odometry(
     quat_wxyz: Sequence[float],
     lin: Sequence[float],
     ang: Sequence[float],
+    pose_covariance: Sequence[float] | None = None,
+    twist_covariance: Sequence[float] | None = None,
 ) -> Any:
-    """A nav_msgs/Odometry from arrays (twist as given, no covariance)."""
+    """A nav_msgs/Odometry from arrays (twist as given; covariances from their 6 diagonal values, as
+    diff_drive_controller's `pose_covariance_diagonal` / `twist_covariance_diagonal`, else zero)."""
     T = msgs.T
     pose = T["geometry_msgs/msg/Pose"](
         position=T["geometry_msgs/msg/Point"](x=float(pos[0]), y=float(pos[1]), z=float(pos[2])),
@@ -70,13 +73,21 @@ def odometry(
         linear=T["geometry_msgs/msg/Vector3"](x=float(lin[0]), y=float(lin[1]), z=float(lin[2])),
         angular=T["geometry_msgs/msg/Vector3"](x=float(ang[0]), y=float(ang[1]), z=float(ang[2])),
     )
-    zeros = np.zeros(36)
     return T["nav_msgs/msg/Odometry"](
         header=msgs.header(now_ns, frame_id),
         child_frame_id=child,
-        pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=zeros),
-        twist=T["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=zeros),
+        pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=_covariance(pose_covariance)),
+        twist=T["geometry_msgs/msg/TwistWithCovariance"](
+            twist=twist, covariance=_covariance(twist_covariance)
+        ),
     )
+
+
+def _covariance(diagonal: Sequence[float] | None) -> np.ndarray:
+    out = np.zeros(36)
+    if diagonal is not None:
+        out[::7] = [float(v) for v in diagonal]
+    return out
 
 
 class BaseDriveParams(RatedParams):
@@ -109,13 +120,22 @@ _TWIST = struct.Struct("<6d")  # linear xyz, angular xyz
 
 
 class OdometryWriter:
-    """Publishes nav_msgs/Odometry with fixed frames (and zero covariances), written in place into a
-    fixed layout: a few microseconds a message instead of building message objects."""
+    """Publishes nav_msgs/Odometry with fixed frames and covariances (zero unless given), written in place
+    into a fixed layout: a few microseconds a message instead of building message objects."""
 
-    def __init__(self, pub: Publisher, frame_id: str, child: str):
+    def __init__(
+        self,
+        pub: Publisher,
+        frame_id: str,
+        child: str,
+        pose_covariance: Sequence[float] | None = None,
+        twist_covariance: Sequence[float] | None = None,
+    ):
         self.pub = pub
         zero = (0.0, 0.0, 0.0)
-        template = odometry(0, frame_id, child, zero, (1.0, 0.0, 0.0, 0.0), zero, zero)
+        template = odometry(
+            0, frame_id, child, zero, (1.0, 0.0, 0.0, 0.0), zero, zero, pose_covariance, twist_covariance
+        )
         self.layout = pub.layout(template, ["header.stamp"])
         self.buf = self.layout.buf
         self.pose_at = self.layout.spans["pose.pose"].offset
