@@ -82,7 +82,13 @@ class Hardware:
                 if a < 0:
                     continue
                 capped = bool(m.actuator_forcelimited[a]) or bool(m.jnt_actfrclimited[jid])
-                kv = (SERVO_STEPS if capped else SERVO_STEPS_UNLIMITED) * inertia / dt
+                # the joint's own damping (URDF <dynamics damping>) is added: a servo weaker than it moves
+                # the joint at a fraction of its setpoint (an LBR wrist, damping 10 N·m·s on a light link,
+                # crept to 0.098 of a 0.3 rad goal in 4 s), where DART's velocity constraint overrides it.
+                # kv = d + inertia/dt at most halves the velocity loop's speed, and stays below the
+                # saturation bound above (kv <= inertia/dt + d, the damping being integrated implicitly too)
+                damping_own = float(m.dof_damping[dof])
+                kv = (SERVO_STEPS if capped else SERVO_STEPS_UNLIMITED) * inertia / dt + damping_own
                 placeholder = m.actuator_gainprm[a, 0] == PLACEHOLDER
                 if mode == "position":
                     if placeholder:
