@@ -115,6 +115,11 @@ class JointTrajectoryControllerParams(PluginParams):
     constraints: Constraints = Field(default_factory=Constraints)
     gains: dict[str, Gains] = Field(default_factory=dict)
     update_rate: PositiveFloat = Field(100.0, description="The controller manager's update rate, Hz.")
+    every_step: bool = Field(
+        False,
+        description="Update at every physics step instead of at update_rate (gazebo_ros_control's default "
+        "control_period, the physics step: ROS 1 controllers).",
+    )
     ros1: bool = Field(False, description="ROS 1 JointTrajectoryController (topics command / state).")
     command_topic: str | None = Field(None, description="Default `<name>/joint_trajectory` (ROS 1: command).")
     state_topic: str | None = Field(None, description="Default `<name>/controller_state` (ROS 1: state).")
@@ -215,11 +220,11 @@ class JointTrajectoryController(Plugin):
 
     @classmethod
     def control_rate_of(cls, params: PluginParams) -> float | None:
-        return float(params.update_rate)  # type: ignore[attr-defined]
+        return None if params.every_step else float(params.update_rate)  # type: ignore[attr-defined]
 
     @classmethod
     def rate_of(cls, params: PluginParams) -> float | None:
-        return float(params.update_rate)  # type: ignore[attr-defined]
+        return None if params.every_step else float(params.update_rate)  # type: ignore[attr-defined]
 
     # ------------------------------------------------------------------------------------------ set up
     def setup(self) -> None:
@@ -255,7 +260,7 @@ class JointTrajectoryController(Plugin):
         self.gains = [p.gains.get(self.joints[k], Gains()) for k in self.cmd_index]
         self.integral = np.zeros(len(self.cmd_index))
         self.from_desired = p.interpolate_from_desired_state or p.open_loop_control or p.ros1
-        self.period = 1.0 / p.update_rate
+        self.period = dt if p.every_step else 1.0 / p.update_rate
         self.default_tol = self._default_tolerances()
         self.active_tol = self.default_tol
         self.goal: GoalHandle | None = None

@@ -526,3 +526,32 @@ def test_velocity_and_effort_interfaces_follow_through_the_pid_of_gains_and_not_
             assert error.max() <= 0.01, (interface, error)
         else:
             assert abs(final.feedback.positions[0]) < 0.01, final.feedback.positions  # not driven
+
+
+def test_ros1_effort_trajectory_controller_updates_every_physics_step_as_gazebo_ros_control(
+    tmp_path: Path,
+) -> None:
+    """gazebo_ros_control updates its controllers every control_period, by default the physics step. A ROS 1
+    effort JointTrajectoryController with stiff PID gains (Interbotix' arms use p 100-500 on light links) is
+    stable there; run at 100 Hz, the same gains flailed (a public 6-DoF arm's joints swung 5.7 rad before any
+    trajectory)."""
+    (tmp_path / "arm.urdf").write_text(ARM)
+    (tmp_path / "ros1.yaml").write_text(
+        "arm_controller:\n  type: effort_controllers/JointTrajectoryController\n  joints: [shoulder, elbow]\n"
+        "  gains:\n    shoulder: {p: 100, i: 0, d: 1}\n    elbow: {p: 200, i: 0, d: 2}\n"
+        "  constraints: {goal_time: 0.5}\n"
+    )
+    path = tmp_path / "r1.yaml"
+    data = _traj(["shoulder", "elbow"], [([0.5, 0.3], 1.0)])
+    path.write_text(
+        "name: r1\nduration: 2\nrate: max\nrobots:\n  - name: bot\n    description: arm.urdf\n    fixed: true\n"
+        "    controllers: [ros1.yaml]\ntimeline:\n"
+        f"  - {{t: 0.5, topic: bot/arm_controller/command, type: trajectory_msgs/msg/JointTrajectory, data: {data}}}\n"
+    )
+    _, bus = _run(path)
+    states = [(s / 1e9, m) for s, m in messages(bus, "bot/arm_controller/state")]
+    before = max(float(np.abs(np.asarray(m.feedback.positions)).max()) for t, m in states if t < 0.5)
+    assert before < 0.05, f"the arm swung {before:.3f} rad before any trajectory"
+    final = np.asarray(states[-1][1].feedback.positions)
+    # a PD with gravity on the elbow: p 200 leaves its weight's torque / p of error
+    assert np.abs(final - [0.5, 0.3]).max() < 0.05, final

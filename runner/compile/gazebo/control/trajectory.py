@@ -148,9 +148,11 @@ def joint_trajectory_controller(ctx: ControlContext, spec: ControllerSpec) -> bo
         family = spec.type.replace("::", "/").split("/")[0]
         params["ros1"] = True
         params["command_interfaces"] = _ROS1_FAMILY[family]
-        # gazebo_ros_control updates its controllers every `control_period` (default: each physics step);
-        # they run at the plugin's default rate here (100 Hz), as ROS 2's controller manager by default
+        # gazebo_ros_control updates its controllers every `control_period`, by default each physics step
+        # (gazebo_ros_control_plugin.cpp: control_period_ = the physics update period): so here. An effort
+        # PID tuned for that (Interbotix' p 100-500 on light links) flails at 100 Hz
         params["update_rate"] = None
+        params["every_step"] = True
         for key in ("state_publish_rate", "action_monitor_rate", "allow_partial_joints_goal"):
             if param(p, key) is not None:
                 params[key] = param(p, key)
