@@ -139,3 +139,28 @@ def test_a_macro_call_without_its_parameters_is_located_at_that_call(tmp_path: P
         expand(main, {}, PackageMap(roots=[tmp_path]))
     assert err.value.file == main and err.value.line == 9, (err.value.file, err.value.line)
     assert "the call of macro 'wheel' does not give parameters [radius]" in str(err.value)
+
+
+def test_a_xacro_urdf_with_only_find_substitutions_is_expanded(tmp_path: Path):
+    """gz_ros2_control's demo robots (`*.xacro.urdf`) declare no xacro namespace: their only xacro is a
+    `$(find pkg)` in the control plugin's <parameters>, which the launch's xacro run resolves. Read as plain
+    URDF, the path stayed literal and the controllers file could not be read."""
+    from tests.helpers import compile_with_notices
+
+    pkg = _package(tmp_path, "demo_pkg")
+    (pkg / "config").mkdir()
+    (pkg / "config" / "c.yaml").write_text(
+        "controller_manager:\n  ros__parameters:\n    joint_state_broadcaster:\n"
+        "      type: joint_state_broadcaster/JointStateBroadcaster\n"
+    )
+    (tmp_path / "bot.xacro.urdf").write_text(
+        '<robot name="bot"><link name="base"><collision><geometry><box size="0.3 0.3 0.1"/></geometry>'
+        '</collision><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" '
+        'iyz="0"/></inertial></link><gazebo><plugin filename="libgz_ros2_control-system.so" '
+        'name="gz_ros2_control::GazeboSimROS2ControlPlugin"><parameters>$(find demo_pkg)/config/c.yaml'
+        "</parameters></plugin></gazebo></robot>"
+    )
+    (tmp_path / "s.yaml").write_text("name: s\nrobots:\n  - {name: r1, description: bot.xacro.urdf}\n")
+    plan, text = compile_with_notices(tmp_path / "s.yaml")
+    assert "cannot be read" not in text, text
+    assert [p.type for p in plan.robots[0].plugins if p.name == "joint_state_broadcaster"] == ["joint_states"]

@@ -4,6 +4,7 @@ summed up, and the model attached under the robot's namespace at its pose."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
@@ -147,14 +148,21 @@ def _needs_file(path: Path, doc: Document, where: PathKey, what: str, kind: str)
         )
 
 
+_SUBSTITUTION = re.compile(r"\$\((find|arg|env|optenv|eval|dirname|find-pkg-share)\b|\$\{[A-Za-z_]")
+
+
 def _looks_like_xacro(path: Path) -> bool:
     """A file whatever its name that uses xacro (launch files run xacro on `.urdf` files too: nav2's
-    sam_bot is one): it declares the xacro namespace or uses xacro elements."""
+    sam_bot is one): it declares the xacro namespace, uses xacro elements, is named `*.xacro.*`, or uses
+    xacro's substitutions alone (gz_ros2_control's demo `*.xacro.urdf` files have only `$(find ...)` in a
+    <parameters>, which its launch's xacro run resolves)."""
+    if ".xacro" in path.name:
+        return True
     try:
         text = path.read_text(encoding="utf-8", errors="replace")
     except OSError:
         return False
-    return "xmlns:xacro" in text or "<xacro:" in text
+    return "xmlns:xacro" in text or "<xacro:" in text or _SUBSTITUTION.search(text) is not None
 
 
 def robot_model(
