@@ -583,3 +583,19 @@ def test_a_remapping_names_a_controller_topic_as_rcl_expands_it(
     g = ReaderBase(etree.fromstring(b"<robot/>"), None, [], False, "r1", Notices())
     ctx = ControlContext(g, (None, None), {}, rules, ns, node="rosbot_base_controller")
     assert ctx.topic(topic) == expected
+
+
+def test_ros2_foxys_joint_state_controller_type_runs_as_the_broadcaster(tmp_path: Path) -> None:
+    """ROS 2 Foxy named the broadcaster `joint_state_controller/JointStateController` (a public arm's
+    controllers file still does): in a ROS 2 file it is the broadcaster, read with its parameters (it was
+    read with ROS 1's table, and compile stopped with a KeyError traceback)."""
+    control = """
+    controller_manager:
+      ros__parameters:
+        update_rate: 50
+        joint_state_controller:
+          type: joint_state_controller/JointStateController
+    """
+    plugins, said = _plugins(_write(tmp_path, {"control.yaml": control}))
+    assert plugins["joint_state_controller"].type == "joint_states", said  # type: ignore[attr-defined]
+    assert plugins["joint_state_controller"].params["rate"] == 50  # type: ignore[attr-defined]

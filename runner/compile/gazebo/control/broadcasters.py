@@ -7,7 +7,7 @@ from __future__ import annotations
 from typing import Any
 
 from runner.compile.gazebo.control import ControlContext, ControllerSpec, Handler
-from runner.compile.gazebo.control.params import check, line_of, read
+from runner.compile.gazebo.control.params import TABLES, check, line_of, read
 
 _STANDARD = ("position", "velocity", "effort")
 
@@ -91,10 +91,14 @@ def joint_state_broadcaster(ctx: ControlContext, spec: ControllerSpec) -> bool:
     `joint_states` (sensor_msgs/JointState: position, velocity, effort, NaN where a joint lacks one) and
     `dynamic_joint_states` (every interface by name), `~/` with `use_local_topics`; `extra_joints` with
     state 0; `frame_id` in the header. ROS 1 joint_state_controller: every joint, at `publish_rate`."""
-    check(ctx, spec)
-    p = read(spec)
     if spec.ros1:
-        return _joint_state_controller(ctx, spec, p)
+        check(ctx, spec)
+        return _joint_state_controller(ctx, spec, read(spec))
+    # ROS 2 Foxy's joint_state_controller/JointStateController in a ROS 2 file (`ros__parameters`) is the
+    # broadcaster before its rename (ros2_controllers foxy): read with the broadcaster's parameters
+    table = TABLES["joint_state_broadcaster/JointStateBroadcaster"]
+    check(ctx, spec, table)
+    p = read(spec, table)
     hardware = _hardware_joints(ctx)
     joints = [str(j) for j in p["joints"] or []]
     interfaces = [str(i) for i in p["interfaces"] or []]
