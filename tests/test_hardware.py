@@ -345,3 +345,18 @@ def test_a_damped_light_joint_follows_its_servo_as_gazebos_velocity_constraint_d
     states = [(t / 1e9, msg) for t, msg in messages(bus, "arm/joint_states")]
     at_1s = next(float(m.position[2]) for t, m in states if t >= 1.1)
     assert abs(at_1s - 0.3) < 0.01, f"the damped joint was at {at_1s:.3f} of 0.3 rad 1 s after the step"
+
+
+def test_gazebo_classic_sets_position_and_velocity_without_the_effort_limit(tmp_path: Path) -> None:
+    """gazebo_ros2_control (Gazebo classic) writes position commands with Joint::SetPosition and velocity
+    commands with Joint::SetVelocity (SetVelocityMaximal: no force, no force limit), where gz_ros2_control's
+    DART servo stops at the effort limit: the arm whose 60 N·m joints cannot hold its 200 N·m weight under
+    gz_ros2_control (test above) is held under the classic plugin, and its effort actuator keeps the limit."""
+    urdf = arm_urdf(effort=60.0, plugin="gazebo_ros2_control/GazeboSystem")
+    held, _ = hold_drift(arm_scenario(tmp_path, urdf, duration=1.0), 1.0)
+    assert held <= 0.005, f"the classic plugin's arm drifted {held:.3f} rad"
+    urdf = arm_urdf(effort=60.0, plugin="gazebo_ros2_control/GazeboSystem", interface="effort")
+    plan = plan_of(arm_scenario(tmp_path, urdf, duration=0.1))
+    m = World(plan, MemoryBus()).model
+    a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "arm/j0/effort")
+    assert list(m.actuator_forcerange[a]) == [-60.0, 60.0]  # SetForce is clamped to the limit there too

@@ -82,7 +82,12 @@ def add_hardware(
             # ROS 1's mechanicalReduction is not applied in Gazebo (transmissions.py): joint units
             act.gear = [1.0, 0, 0, 0, 0, 0]
             frc = list(joint.actfrcrange)
-            if frc[1] > frc[0]:  # URDF <limit effort>; none: unlimited, as Gazebo
+            if _kinematic(tr, mode):
+                # Gazebo classic sets the joint's position / velocity itself, whatever force it takes: no
+                # effort limit (the joint's own range would clamp this actuator too: lifted, and any other
+                # interface's actuator keeps the limit as its own)
+                joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_FALSE
+            elif frc[1] > frc[0]:  # URDF <limit effort>; none: unlimited, as Gazebo
                 act.forcelimited = True
                 act.forcerange = frc
             lo, hi = tr.limits.get(mode, (None, None))
@@ -146,6 +151,19 @@ def _mimic(spec: mujoco.MjSpec, tr: Transmission, notices: Notices) -> bool:
     data[0], data[1] = mimic.offset, mimic.multiplier  # q1 = offset + multiplier * q2
     spec.add_equality(type=mujoco.mjtEq.mjEQ_JOINT, name1=tr.joint, name2=mimic.joint, data=data)
     return True
+
+
+def _kinematic(tr: Transmission, mode: str) -> bool:
+    """Whether Gazebo sets the joint's state for this command kinematically, with no effort limit:
+    gazebo_ros2_control (classic, ROS 2) writes position commands with Joint::SetPosition and velocity
+    commands with Joint::SetVelocity (gazebo_system.cpp write(), humble :855-858), which Gazebo classic
+    implements as SetVelocityMaximal, "without applying forces" and not respecting force limits; ROS 1's
+    DefaultRobotHWSim sets a position without PID gains with SetPosition (its velocity goes through ODE's
+    "vel"/"fmax", the effort limit: limited). A public base's 6 N·m wheels stalled at 0.88 rad/s of their
+    command where Gazebo classic drives them at it."""
+    if tr.family == "classic":
+        return mode in ("position", "velocity")
+    return tr.family == "ros1" and mode == "position" and tr.pid is None
 
 
 def release_hardware(spec: mujoco.MjSpec, hardware: list[HardwareJoint]) -> None:
