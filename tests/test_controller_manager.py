@@ -599,3 +599,20 @@ def test_ros2_foxys_joint_state_controller_type_runs_as_the_broadcaster(tmp_path
     plugins, said = _plugins(_write(tmp_path, {"control.yaml": control}))
     assert plugins["joint_state_controller"].type == "joint_states", said  # type: ignore[attr-defined]
     assert plugins["joint_state_controller"].params["rate"] == 50  # type: ignore[attr-defined]
+
+
+def test_a_vendors_fork_of_a_controller_runs_as_its_parent_and_is_said(tmp_path: Path) -> None:
+    """Vendors copy a controller into a package of their own (Clearpath's
+    `clearpath_mecanum_drive_controller/MecanumDriveController`, a copy of ros2_controllers' mecanum
+    controller): same class, the parent's package name inside its own. It runs as the parent, said at
+    its line; a type that is no fork stays "not run"."""
+    control = """
+    controller_manager:
+      ros__parameters:
+        acme_joint_state_broadcaster.type: acme_joint_state_broadcaster/JointStateBroadcaster
+        other: {type: acme_controllers/JointStateBroadcasterish}
+    """
+    plugins, said = _plugins(_write(tmp_path, {"control.yaml": control}))
+    assert plugins["acme_joint_state_broadcaster"].type == "joint_states", said  # type: ignore[attr-defined]
+    assert "is run as joint_state_broadcaster/JointStateBroadcaster" in said and "control.yaml:3" in said, said
+    assert "'other' (acme_controllers/JointStateBroadcasterish) is not run" in said, said

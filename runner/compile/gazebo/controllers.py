@@ -20,6 +20,7 @@ replaces the earlier), ROS 1 files keep the later block (rosparam loads them wit
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,7 +29,7 @@ from typing import Any
 import yaml
 
 from runner.compile.gazebo.base import ReaderBase
-from runner.compile.gazebo.control import ControlContext, ControllerSpec, Remap, handler_for
+from runner.compile.gazebo.control import ControlContext, ControllerSpec, Remap, fork_of, handler_for
 from runner.compile.gazebo.control.params import Block
 from runner.compile.gazebo.info import Where
 from runner.compile.gazebo.tags import TagReader
@@ -424,6 +425,15 @@ def dispatch(ctx: ControlContext, specs: list[ControllerSpec]) -> int:
     count = 0
     for spec in specs:
         handler = handler_for(spec.type)
+        parent = fork_of(spec.type) if handler is None else None
+        if parent is not None:
+            ctx.g.notices.add(
+                f"controller {spec.name!r}: {spec.type} is run as {parent}, the controller it is a fork of; "
+                "parameters of the fork's own are said",
+                *spec.where,
+            )
+            spec = dataclasses.replace(spec, type=parent)
+            handler = handler_for(parent)
         if handler is None:
             ctx.g.notices.add(
                 f"ros_control controller {spec.name!r} ({spec.type}) is not run",

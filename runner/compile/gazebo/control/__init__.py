@@ -137,6 +137,21 @@ def handlers() -> dict[str, Handler]:
     return out
 
 
+def fork_of(type_name: str) -> str | None:
+    """The controller type a vendor's fork copies, by its class name and package: `clearpath_mecanum_drive_
+    controller/MecanumDriveController` is ros2_controllers' `mecanum_drive_controller/MecanumDriveController`
+    (a copy with extra parameters). None when no known type's package is part of this one's."""
+    name = type_name.strip().replace("::", "/")
+    if "/" not in name:
+        return None
+    package, cls = name.rsplit("/", 1)
+    for known in sorted(handlers(), key=len, reverse=True):
+        kpackage, kcls = known.rsplit("/", 1)
+        if kcls == cls and kpackage != package and kpackage in package:
+            return known
+    return None
+
+
 def handler_for(type_name: str) -> Handler | None:
     """The handler of a controller type, by its full name (`pkg/Class`); ROS 1's `pkg::Class` too."""
     found = handlers()
