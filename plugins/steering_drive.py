@@ -28,14 +28,19 @@ from plugins.diff_drive import _auto_gain, _wheel_radius
 from runner.plugin import BuildContext, Plugin, PluginConfigError, Topic
 from runner.wire import msgs
 
-Kinematics = Literal["ackermann", "bicycle", "tricycle"]
-_COUNTS = {"ackermann": (2, 2), "bicycle": (1, 1), "tricycle": (2, 1)}
+Kinematics = Literal["ackermann", "bicycle", "tricycle", "steered_traction"]
+# steered_traction: tricycle_controller's one wheel that both steers and drives (rear wheels passive)
+_COUNTS = {"ackermann": (2, 2), "bicycle": (1, 1), "tricycle": (2, 1), "steered_traction": (1, 1)}
 _MIN_PHI_DELTA = math.pi / 6.0  # reduce_wheel_speed_until_steering_reached (steering_kinematics.cpp)
 _MAX_PHI_DELTA = 1.5608
 
 
 class SteeringDriveParams(ReferenceParams):
-    kinematics: Kinematics = Field("ackermann", description="ackermann, bicycle or tricycle.")
+    kinematics: Kinematics = Field(
+        "ackermann",
+        description="ackermann, bicycle or tricycle (steering_controllers_library), or steered_traction "
+        "(tricycle_controller: one front wheel steers and drives, the rear wheels roll free).",
+    )
     traction_joints_names: list[str] = Field(
         ["rear_right_wheel_joint", "rear_left_wheel_joint"],
         min_length=1,
@@ -233,6 +238,10 @@ class SteeringDrive(Plugin):
             self.steer_pos = (right + left) * 0.5
         else:
             self.steer_pos = steer[0]
+        if p.kinematics == "steered_traction":  # tricycle_controller odometry.cpp update()
+            vs = vel[0] * self.radius
+            self.odom.update(vs * math.cos(self.steer_pos) * dt, vs * math.sin(self.steer_pos) / L * dt, dt)
+            return
         one = len(vel) == 1
         linear = vel[0] * self.radius if one else self._double_axle(vel[0], vel[1], self.steer_pos)
         angular = math.tan(self.steer_pos) * linear / L
@@ -253,6 +262,8 @@ class SteeringDrive(Plugin):
         L = self.wheelbase
         if p.angular_is_steering_angle:  # ackermann_steering_controller.cpp (Noetic) update()
             return [v / self.radius], [w]
+        if p.kinematics == "steered_traction":
+            return self._steered_traction(v, w)
         phi = math.atan(w * L / v) if v != 0 else 0.0
         if not math.isfinite(phi):
             phi = 0.0
@@ -278,6 +289,22 @@ class SteeringDrive(Plugin):
         side = self.track_s * math.sin(phi)
         return traction, [math.atan2(num, den + side), math.atan2(num, den - side)]
 
+    def _steered_traction(self, v: float, w: float) -> tuple[list[float], list[float]]:
+        """tricycle_controller.cpp twist_to_ackermann() and its speed reduction: the steered wheel's angle
+        and speed for (v, w), slowed while the wheel is far from that angle (cos of the error past 30°,
+        0.01 past 90°)."""
+        L = self.wheelbase
+        if v == 0.0:
+            if w == 0.0:  # convert_trans_rot_vel_to_steering_angle gives 0: it steers straight
+                return [0.0], [0.0]
+            alpha, ws = math.copysign(math.pi / 2, w), abs(w) * L / self.radius
+        else:
+            alpha = math.atan(w * L / v)
+            ws = v / (self.radius * math.cos(alpha))
+        delta = abs(alpha - self.steer_pos)
+        scale = 1.0 if delta < math.pi / 6 else 0.01 if delta > math.pi / 2 else math.cos(delta)
+        return [ws * scale], [alpha]
+
     def before_step(self, now_ns: int) -> None:
         p, d = self.params, self.ctx.data
         usable = reference_usable(self.command, p.reference_timeout, now_ns)
@@ -288,7 +315,9 @@ class SteeringDrive(Plugin):
             self._odometry((now_ns - last) / 1e9, v, w)
         if usable:
             self.traction_cmd, self.steering_cmd = self._commands(v, w)
-        elif p.angular_is_steering_angle:  # ROS 1: a stale command is zero, steering straight
+        elif p.angular_is_steering_angle or p.kinematics == "steered_traction":
+            # ROS 1, and tricycle_controller ("brake if cmd_vel has timeout"): a stale command is zero,
+            # steering straight
             self.traction_cmd, self.steering_cmd = [0.0] * len(self.t_act), [0.0] * len(self.s_act)
         else:  # no reference: the traction wheels stop, the steering stays where it was sent
             self.traction_cmd = [0.0] * len(self.t_act)

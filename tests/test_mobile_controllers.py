@@ -381,3 +381,44 @@ def test_a_controller_drive_reuses_the_hardwares_wheel_actuator_and_keeps_each_j
 
     assert built("joint") == {"hw/left": (-7.0, 7.0), "base/right": (-3.0, 3.0)}
     assert built(20.0) == {"hw/left": (-20.0, 20.0), "base/right": (-20.0, 20.0)}
+
+
+TRICYCLE = """
+controller_manager:
+  ros__parameters:
+    update_rate: 100
+    tricycle_controller: {type: tricycle_controller/TricycleController}
+tricycle_controller:
+  ros__parameters:
+    traction_joint_name: front_wheel_joint
+    steering_joint_name: front_steer_joint
+    wheelbase: 0.4
+    wheel_radius: 0.08
+    cmd_vel_timeout: 0.5
+    traction:
+      max_velocity: 10.0
+"""
+
+
+@pytest.mark.timeout(120)
+def test_a_tricycle_controller_steers_and_drives_its_one_front_wheel(tmp_path: Path):
+    """tricycle_controller/TricycleController (not the steering library's tricycle): the front wheel
+    steers and drives, the rear wheels roll free. 0.3 m/s and 0.3 rad/s on `tricycle_controller/cmd_vel`
+    (TwistStamped) ask for a 1.0 m radius: the front wheel is steered atan(w L / v) and spun
+    v / (r cos(alpha)) (twist_to_ackermann); the car turns on that radius within 10 %, its odometry
+    (`tricycle_controller/odom`) from the wheel follows it, and its limiter parameters are said."""
+    urdf = ackermann_car(control("CONTROL_YAML"), tricycle=True)
+    timeline = stream(0.5, 6.5, "tricycle_controller/cmd_vel", lin=0.3, ang=0.3, stamped=True)
+    path = write(tmp_path, urdf, TRICYCLE, 7.0, timeline, z=0.1)
+    _, said = compile_with_notices(path)
+    assert "`traction.max_velocity` is not run" in said, said
+    bus = simulate_bus(path)
+    t, pose = truth(bus)
+    a, b = np.searchsorted(t, 1.5), np.searchsorted(t, 6.5)
+    steps = np.linalg.norm(np.diff(pose[a:b, :2], axis=0), axis=1)
+    turned = float(pose[b, 2] - pose[a, 2])
+    radius = float(steps.sum()) / turned
+    assert abs(radius - 1.0) < 0.1, radius
+    assert turned > 1.2, turned  # 0.3 rad/s for 5 s: 1.5 rad asked
+    od = messages(bus, "r1/tricycle_controller/odom")
+    assert abs(yaw(od[-1][1].pose.pose.orientation) - float(pose[-1, 2])) < 0.15

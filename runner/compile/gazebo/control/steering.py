@@ -10,12 +10,14 @@ from runner.compile.gazebo.control import ControlContext, ControllerSpec, Handle
 from runner.compile.gazebo.control.mobile_params import (
     axis_limits,
     diagonal,
+    is_humble,
     limit_keys,
     number,
     odometry_params,
     reference,
     unknown,
 )
+from runner.compile.gazebo.control.params import flat
 
 _MECANUM_WHEELS = ("front_left", "front_right", "rear_right", "rear_left")
 _MECANUM = (
@@ -298,6 +300,54 @@ def _ros1_ackermann(ctx: ControlContext, spec: ControllerSpec) -> bool:
     return True
 
 
+def _tricycle_controller(ctx: ControlContext, spec: ControllerSpec) -> bool:
+    """tricycle_controller/TricycleController (ros2_controllers, Humble and Jazzy; not the steering library's
+    tricycle_steering_controller): one wheel that steers (`steering_joint_name`, position) and drives
+    (`traction_joint_name`, velocity), the rear wheels passive; `~/cmd_vel` (TwistStamped; Humble's
+    `use_stamped_vel: false`: Twist) in, `~/odom` out and `/tf` when `enable_odom_tf`
+    (tricycle_controller.cpp :36-40, twist_to_ackermann :566-583, odometry.cpp update :37-55)."""
+    p, name = spec.params, spec.name
+    traction, steering = param(p, "traction_joint_name"), param(p, "steering_joint_name")
+    if not traction or not steering:
+        ctx.say(spec, f"tricycle controller {name!r} names no traction_joint_name / steering_joint_name")
+        return False
+    stamped = not is_humble(p) or bool(param(p, "use_stamped_vel"))
+    timeout = number(param(p, "cmd_vel_timeout"))
+    odometry = odometry_params(ctx, spec)
+    params: dict[str, Any] = {
+        "kinematics": "steered_traction",
+        "traction_joints_names": [str(traction)],
+        "steering_joints_names": [str(steering)],
+        "wheelbase": number(param(p, "wheelbase")) or None,
+        "traction_wheels_radius": number(param(p, "wheel_radius")) or None,
+        "open_loop": bool(param(p, "open_loop")),
+        "velocity_rolling_window_size": int(param(p, "velocity_rolling_window_size") or 10),
+        "reference_timeout": timeout if timeout is not None else 0.5,
+        "reference_topic": ctx.topic(f"{name}/cmd_vel"),
+        "reference_type": "twist_stamped" if stamped else "twist",
+        **{k: v for k, v in odometry.items() if k not in ("odometry_topic", "tf_topic", "state_topic")},
+        "odometry_topic": ctx.topic(f"{name}/odom"),
+        "tf_topic": ctx.topic("tf"),
+        "state_topic": "",  # it publishes no controller state
+        "publish_rate": number(param(p, "publish_rate")),
+    }
+    known = {
+        "traction_joint_name", "steering_joint_name", "wheelbase", "wheel_radius", "open_loop",
+        "use_stamped_vel", "velocity_rolling_window_size", "cmd_vel_timeout", "odom_frame_id",
+        "base_frame_id", "enable_odom_tf", "pose_covariance_diagonal", "twist_covariance_diagonal",
+        "publish_rate",
+    }  # fmt: skip
+    said = {
+        "publish_ackermann_command": "~/cmd_ackermann (ackermann_msgs/AckermannDrive) is not published",
+        "odom_only_twist": "the pose is published too",
+    }
+    limiter = "the tricycle controller's speed limiter is not run"
+    said.update({k: limiter for k, _ in flat(p) if k.startswith(("traction.", "steering."))})
+    unknown(ctx, spec, known, said)
+    ctx.add(spec, "steering_drive", params)
+    return True
+
+
 def _four_wheel_steering(ctx: ControlContext, spec: ControllerSpec) -> bool:
     ctx.say(
         spec,
@@ -314,4 +364,5 @@ STEERING_HANDLERS: dict[str, Handler] = {
     "bicycle_steering_controller/BicycleSteeringController": _steering("bicycle"),
     "tricycle_steering_controller/TricycleSteeringController": _steering("tricycle"),
     "four_wheel_steering_controller/FourWheelSteeringController": _four_wheel_steering,
+    "tricycle_controller/TricycleController": _tricycle_controller,
 }
