@@ -616,3 +616,39 @@ def test_a_vendors_fork_of_a_controller_runs_as_its_parent_and_is_said(tmp_path:
     assert plugins["acme_joint_state_broadcaster"].type == "joint_states", said  # type: ignore[attr-defined]
     assert "is run as joint_state_broadcaster/JointStateBroadcaster" in said and "control.yaml:3" in said, said
     assert "'other' (acme_controllers/JointStateBroadcasterish) is not run" in said, said
+
+
+def test_spawn_runs_only_the_controllers_the_launch_spawns_and_controller_types_give_a_spawners_type(
+    tmp_path: Path,
+) -> None:
+    """A launch spawns some of a file's controllers (one `--inactive`, one not at all), and PAL's give a
+    controller's type only on the spawner's command line (`-t`): the robot's `spawn:` and
+    `controller_types:` say so. The others are said at their lines, a spawned name no file has at its
+    scenario line."""
+    control = """
+    controller_manager:
+      ros__parameters:
+        joint_state_broadcaster: {type: joint_state_broadcaster/JointStateBroadcaster}
+        forward_position_controller: {type: position_controllers/JointGroupPositionController}
+    forward_position_controller:
+      ros__parameters:
+        joints: [shoulder, elbow]
+    arm_controller:
+      ros__parameters:
+        joints: [shoulder, elbow]
+        command_interfaces: [position]
+        state_interfaces: [position, velocity]
+    """
+    path = _write(tmp_path, {"control.yaml": control}, params="control.yaml")
+    text = path.read_text().replace(
+        "    controllers: []\n",
+        "    spawn: [joint_state_broadcaster, arm_controller, gripper_controller]\n"
+        "    controller_types: {arm_controller: joint_trajectory_controller/JointTrajectoryController}\n",
+    )
+    path.write_text(text)
+    plugins, said = _plugins(path)
+    assert set(plugins) == {"joint_state_broadcaster", "arm_controller"}, said
+    assert plugins["arm_controller"].type == "joint_trajectory_controller"  # type: ignore[attr-defined]
+    assert "'forward_position_controller' is not spawned" in said and "control.yaml:4" in said, said
+    assert "`spawn:` names controller 'gripper_controller', which no controllers file has" in said, said
+    assert f"{path.name}:9" in said, said  # the scenario line of `spawn:`

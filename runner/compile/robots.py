@@ -14,6 +14,7 @@ from runner.checks import truth_robots
 from runner.checks.judge import TRUTH_RATE, TRUTH_TOPIC
 from runner.compile.filesize import HINT as SIZE_HINT
 from runner.compile.filesize import too_large
+from runner.compile.gazebo.info import Spawn
 from runner.compile.hardware import add_hardware, release_hardware, summary
 from runner.compile.packages import PackageMap
 from runner.compile.parity import summarize
@@ -130,6 +131,18 @@ def _welded_by_description(model: RobotModel, robot: Robot, i: int, doc: Documen
         )
 
 
+def _spawn(robot: Robot, i: int, doc: Document) -> Spawn:
+    """The robot's `spawn:` and `controller_types:`, with where each name is written (for notices)."""
+    where: dict[str, tuple[Path | None, int | None]] = {}
+    for k, name in enumerate(robot.spawn or []):
+        loc = doc.locate(("robots", i, "spawn", k))
+        where[name] = (loc.file, loc.line)
+    for name in robot.controller_types:
+        loc = doc.locate(("robots", i, "controller_types", name))
+        where.setdefault(name, (loc.file, loc.line))
+    return Spawn(robot.spawn, dict(robot.controller_types), where)
+
+
 def description_path(robot: Robot, base: Path) -> Path:
     return (base / robot.desc.file).resolve()
 
@@ -180,6 +193,7 @@ def robot_model(
         found = doc.base_dir / name
         _needs_file(found, doc, ("robots", i, "controllers", k), "controllers", "a ros_control YAML file")
         controllers.append(found)
+    spawn = _spawn(robot, i, doc)
     try:
         oversize = too_large(path)
         if oversize is not None:  # (before it is read or parsed; its includes: xacro_expand._cycle_guard)
@@ -199,6 +213,7 @@ def robot_model(
                 expanded=True,
                 timestep=timestep,
                 controllers=controllers,
+                spawn=spawn,
             )
         else:
             if robot.desc.args:
@@ -221,6 +236,7 @@ def robot_model(
                 notices=notices,
                 timestep=timestep,
                 controllers=controllers,
+                spawn=spawn,
             )
     except SourceError as e:
         where = Location(e.file, e.line) if e.file else doc.locate(file_path)

@@ -11,7 +11,7 @@ import re
 from pathlib import Path
 from typing import Any
 
-from runner.compile.gazebo.info import DescribedPlugin, GazeboInfo, Where
+from runner.compile.gazebo.info import DescribedPlugin, GazeboInfo, Spawn, Where
 from runner.compile.gazebo.tables import IGNORED_REASONS
 from runner.compile.gazebo.tags import TagReader, ros_topic
 from runner.compile.locate import Locator
@@ -35,6 +35,7 @@ class ReaderBase:
         self.namespace = namespace
         self.model = model or namespace  # the model's name in Gazebo: the robot's name in the scenario
         self.controller_files: list[Path] = []
+        self.spawn = Spawn()  # what the launch's spawners start (the scenario's `spawn:`)
         self.control_plugins: list[Any] = []  # the ros_control plugins (runner.compile.gazebo.controllers)
         self.notices = notices
         self.info = GazeboInfo()

@@ -264,6 +264,15 @@ def _ros2_specs(g: ReaderBase, files: list[_File], manager: str) -> tuple[list[C
                 )
             typed = [m for m in nodes if m.name == name and "type" in m.params][-1]  # the last one wins
             listed[name] = (kind, typed.file, typed.params.lines.get("type", typed.line))
+    for name, kind in g.spawn.types.items():  # a spawner's `-t <type>` (the scenario's controller_types:)
+        if name in listed and listed[name][0] != kind:
+            g.notices.add(
+                f"controller {name!r}: controller_types gives {kind}, the file {listed[name][0]}: the "
+                "spawner's -t wins",
+                *g.spawn.where.get(name, (None, None)),
+            )
+        file, line = (first[name].file, first[name].line) if name in first else (None, None)
+        listed[name] = (kind, file, line)
     for name, (kind, file, line) in listed.items():
         mine = own.get(name, Block())
         params = _merge(_copy(shared), mine)
@@ -421,9 +430,17 @@ def read_controllers(
 
 
 def dispatch(ctx: ControlContext, specs: list[ControllerSpec]) -> int:
-    """Each controller to the handler of its type; returns how many run."""
+    """Each controller to the handler of its type; returns how many run. With the scenario's `spawn:`, only
+    the controllers it names (what the launch's spawners start); the others are loaded by no spawner."""
     count = 0
+    spawn = ctx.g.spawn.names
     for spec in specs:
+        if spawn is not None and spec.name not in spawn:
+            ctx.g.notices.add(
+                f"controller {spec.name!r} is not spawned (the robot's `spawn:` leaves it out): not run",
+                *spec.where,
+            )
+            continue
         handler = handler_for(spec.type)
         parent = fork_of(spec.type) if handler is None else None
         if parent is not None:
@@ -464,6 +481,7 @@ def run_controller_files(g: ReaderBase) -> None:
     scenario_files = list(g.controller_files)
     if not plugins and not scenario_files:
         return
+    names: set[str] = set()
     if not plugins:
         plugins = [ControlPlugin((scenario_files[0], None), "")]
     for k, plugin in enumerate(plugins):
@@ -474,6 +492,7 @@ def run_controller_files(g: ReaderBase) -> None:
         paths = [p for p, _ in plugin.files] + (scenario_files if k == 0 else [])
         on_error = {path: unreadable(el) for path, el in plugin.files}
         specs = read_controllers(g, paths, plugin.manager, on_error)
+        names |= {s.name for s in specs}
         # the rules as written (`~/` kept) replace the plugin's remap table, which has lost the `~/`
         ctx = ControlContext(g, plugin.where, {}, plugin.rules, plugin.namespace)
         ran = dispatch(ctx, specs)
@@ -487,6 +506,14 @@ def run_controller_files(g: ReaderBase) -> None:
             hint="name the controllers file the robot's launch loads in the scenario (`controllers:`), or "
             "command joints with a `joint_controller` plugin",
         )
+    for name in g.spawn.names or []:
+        if name not in names:
+            g.notices.add(
+                f"`spawn:` names controller {name!r}, which no controllers file has: nothing is spawned "
+                "for it (the spawner would fail to load it)",
+                *g.spawn.where.get(name, (None, None)),
+                hint="controllers: " + ", ".join(sorted(names)) if names else None,
+            )
 
 
 def _ros_rules(r: TagReader) -> tuple[list[Remap], str]:

@@ -25,6 +25,17 @@ Where = tuple[Path | None, int | None]  # (file, line) of a tag in the user's fi
 
 
 @dataclass
+class Spawn:
+    """What a launch file's spawners start (the scenario's `spawn:` / `controller_types:`): the controllers
+    by name (None: every controller of the files, as a launch spawning them all), and the types a spawner
+    gives on its command line (`-t` / `--controller-type`), for files that have none."""
+
+    names: list[str] | None = None
+    types: dict[str, str] = field(default_factory=dict)
+    where: dict[str, Where] = field(default_factory=dict)  # a name's place in the scenario, for notices
+
+
+@dataclass
 class LinkProps:
     rgba: tuple[float, float, float, float] | None = None
     friction: float | None = None

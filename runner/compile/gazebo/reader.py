@@ -17,7 +17,7 @@ from lxml import etree
 
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.controllers import run_controller_files
-from runner.compile.gazebo.info import DescribedPlugin, GazeboInfo, LinkProps
+from runner.compile.gazebo.info import DescribedPlugin, GazeboInfo, LinkProps, Spawn
 from runner.compile.gazebo.model_plugins import read_model_plugin
 from runner.compile.gazebo.sensors import read_sensor
 from runner.compile.gazebo.tables import JOINT_LIST_PARAMS, JOINT_PARAMS
@@ -250,9 +250,11 @@ def read_gazebo(
     model: str | None = None,
     notices: Notices,
     controllers: list[Path] | None = None,
+    spawn: Spawn | None = None,
 ) -> GazeboInfo:
     reader = GazeboReader(root, file, sources or [], expanded, namespace, notices, model)
     reader.controller_files = list(controllers or [])
+    reader.spawn = spawn or Spawn()
     return reader.read()
 
 

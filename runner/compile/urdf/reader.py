@@ -15,6 +15,7 @@ import mujoco
 from lxml import etree
 
 from runner.compile.gazebo import GazeboInfo, parse, read_gazebo
+from runner.compile.gazebo.info import Spawn
 from runner.compile.locate import Locator
 from runner.compile.packages import PackageMap
 from runner.compile.urdf.checks import DescriptionError, check_numbers, check_structure, drop_empty_shapes
@@ -59,6 +60,7 @@ def urdf_to_model(
     expanded: bool = False,
     timestep: float = 0.002,
     controllers: list[Path] | None = None,
+    spawn: Spawn | None = None,
 ) -> RobotModel:
     notices = notices if notices is not None else Notices()
     base_dir = file.parent if file else Path.cwd()
@@ -86,6 +88,7 @@ def urdf_to_model(
         model=model or namespace,
         notices=notices,
         controllers=controllers,
+        spawn=spawn,
     )
     transmissions = read_transmissions(root, where, notices, controllers)
     vlimits = velocity_limits(root)

@@ -64,6 +64,17 @@ class Robot(Strict):
         "gazebo_ros_control), relative to the scenario: their diff drive and joint state controllers run "
         "as in Gazebo (`<controller>/cmd_vel`, `<controller>/odom`, `joint_states`).",
     )
+    spawn: list[str] | None = Field(
+        None,
+        description="The controllers the robot's launch file spawns, by name (default: every controller "
+        "of its controllers files). Those left out are not run, as a controller no spawner loads; one "
+        "spawned `--inactive` is left out too.",
+    )
+    controller_types: dict[str, str] = Field(
+        default_factory=dict,
+        description="Controller types a spawner gives on its command line (`-t` / `--controller-type`), by "
+        "controller name: for controllers files that give parameters but no `type:`.",
+    )
 
     @property
     def ns(self) -> str:
