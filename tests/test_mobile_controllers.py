@@ -422,3 +422,43 @@ def test_a_tricycle_controller_steers_and_drives_its_one_front_wheel(tmp_path: P
     assert turned > 1.2, turned  # 0.3 rad/s for 5 s: 1.5 rad asked
     od = messages(bus, "r1/tricycle_controller/odom")
     assert abs(yaw(od[-1][1].pose.pose.orientation) - float(pose[-1, 2])) < 0.15
+
+
+HUSARION_MECANUM = """
+/**/controller_manager:
+  ros__parameters:
+    update_rate: 25
+    base_controller: {type: mecanum_drive_controller/MecanumDriveController}
+/**/base_controller:
+  ros__parameters:
+    front_left_wheel_name: front_left_wheel_joint
+    front_right_wheel_name: front_right_wheel_joint
+    rear_left_wheel_name: rear_left_wheel_joint
+    rear_right_wheel_name: rear_right_wheel_joint
+    wheel_separation_x: 0.3
+    wheel_separation_y: 0.34
+    wheel_radius: 0.05
+    cmd_vel_timeout: 0.5
+    use_stamped_vel: false
+    linear:
+      y: {has_velocity_limits: true, max_velocity: 0.8}
+"""
+
+
+@pytest.mark.timeout(120)
+def test_husarions_mecanum_controller_of_the_same_type_name_is_told_apart_by_its_parameters(tmp_path: Path):
+    """Husarion's mecanum_drive_controller (ROSbot XL) has ros2_controllers' package and type name but
+    diff-drive-like parameters and topics: `~/cmd_vel_unstamped` (Twist, `use_stamped_vel: false`), `~/odom`.
+    Read as ros2_controllers' it failed to configure and the robot stood still; read as Husarion's it
+    strafes 0.2 m/s for 4.4 s (and its 0.5 s timeout) as asked."""
+    from bench.mobile import mecanum_robot
+
+    timeline = stream(0.5, 4.5, "base_controller/cmd_vel_unstamped", lin_y=0.2)
+    path = write(tmp_path, mecanum_robot(control("CONTROL_YAML")), HUSARION_MECANUM, 5.5, timeline, z=0.06)
+    _, said = compile_with_notices(path)
+    assert "read as Husarion's mecanum_drive_controller" in said, said
+    bus = simulate_bus(path)
+    t, pose = truth(bus)
+    moved = at(t, pose, 5.5) - pose[0]
+    assert abs(moved[1] - 0.88) < 0.06 and abs(moved[0]) < 0.03 and abs(moved[2]) < 0.05, moved
+    assert messages(bus, "r1/base_controller/odom")

@@ -50,6 +50,8 @@ def mecanum_drive_controller(ctx: ControlContext, spec: ControllerSpec) -> bool:
     `<name>/reference` in, `<name>/odometry`, `<name>/tf_odometry`, `<name>/controller_state` out at the
     controller manager's rate; wheel odometry from the wheels' velocities."""
     p, name = spec.params, spec.name
+    if param(p, "front_left_wheel_name") is not None:
+        return _husarion_mecanum(ctx, spec)
     joints = {w: param(p, f"{w}_wheel_command_joint_name") for w in _MECANUM_WHEELS}
     missing = [w for w, j in joints.items() if not j]
     if missing:
@@ -92,6 +94,70 @@ def mecanum_drive_controller(ctx: ControlContext, spec: ControllerSpec) -> bool:
         **odometry_params(ctx, spec),
     }
     unknown(ctx, spec, _MECANUM, {})
+    ctx.add(spec, "mecanum_drive", params)
+    return True
+
+
+def _husarion_mecanum(ctx: ControlContext, spec: ControllerSpec) -> bool:
+    """Husarion's mecanum_drive_controller (husarion_controllers; ROSbot XL), whose package and type name
+    are ros2_controllers' own: told apart by its diff-drive-like parameters (`front_left_wheel_name`,
+    `wheel_separation_x`/`_y`, `wheel_radius`). mecanum_drive_controller.cpp: `~/cmd_vel` (TwistStamped) or,
+    with `use_stamped_vel: false`, `~/cmd_vel_unstamped` (Twist) :38-39, braking `cmd_vel_timeout` after the
+    last; wheel speeds (vx -+ vy -+ (sep_x + sep_y) / 2 * wz) / r :248-253; `~/odom` and `/tf`."""
+    p, name = spec.params, spec.name
+    ctx.say(
+        spec,
+        f"mecanum drive {name!r}: read as Husarion's mecanum_drive_controller (same type name as "
+        "ros2_controllers'; its parameters are Husarion's)",
+    )
+    wheels = {
+        "front_left": "front_left_wheel_name",
+        "front_right": "front_right_wheel_name",
+        "rear_right": "rear_right_wheel_name",
+        "rear_left": "rear_left_wheel_name",
+    }
+    joints = {w: param(p, key) for w, key in wheels.items()}
+    if not all(joints.values()):
+        ctx.say(spec, f"mecanum drive {name!r} does not name its four wheels: not run")
+        return False
+    sep_x = (number(param(p, "wheel_separation_x")) or 0.0) * (
+        number(param(p, "wheel_separation_multiplier_x")) or 1.0
+    )
+    sep_y = (number(param(p, "wheel_separation_y")) or 0.0) * (
+        number(param(p, "wheel_separation_multiplier_y")) or 1.0
+    )
+    radius = (number(param(p, "wheel_radius")) or 0.0) * (number(param(p, "wheel_radius_multiplier")) or 1.0)
+    stamped = bool(param(p, "use_stamped_vel")) if param(p, "use_stamped_vel") is not None else True
+    timeout = number(param(p, "cmd_vel_timeout"))
+    odometry = odometry_params(ctx, spec)
+    params: dict[str, Any] = {
+        **{f"{w}_wheel_command_joint_name": str(j) for w, j in joints.items()},
+        "wheels_radius": radius or None,
+        "sum_of_robot_center_projection_on_X_Y_axis": (sep_x + sep_y) / 2 or None,
+        "reference_timeout": timeout if timeout is not None else 0.5,
+        "linear_x_limits": axis_limits(p, "linear.x", False),
+        "linear_y_limits": axis_limits(p, "linear.y", False),
+        "angular_z_limits": axis_limits(p, "angular.z", False),
+        "reference_topic": ctx.topic(f"{name}/cmd_vel" if stamped else f"{name}/cmd_vel_unstamped"),
+        "reference_type": "twist_stamped" if stamped else "twist",
+        **{k: v for k, v in odometry.items() if k not in ("odometry_topic", "tf_topic", "state_topic")},
+        "odometry_topic": ctx.topic(f"{name}/odom"),
+        "tf_topic": ctx.topic("tf"),
+        "state_topic": "",
+    }
+    known = set(wheels.values()) | {
+        "wheel_separation_x", "wheel_separation_y", "wheel_separation_multiplier_x",
+        "wheel_separation_multiplier_y", "wheel_radius", "wheel_radius_multiplier", "use_stamped_vel",
+        "cmd_vel_timeout", "odom_frame_id", "base_frame_id", "enable_odom_tf", "pose_covariance_diagonal",
+        "twist_covariance_diagonal", "publish_rate", "tf_frame_prefix_enable", "tf_frame_prefix",
+    } | limit_keys("linear.x") | limit_keys("linear.y") | limit_keys("angular.z")  # fmt: skip
+    said = {
+        "open_loop": "odometry comes from the wheels",
+        "position_feedback": "odometry comes from the wheels' velocities",
+        "velocity_rolling_window_size": "the odometry twist is not averaged",
+        "publish_limited_velocity": "~/cmd_vel_out is not published",
+    }
+    unknown(ctx, spec, known, said)
     ctx.add(spec, "mecanum_drive", params)
     return True
 
