@@ -360,3 +360,25 @@ def test_gazebo_classic_sets_position_and_velocity_without_the_effort_limit(tmp_
     m = World(plan, MemoryBus()).model
     a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "arm/j0/effort")
     assert list(m.actuator_forcerange[a]) == [-60.0, 60.0]  # SetForce is clamped to the limit there too
+
+
+def test_command_interface_min_max_apply_only_where_ros2_control_enforces_them(tmp_path: Path) -> None:
+    """Gazebo's systems never read a command interface's `min`/`max`; ros2_control clamps commands to them
+    only with the controller manager's `enforce_command_limits` (false by default on Humble and Jazzy). A
+    public base's wheels (max 1 rad/s) crawled at 0.09 m/s with them applied, where Gazebo drives them at
+    3 rad/s: not applied, said at their line; applied when the manager enforces them."""
+    urdf = arm_urdf(interface="velocity").replace(
+        '<joint name="j0"><command_interface name="velocity"/>',
+        '<joint name="j0"><command_interface name="velocity"><param name="min">-1</param>'
+        '<param name="max">1</param></command_interface>',
+    )
+    manager = "controller_manager:\n  ros__parameters:\n    update_rate: 100\n"
+    for enforce, expected in ((None, False), ("true", True)):
+        text = manager + (f"    enforce_command_limits: {enforce}\n" if enforce else "")
+        path = arm_scenario(tmp_path, urdf, duration=0.1, controllers=text)
+        plan, said = compile_with_notices(path)
+        m = World(plan, MemoryBus()).model
+        a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "arm/j0/velocity")
+        limited = bool(m.actuator_ctrllimited[a]) and list(m.actuator_ctrlrange[a]) == [-1.0, 1.0]
+        assert limited == expected, (enforce, list(m.actuator_ctrlrange[a]), said)
+        assert ("command min/max are not applied" in said) != expected, said

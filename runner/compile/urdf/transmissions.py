@@ -112,6 +112,9 @@ class _Settings:
     position_gain: float = POSITION_GAIN
     update_rate: float = UPDATE_RATE
     hold: bool = True
+    # controller_manager's enforce_command_limits: false on Humble (none) and Jazzy, true from Kilted
+    # (controller_manager_parameters.yaml): only then are a command interface's min/max applied
+    enforce_limits: bool = False
     pid: dict[str, dict[str, float]] = field(default_factory=dict)  # ROS 1: joint -> {p, i, d, ...}
     where_hold: tuple[Path | None, int | None] = (None, None)
 
@@ -127,6 +130,8 @@ def _walk(doc: Any, out: _Settings, path: tuple[str, ...] = ()) -> None:
             out.position_gain = float(value)
         elif k == "hold_joints" and value is False:
             out.hold = False
+        elif k == "enforce_command_limits" and "controller_manager" in path and isinstance(value, bool):
+            out.enforce_limits = value
         elif k == "pid_gains" and path and path[-1] == "gazebo_ros_control" and isinstance(value, dict):
             for joint, gains in value.items():
                 if isinstance(gains, dict):
@@ -320,8 +325,19 @@ def _joint(joint: Any, family: Family, where: Any, notices: Notices, s: _Setting
                 )
         lo = _number(cparams["min"].text) if "min" in cparams else None
         hi = _number(cparams["max"].text) if "max" in cparams else None
-        if lo is not None or hi is not None:
+        if (lo is not None or hi is not None) and s.enforce_limits:
             tr.limits[mode] = (lo, hi)
+        elif lo is not None or hi is not None:
+            # Gazebo's systems never read them (gz_system.cpp, gazebo_system.cpp); ros2_control clamps to them
+            # only with the manager's enforce_command_limits (default false on Humble and Jazzy): a public
+            # base's wheels, max 1 rad/s here, would crawl at 0.09 m/s where Gazebo drives them at 3 rad/s
+            notices.add(
+                f"joint {jname!r}: {raw} command min/max are not applied, as in Gazebo: ros2_control "
+                "enforces them only with the controller manager's enforce_command_limits (default false on "
+                "Humble and Jazzy, true from Kilted)",
+                *where(ci),
+                hint="set `enforce_command_limits: true` in controller_manager's ros__parameters",
+            )
     for si in joint.findall("state_interface"):
         sname = (si.get("name") or "").strip()
         tr.states.append(sname)
