@@ -35,6 +35,8 @@ class Hardware:
         self._limited: list[tuple[int, int, float, float]] = []  # (actuator, qpos adr, loop gain, vmax)
         self._target: np.ndarray = np.zeros(0)
         self._written: np.ndarray = np.zeros(0)
+        self._ff_dofs: np.ndarray = np.zeros(0, dtype=int)  # free-base held joints (`_feedforward`)
+        self._ff_limit: np.ndarray = np.zeros(0)
         self.active = False  # a position setpoint is held back by a velocity limit
         joints: list[tuple[RobotPlan, HardwareJoint, int]] = []
         for rp in robots:
@@ -47,6 +49,7 @@ class Hardware:
         self._start(joints)
         mujoco.mj_forward(model, data)
         self._gains(joints)
+        self._feedforward(joints)
 
     def _start(self, joints: list[tuple[RobotPlan, HardwareJoint, int]]) -> None:
         """gz_system.cpp: JointPositionReset / JointVelocityReset with the `initial_value`s."""
@@ -126,11 +129,48 @@ class Hardware:
         self._target = d.ctrl[self._acts].copy()
         self._written = self._target.copy()
 
+    def _feedforward(self, joints: list[tuple[RobotPlan, HardwareJoint, int]]) -> None:
+        """The position-held joints of a robot on a free base (a mobile manipulator; an arm Gazebo spawns
+        standing free). Their links' weight cannot go through MuJoCo's gravity compensation, which would
+        lift the base too (runner.compile.hardware's `_gravity` leaves them out); DART's servo constraint
+        holds them all the same. So their bias forces (gravity, and the arm's Coriolis terms) are applied
+        as joint torques on those joints only, within their effort limits, refreshed at every boundary:
+        the base carries the arm's weight through its joints as in Gazebo."""
+        m = self.m
+        dofs: list[int] = []
+        limits: list[float] = []
+        for rp, hj, jid in joints:
+            if rp.fixed or bool(m.jnt_actgravcomp[jid]) or "position" not in hj.actuators:
+                continue
+            if hj.pid is not None and not hj.pid.get("i", 0.0) > 0:
+                continue  # a PID without an integral term sags in Gazebo too
+            a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, rp.prefix + hj.actuators["position"])
+            if a < 0 or m.actuator_gear[a, 0] == 0:
+                continue
+            dofs.append(int(m.jnt_dofadr[jid]))
+            limited = bool(m.jnt_actfrclimited[jid]) or bool(m.actuator_forcelimited[a])
+            lim = (
+                float(m.jnt_actfrcrange[jid, 1])
+                if m.jnt_actfrclimited[jid]
+                else float(m.actuator_forcerange[a, 1])
+            )
+            limits.append(lim if limited else np.inf)
+        self._ff_dofs = np.array(dofs, dtype=int)
+        self._ff_limit = np.array(limits)
+        if dofs:
+            self._apply_feedforward()
+
+    def _apply_feedforward(self) -> None:
+        d = self.d
+        d.qfrc_applied[self._ff_dofs] = np.clip(d.qfrc_bias[self._ff_dofs], -self._ff_limit, self._ff_limit)
+
     def boundary(self, _now: int) -> None:
         """At every boundary, after the controllers' hooks (controls change only there): DART clips a servo's
         velocity setpoint to the joint's velocity limits, so a position servo's setpoint is kept within
         `vmax / loop_gain` of the joint and never asks for more. A control that differs from what this wrote
         last is a controller's new command. While a setpoint is held back, every step is a boundary."""
+        if len(self._ff_dofs):
+            self._apply_feedforward()
         if not self._limited:
             return
         d, acts = self.d, self._acts
