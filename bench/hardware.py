@@ -155,7 +155,7 @@ def run(quick: bool = False) -> tuple[dict[str, Any], str]:
         doc["drift"]["servo alone, no effort limit"] = drift
         rows.append(
             [
-                "  the servo alone, joints without an effort limit (50x the damping: nothing saturates)",
+                "  the servo alone, joints without an effort limit",
                 f"{drift:.1e} rad",
                 f"{drift / DRIFT_LIMIT:.3f}",
             ]

@@ -412,3 +412,65 @@ def test_an_arm_on_a_free_base_holds_its_pose_and_the_base_carries_its_weight(tm
         support += force[0]
     weight = float(sum(m.body_mass)) * 9.81
     assert abs(support / weight - 1.0) < 0.01, support / weight  # nothing lifts the base
+
+
+TRIKE = """<?xml version="1.0"?>
+<robot name="trike">
+  <link name="chassis">
+    <inertial><mass value="1"/><inertia ixx="0.1" iyy="0.4" izz="0.48" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="2 1 0.5"/></geometry></collision>
+  </link>
+  {rear}
+  <link name="steering_link">
+    <inertial><mass value="0.005"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
+  </link>
+  <joint name="steering_joint" type="continuous">
+    <parent link="chassis"/><child link="steering_link"/><origin xyz="0.9 0 -0.2"/><axis xyz="0 0 1"/>
+  </joint>
+  <link name="front_wheel">
+    <inertial><mass value="15"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin rpy="1.5708 0 0"/><geometry><cylinder radius="0.3" length="0.08"/></geometry></collision>
+  </link>
+  <joint name="traction_joint" type="continuous">
+    <parent link="steering_link"/><child link="front_wheel"/><axis xyz="0 1 0"/>
+  </joint>
+  <ros2_control name="trike" type="system">
+    <hardware><plugin>gz_ros2_control/GazeboSimSystem</plugin></hardware>
+    <joint name="steering_joint"><command_interface name="position"/><state_interface name="position"/></joint>
+    <joint name="traction_joint"><command_interface name="velocity"/><state_interface name="velocity"/></joint>
+  </ros2_control>
+</robot>
+"""
+
+
+def test_a_steering_step_without_an_effort_limit_turns_the_wheel_without_flinging_the_robot(
+    tmp_path: Path,
+) -> None:
+    """gz_ros2_control's demo tricycle: a 1 kg chassis, a 15 kg steered front wheel, no effort limits. A
+    1 rad steering command: DART's servo turns the wheel at its velocity setpoint (loop gain x error), the
+    force that takes within a step. A servo 50 times stiffer put kp x error = 129 kN·m into one step, which
+    the contact solver met in full: the robot was flung off the ground spinning at 10 rad/s."""
+    rear = "".join(
+        f'<link name="{s}_wheel"><inertial><mass value="2"/><inertia ixx="0.15" iyy="0.15" izz="0.125" '
+        'ixy="0" ixz="0" iyz="0"/></inertial><collision><origin rpy="1.5708 0 0"/><geometry>'
+        '<cylinder radius="0.3" length="0.08"/></geometry></collision></link>'
+        f'<joint name="{s}_wheel_joint" type="continuous"><parent link="chassis"/><child link="{s}_wheel"/>'
+        f'<origin xyz="-0.8 {y} -0.2"/><axis xyz="0 1 0"/></joint>'
+        for s, y in (("left", 0.5), ("right", -0.5))
+    )
+    (tmp_path / "trike.urdf").write_text(TRIKE.format(rear=rear))
+    path = tmp_path / "trike.yaml"
+    path.write_text(
+        "name: trike\nduration: 2.0\nrate: max\nrobots:\n  - name: r1\n    description: trike.urdf\n"
+        "    pose: {xyz: [0, 0, 0.52]}\n"
+        "    plugins: [{type: joint_controller, name: steer, params: {joints: [steering_joint]}},"
+        " {type: ground_truth, params: {rate: 100}}]\n"
+        "timeline:\n  - {t: 0.5, topic: r1/steer/command, type: std_msgs/msg/Float64, data: {data: 1.03}}\n"
+    )
+    bus = MemoryBus()
+    World(plan_of(path), bus).run()
+    truth = [m for _t, m in messages(bus, "r1/ground_truth")]
+    spin = max(abs(float(m.twist.twist.angular.z)) for m in truth)
+    lift = max(float(m.pose.pose.position.z) for m in truth[60:])
+    assert spin < 2.0, f"the chassis spun at {spin:.2f} rad/s"
+    assert lift < 0.6, f"the robot was thrown {lift:.2f} m up"

@@ -20,12 +20,16 @@ import numpy as np
 
 from runner.plan import HardwareJoint, RobotPlan
 
-# kv = SERVO_STEPS * inertia / timestep (bench/hardware.py). With an effort limit, a servo pushed to it
-# overshoots by up to limit * timestep / inertia in a step; past 1 its correction hits the opposite limit and
-# it chatters (measured: 28 rad/s against a 3.14 limit at 10). Without one nothing saturates and the
-# implicit damping is stable however high: 50 leaves 1/50 of the sag.
+# kv = SERVO_STEPS * inertia / timestep (bench/hardware.py): the force DART's servo constraint would apply
+# to reach its velocity setpoint within a step. With an effort limit, a servo pushed to it overshoots by up to
+# limit * timestep / inertia in a step; past 1 its correction hits the opposite limit and it chatters
+# (measured: 28 rad/s against a 3.14 limit at 10). Without one the implicit damping would stay stable
+# however high, but the position term stays explicit: at 50 x, a public tricycle's 1 rad steering step put
+# kp * error = 129 kN·m into one step, which the contact solver met in full (the robot was flung off the
+# ground at 12 m/s); at 1 x the steering turns at the loop's rate and the car drives off as in Gazebo. The
+# weight the servos hold goes through gravity compensation or feed-forward, not through their stiffness.
 SERVO_STEPS = 1.0
-SERVO_STEPS_UNLIMITED = 50.0
+SERVO_STEPS_UNLIMITED = 1.0
 PLACEHOLDER = 1e-9  # runner.compile.hardware's placeholder gains
 
 
