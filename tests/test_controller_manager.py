@@ -614,7 +614,9 @@ def test_a_vendors_fork_of_a_controller_runs_as_its_parent_and_is_said(tmp_path:
     """
     plugins, said = _plugins(_write(tmp_path, {"control.yaml": control}))
     assert plugins["acme_joint_state_broadcaster"].type == "joint_states", said  # type: ignore[attr-defined]
-    assert "is run as joint_state_broadcaster/JointStateBroadcaster" in said and "control.yaml:3" in said, said
+    assert "is run as joint_state_broadcaster/JointStateBroadcaster" in said and "control.yaml:3" in said, (
+        said
+    )
     assert "'other' (acme_controllers/JointStateBroadcasterish) is not run" in said, said
 
 
