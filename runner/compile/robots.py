@@ -161,14 +161,15 @@ def _needs_file(path: Path, doc: Document, where: PathKey, what: str, kind: str)
         )
 
 
-_SUBSTITUTION = re.compile(r"\$\((find|arg|env|optenv|eval|dirname|find-pkg-share)\b|\$\{[A-Za-z_]")
+_SUBSTITUTION = re.compile(r"\$\((find|arg|env|optenv|eval|dirname|find-pkg-share)\b")
 
 
 def _looks_like_xacro(path: Path) -> bool:
     """A file whatever its name that uses xacro (launch files run xacro on `.urdf` files too: nav2's
     sam_bot is one): it declares the xacro namespace, uses xacro elements, is named `*.xacro.*`, or uses
     xacro's substitutions alone (gz_ros2_control's demo `*.xacro.urdf` files have only `$(find ...)` in a
-    <parameters>, which its launch's xacro run resolves)."""
+    <parameters>, which its launch's xacro run resolves). A bare `${...}` does not count: in a plain URDF it
+    is more likely a value left unexpanded, said as such at its line."""
     if ".xacro" in path.name:
         return True
     try:
