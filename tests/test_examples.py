@@ -1,12 +1,16 @@
-"""Every scenario shipped in scenarios/ validates, and runs for a sim second through the real CLI."""
+"""Every scenario shipped in scenarios/ validates (the real CLI's command, in process). That each one runs,
+records and passes its assertions through the real CLI, in processes, is one `scenario test` over them all
+(tests/test_scenario_test.py::test_all_examples_pass_their_assertions_with_junit)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import pytest
+from typer.testing import CliRunner
 
-from tests.conftest import SCENARIOS, read_mcap, run_cli
+from runner.cli import app
+from tests.conftest import SCENARIOS
 
 EXAMPLES = sorted(SCENARIOS.glob("*.yaml"))
 
@@ -17,13 +21,7 @@ def test_there_are_examples():
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])
 @pytest.mark.timeout(60)
-def test_example_validates_and_runs(path: Path, tmp_path: Path):
-    proc = run_cli("validate", str(path))
-    assert proc.returncode == 0, proc.stderr
-    mcap = tmp_path / "out.mcap"
-    proc = run_cli(
-        "run", str(path), "--duration", "0.2", "--rate", "max", "--record", str(mcap), "--no-judge"
-    )
-    assert proc.returncode == 0, proc.stderr
-    # a matrix's variants record to out-0.mcap, out-1.mcap...
-    assert read_mcap(mcap if mcap.exists() else tmp_path / "out-0.mcap")
+def test_example_validates(path: Path):
+    result = CliRunner().invoke(app, ["validate", str(path)])
+    assert result.exit_code == 0, result.output
+    assert "Traceback" not in result.output

@@ -9,14 +9,21 @@ from pathlib import Path
 
 import pytest
 
-from tests.conftest import REPO, SCENARIOS, run_cli
+from tests.conftest import REPO, SCENARIOS, read_mcap, run_cli
 
 
 @pytest.mark.timeout(400)
 def test_all_examples_pass_their_assertions_with_junit(tmp_path: Path):
-    junit = tmp_path / "out.xml"
-    proc = run_cli("test", str(SCENARIOS), "-j", "2", "--no-record", "--junit", str(junit), timeout=380)
+    """Every example (and each variant of a matrix) runs through the real CLI in processes, two at a time,
+    records a file an independent decoder reads, and passes its assertions; the JUnit report says so."""
+    junit, out = tmp_path / "out.xml", tmp_path / "rec"
+    proc = run_cli("test", str(SCENARIOS), "-j", "2", "--out", str(out), "--junit", str(junit), timeout=380)
     assert proc.returncode == 0, proc.stdout + proc.stderr
+    recordings = sorted(out.rglob("*.mcap"))
+    recorded = {p.stem.split("[")[0].split("-")[0] for p in recordings}
+    assert {p.stem for p in SCENARIOS.glob("*.yaml")} <= recorded, (recorded, recordings)
+    for path in recordings:
+        assert read_mcap(path), path
     root = ET.parse(junit).getroot()
     assert root.tag == "testsuites"
     suites = root.findall("testsuite")
