@@ -654,3 +654,20 @@ def test_spawn_runs_only_the_controllers_the_launch_spawns_and_controller_types_
     assert "'forward_position_controller' is not spawned" in said and "control.yaml:4" in said, said
     assert "`spawn:` names controller 'gripper_controller', which no controllers file has" in said, said
     assert f"{path.name}:9" in said, said  # the scenario line of `spawn:`
+
+
+def test_a_launch_that_spawns_no_controller_is_said_as_such(tmp_path: Path) -> None:
+    """A public arm's Gazebo launch spawns no controller (`spawn: []`): its file's controllers are each
+    said as not spawned, and the plugin says why none runs (not that its files have none)."""
+    control = """
+    controller_manager:
+      ros__parameters:
+        joint_state_broadcaster: {type: joint_state_broadcaster/JointStateBroadcaster}
+    """
+    path = _write(tmp_path, {"control.yaml": control})
+    path.write_text(path.read_text().replace("    controllers: []\n", "    spawn: []\n"))
+    plugins, said = _plugins(path)
+    assert plugins == {}, said
+    assert "'joint_state_broadcaster' is not spawned" in said, said
+    assert "the robot's `spawn:` starts none of its controllers" in said, said
+    assert "yield no controller" not in said, said

@@ -498,11 +498,14 @@ def run_controller_files(g: ReaderBase) -> None:
         ran = dispatch(ctx, specs)
         if ran or plugin.el is None:
             continue
+        if g.spawn.names is not None and specs:
+            why = " (the robot's `spawn:` starts none of its controllers)"
+        else:
+            why = " (its <parameters> files yield no controller we run)" if plugin.files else ""
         g.note(
             plugin.el,
-            f"{plugin.filename!r}: ros_control controllers are not run"
-            + (" (its <parameters> files yield no controller we run)" if plugin.files else "")
-            + "; transmissions became MuJoCo actuators",
+            f"{plugin.filename!r}: ros_control controllers are not run{why}; the hardware holds its joints "
+            "where they start, as Gazebo's system holds joints no controller claims",
             hint="name the controllers file the robot's launch loads in the scenario (`controllers:`), or "
             "command joints with a `joint_controller` plugin",
         )
