@@ -12,11 +12,12 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 from pydantic import Field
 
-from runner.plugin import PluginParams
+from plugins._common import OdometryWriter, TransformWriter
+from runner.plugin import Plugin, PluginParams, Topic
 
 CommandType = Literal["twist", "twist_stamped"]
 COMMAND_TYPES = {"twist": "geometry_msgs/msg/Twist", "twist_stamped": "geometry_msgs/msg/TwistStamped"}
@@ -217,3 +218,69 @@ def reference_usable(cmd: Command, timeout: float, now_ns: int) -> bool:
         fresh, cmd.fresh = cmd.fresh, False
         return fresh
     return cmd.age_s(now_ns) <= timeout
+
+
+class ReferenceDrive(Plugin):
+    """What mecanum_drive_controller and the steering controllers run alike (`ReferenceParams`): their rates,
+    the reference they subscribe, and the odometry, TF and controller state they publish. A subclass names
+    its state message (`STATE_TYPE`) and the covariances it publishes when none are given."""
+
+    STATE_TYPE: ClassVar[str] = ""
+    COVARIANCE_DEFAULT: ClassVar[list[float] | None] = None  # None: zeros (OdometryWriter's)
+
+    @classmethod
+    def rate_of(cls, params: Any) -> float | None:
+        return float(params.publish_rate or params.update_rate or 100.0)
+
+    @classmethod
+    def control_rate_of(cls, params: Any) -> float | None:
+        return float(params.update_rate or 100.0)
+
+    @classmethod
+    def reference_topics(cls, params: Any, name: str) -> list[Topic]:
+        """The reference it takes and what it publishes, with their defaults under `<name>/`."""
+        rate = cls.rate_of(params)
+        topics = [
+            Topic(params.reference_topic or f"{name}/reference", COMMAND_TYPES[params.reference_type], "sub"),
+            Topic(params.odometry_topic or f"{name}/odometry", "nav_msgs/msg/Odometry", "pub", rate),
+        ]
+        if params.enable_odom_tf:
+            topics.append(
+                Topic(params.tf_topic or f"{name}/tf_odometry", "tf2_msgs/msg/TFMessage", "pub", rate)
+            )
+        if params.state_topic != "":
+            topics.append(
+                Topic(params.state_topic or f"{name}/controller_state", cls.STATE_TYPE, "pub", rate)
+            )
+        return topics
+
+    def setup_reference(self) -> None:
+        """Subscribe the reference (`self.command`) and make the odometry, TF and state publishers."""
+        p, r = self.params, self.ctx.robot  # type: ignore[attr-defined]
+        self.command = Command(p.reference_type == "twist_stamped")
+        self.ctx.subscribe(
+            p.reference_topic or f"{self.name}/reference", COMMAND_TYPES[p.reference_type], self.command.take
+        )
+        odom, base_frame = p.odom_frame_id or r.frame("odom"), p.base_frame_id or r.frame(r.root_link)
+        default = self.COVARIANCE_DEFAULT
+        self.odom_out = OdometryWriter(
+            self.ctx.publisher(p.odometry_topic or f"{self.name}/odometry", "nav_msgs/msg/Odometry"),
+            odom,
+            base_frame,
+            p.pose_covariance_diagonal or default,
+            p.twist_covariance_diagonal or default,
+        )
+        self.tf_out = (
+            TransformWriter(
+                self.ctx.publisher(p.tf_topic or f"{self.name}/tf_odometry", "tf2_msgs/msg/TFMessage"),
+                odom,
+                base_frame,
+            )
+            if p.enable_odom_tf
+            else None
+        )
+        self.state_pub = (
+            self.ctx.publisher(p.state_topic or f"{self.name}/controller_state", self.STATE_TYPE)
+            if p.state_topic != ""
+            else None
+        )

@@ -25,18 +25,16 @@ import numpy as np
 from pydantic import Field, PositiveFloat
 
 from plugins._actuators import claim_actuator, find_actuator
-from plugins._common import OdometryWriter, TransformWriter
 from plugins._mobile import (
-    COMMAND_TYPES,
     AxisLimits,
-    Command,
+    ReferenceDrive,
     ReferenceParams,
     SpeedLimiter,
     reference_usable,
 )
 from plugins.diff_drive import _auto_gain, _wheel_radius
 from runner.geometry import wheel_radius
-from runner.plugin import BuildContext, Plugin, PluginConfigError, Topic
+from runner.plugin import BuildContext, PluginConfigError, Topic
 from runner.wire import msgs
 
 WHEELS = ("front_left", "front_right", "rear_right", "rear_left")  # the controller's order
@@ -180,17 +178,11 @@ def _add_rollers(ctx: BuildContext, name: str, joints: list[Any]) -> None:
             )
 
 
-class MecanumDrive(Plugin):
+class MecanumDrive(ReferenceDrive):
     Params = MecanumDriveParams
     params: MecanumDriveParams
-
-    @classmethod
-    def rate_of(cls, params: Any) -> float | None:
-        return float(params.publish_rate or params.update_rate or 100.0)
-
-    @classmethod
-    def control_rate_of(cls, params: Any) -> float | None:
-        return float(params.update_rate or 100.0)
+    STATE_TYPE = "control_msgs/msg/MecanumDriveControllerState"
+    COVARIANCE_DEFAULT = [0.1] * 6
 
     @classmethod
     def build(cls, params: MecanumDriveParams, ctx: BuildContext, name: str) -> list[Topic]:
@@ -207,19 +199,7 @@ class MecanumDrive(Plugin):
             _add_rollers(ctx, name, joints)
         for joint in joints:
             claim_actuator(ctx.spec, name, joint, "velocity", max_effort=params.max_wheel_torque)
-        rate = cls.rate_of(params)
-        topics = [
-            Topic(params.reference_topic or f"{name}/reference", COMMAND_TYPES[params.reference_type], "sub"),
-            Topic(params.odometry_topic or f"{name}/odometry", "nav_msgs/msg/Odometry", "pub", rate),
-        ]
-        if params.enable_odom_tf:
-            topics.append(
-                Topic(params.tf_topic or f"{name}/tf_odometry", "tf2_msgs/msg/TFMessage", "pub", rate)
-            )
-        if params.state_topic != "":
-            state = params.state_topic or f"{name}/controller_state"
-            topics.append(Topic(state, "control_msgs/msg/MecanumDriveControllerState", "pub", rate))
-        return topics
+        return cls.reference_topics(params, name)
 
     def setup(self) -> None:
         p = self.params
@@ -250,39 +230,11 @@ class MecanumDrive(Plugin):
             SpeedLimiter(lim) if lim else None
             for lim in (p.linear_x_limits, p.linear_y_limits, p.angular_z_limits)
         ]
-        self.command = Command(p.reference_type == "twist_stamped")
-        self.ctx.subscribe(
-            p.reference_topic or f"{self.name}/reference", COMMAND_TYPES[p.reference_type], self.command.take
-        )
         self.x = self.y = self.heading = 0.0
         self.vel = (0.0, 0.0, 0.0)
         self.reference = (math.nan, math.nan, math.nan)
         self.last_ns: int | None = None
-        odom, base_frame = p.odom_frame_id or r.frame("odom"), p.base_frame_id or r.frame(r.root_link)
-        self.odom_out = OdometryWriter(
-            self.ctx.publisher(p.odometry_topic or f"{self.name}/odometry", "nav_msgs/msg/Odometry"),
-            odom,
-            base_frame,
-            p.pose_covariance_diagonal if p.pose_covariance_diagonal else [0.1] * 6,
-            p.twist_covariance_diagonal if p.twist_covariance_diagonal else [0.1] * 6,
-        )
-        self.tf_out = (
-            TransformWriter(
-                self.ctx.publisher(p.tf_topic or f"{self.name}/tf_odometry", "tf2_msgs/msg/TFMessage"),
-                odom,
-                base_frame,
-            )
-            if p.enable_odom_tf
-            else None
-        )
-        self.state_pub = (
-            self.ctx.publisher(
-                p.state_topic or f"{self.name}/controller_state",
-                "control_msgs/msg/MecanumDriveControllerState",
-            )
-            if p.state_topic != ""
-            else None
-        )
+        self.setup_reference()
 
     def _odometry(self, dt: float) -> None:
         """mecanum_drive_controller's Odometry::update, from the wheels' velocities."""

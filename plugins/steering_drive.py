@@ -15,17 +15,16 @@ URDF effort limits kept), else through actuators of ours with the joint's own li
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from typing import Literal
 
 import mujoco
 import numpy as np
 from pydantic import Field, PositiveFloat
 
 from plugins._actuators import auto_gains, claim_actuator, find_actuator
-from plugins._common import OdometryWriter, TransformWriter
-from plugins._mobile import COMMAND_TYPES, Command, PlanarOdometry, ReferenceParams, reference_usable
+from plugins._mobile import PlanarOdometry, ReferenceDrive, ReferenceParams, reference_usable
 from plugins.diff_drive import _auto_gain, _wheel_radius
-from runner.plugin import BuildContext, Plugin, PluginConfigError, Topic
+from runner.plugin import BuildContext, PluginConfigError, Topic
 from runner.wire import msgs
 
 Kinematics = Literal["ackermann", "bicycle", "tricycle", "steered_traction"]
@@ -78,17 +77,10 @@ class SteeringDriveParams(ReferenceParams):
     )
 
 
-class SteeringDrive(Plugin):
+class SteeringDrive(ReferenceDrive):
     Params = SteeringDriveParams
     params: SteeringDriveParams
-
-    @classmethod
-    def rate_of(cls, params: Any) -> float | None:
-        return float(params.publish_rate or params.update_rate or 100.0)
-
-    @classmethod
-    def control_rate_of(cls, params: Any) -> float | None:
-        return float(params.update_rate or 100.0)
+    STATE_TYPE = "control_msgs/msg/SteeringControllerStatus"
 
     @classmethod
     def build(cls, params: SteeringDriveParams, ctx: BuildContext, name: str) -> list[Topic]:
@@ -106,25 +98,7 @@ class SteeringDrive(Plugin):
                     raise PluginConfigError(f"joint {jname!r} is not revolute/continuous", key)
                 max_effort = params.max_wheel_torque if mode == "velocity" else None
                 claim_actuator(ctx.spec, name, joint, mode, max_effort=max_effort)  # type: ignore[arg-type]
-        rate = cls.rate_of(params)
-        topics = [
-            Topic(params.reference_topic or f"{name}/reference", COMMAND_TYPES[params.reference_type], "sub"),
-            Topic(params.odometry_topic or f"{name}/odometry", "nav_msgs/msg/Odometry", "pub", rate),
-        ]
-        if params.enable_odom_tf:
-            topics.append(
-                Topic(params.tf_topic or f"{name}/tf_odometry", "tf2_msgs/msg/TFMessage", "pub", rate)
-            )
-        if params.state_topic != "":
-            topics.append(
-                Topic(
-                    params.state_topic or f"{name}/controller_state",
-                    "control_msgs/msg/SteeringControllerStatus",
-                    "pub",
-                    rate,
-                )
-            )
-        return topics
+        return cls.reference_topics(params, name)
 
     def setup(self) -> None:
         p = self.params
@@ -179,42 +153,11 @@ class SteeringDrive(Plugin):
         self.last_t_q = [float(d.qpos[q]) for q in self.t_q]
         self.odom = PlanarOdometry(p.velocity_rolling_window_size)
         self.last_ns: int | None = None
-        self.command = Command(p.reference_type == "twist_stamped")
-        self.ctx.subscribe(
-            p.reference_topic or f"{self.name}/reference", COMMAND_TYPES[p.reference_type], self.command.take
-        )
         self.traction_cmd = [0.0] * len(self.t_joints)
         self.steering_cmd = [float(d.qpos[q]) for q in self.s_q]
         for a, q in zip(self.s_act, self.steering_cmd, strict=True):
             d.ctrl[a] = q
-        self._setup_io()
-
-    def _setup_io(self) -> None:
-        p, r = self.params, self.ctx.robot
-        odom, base_frame = p.odom_frame_id or r.frame("odom"), p.base_frame_id or r.frame(r.root_link)
-        self.odom_out = OdometryWriter(
-            self.ctx.publisher(p.odometry_topic or f"{self.name}/odometry", "nav_msgs/msg/Odometry"),
-            odom,
-            base_frame,
-            p.pose_covariance_diagonal,
-            p.twist_covariance_diagonal,
-        )
-        self.tf_out = (
-            TransformWriter(
-                self.ctx.publisher(p.tf_topic or f"{self.name}/tf_odometry", "tf2_msgs/msg/TFMessage"),
-                odom,
-                base_frame,
-            )
-            if p.enable_odom_tf
-            else None
-        )
-        self.state_pub = (
-            self.ctx.publisher(
-                p.state_topic or f"{self.name}/controller_state", "control_msgs/msg/SteeringControllerStatus"
-            )
-            if p.state_topic != ""
-            else None
-        )
+        self.setup_reference()
 
     def _odometry(self, dt: float, v_ref: float, w_ref: float) -> None:
         """update_odometry of each steering controller (steering_kinematics.cpp)."""
