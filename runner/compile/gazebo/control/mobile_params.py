@@ -154,3 +154,14 @@ def odometry_params(ctx: ControlContext, spec: ControllerSpec) -> dict[str, Any]
         "twist_covariance_diagonal": diagonal(p, "twist_covariance_diagonal"),
         "update_rate": number(spec.update_rate),
     }
+
+
+def diff_drive_style_outputs(ctx: ControlContext, spec: ControllerSpec) -> dict[str, Any]:
+    """`odometry_params` for a controller laid out as diff_drive_controller is (Husarion's mecanum,
+    tricycle_controller): `~/odom` and `/tf`, and no controller state."""
+    return {
+        **odometry_params(ctx, spec),
+        "odometry_topic": ctx.topic(f"{spec.name}/odom"),
+        "tf_topic": ctx.topic("tf"),
+        "state_topic": "",
+    }

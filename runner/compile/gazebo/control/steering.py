@@ -10,6 +10,7 @@ from runner.compile.gazebo.control import ControlContext, ControllerSpec, Handle
 from runner.compile.gazebo.control.mobile_params import (
     axis_limits,
     diagonal,
+    diff_drive_style_outputs,
     is_humble,
     limit_keys,
     number,
@@ -129,7 +130,6 @@ def _husarion_mecanum(ctx: ControlContext, spec: ControllerSpec) -> bool:
     radius = (number(param(p, "wheel_radius")) or 0.0) * (number(param(p, "wheel_radius_multiplier")) or 1.0)
     stamped = bool(param(p, "use_stamped_vel")) if param(p, "use_stamped_vel") is not None else True
     timeout = number(param(p, "cmd_vel_timeout"))
-    odometry = odometry_params(ctx, spec)
     params: dict[str, Any] = {
         **{f"{w}_wheel_command_joint_name": str(j) for w, j in joints.items()},
         "wheels_radius": radius or None,
@@ -140,10 +140,7 @@ def _husarion_mecanum(ctx: ControlContext, spec: ControllerSpec) -> bool:
         "angular_z_limits": axis_limits(p, "angular.z", False),
         "reference_topic": ctx.topic(f"{name}/cmd_vel" if stamped else f"{name}/cmd_vel_unstamped"),
         "reference_type": "twist_stamped" if stamped else "twist",
-        **{k: v for k, v in odometry.items() if k not in ("odometry_topic", "tf_topic", "state_topic")},
-        "odometry_topic": ctx.topic(f"{name}/odom"),
-        "tf_topic": ctx.topic("tf"),
-        "state_topic": "",
+        **diff_drive_style_outputs(ctx, spec),
     }
     known = set(wheels.values()) | {
         "wheel_separation_x", "wheel_separation_y", "wheel_separation_multiplier_x",
@@ -379,7 +376,6 @@ def _tricycle_controller(ctx: ControlContext, spec: ControllerSpec) -> bool:
         return False
     stamped = not is_humble(p) or bool(param(p, "use_stamped_vel"))
     timeout = number(param(p, "cmd_vel_timeout"))
-    odometry = odometry_params(ctx, spec)
     params: dict[str, Any] = {
         "kinematics": "steered_traction",
         "traction_joints_names": [str(traction)],
@@ -391,10 +387,7 @@ def _tricycle_controller(ctx: ControlContext, spec: ControllerSpec) -> bool:
         "reference_timeout": timeout if timeout is not None else 0.5,
         "reference_topic": ctx.topic(f"{name}/cmd_vel"),
         "reference_type": "twist_stamped" if stamped else "twist",
-        **{k: v for k, v in odometry.items() if k not in ("odometry_topic", "tf_topic", "state_topic")},
-        "odometry_topic": ctx.topic(f"{name}/odom"),
-        "tf_topic": ctx.topic("tf"),
-        "state_topic": "",  # it publishes no controller state
+        **diff_drive_style_outputs(ctx, spec),  # it publishes no controller state
         "publish_rate": number(param(p, "publish_rate")),
     }
     known = {
