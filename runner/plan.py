@@ -18,6 +18,16 @@ class TopicPlan(BaseModel):
     owner: str = ""  # e.g. r1/lidar
 
 
+class ServicePlan(BaseModel):
+    """A service (`kind="service"`, `type` pkg/srv/Name) or an action server (`kind="action"`, `type`
+    pkg/action/Name) the world answers; an action's services and topics are under `<key>/_action/`."""
+
+    key: str  # full Zenoh key, e.g. arm/arm_controller/follow_joint_trajectory
+    type: str
+    kind: Literal["service", "action"] = "service"
+    owner: str = ""  # e.g. arm/arm_controller, or `world`
+
+
 class PluginPlan(BaseModel):
     type: str
     name: str
@@ -25,6 +35,7 @@ class PluginPlan(BaseModel):
     rate: float | None
     control_rate: float | None = None  # how often before_step runs, when not at `rate`
     topics: list[TopicPlan] = []
+    services: list[ServicePlan] = []
     source_file: str | None = None  # where the description declares it (a Gazebo <plugin> or <sensor>)
     source_line: int | None = None
     added: str | None = None  # not declared, added by the runner, and why (`foxglove.scene`)
@@ -187,6 +198,7 @@ class RunPlan(BaseModel):
     foxglove: FoxglovePlan = FoxglovePlan()  # what the world publishes for a 3D view
     best_effort: list[str] = []  # key expressions whose publishers drop rather than block (qos:)
     bridges: list[BridgePlan] = []  # run by the bridge process (a node of the run)
+    world_services: list[ServicePlan] = []  # the world's own (simulation control), beside the plugins'
     ros2: Ros2Plan | None = None  # the run's rmw_zenoh settings, when it appears to ROS 2 as a whole
     # Several worlds: each its own plan, named `<run>/<world>` (so its keys are `<run>/<world>/<ns>/...`),
     # run by a process of its own; this plan then holds the run-wide parts (record, nodes, stop_on).
@@ -226,6 +238,10 @@ class RunPlan(BaseModel):
     @property
     def clock_key(self) -> str:
         return f"{self.name}/clock"
+
+    def services(self) -> list[ServicePlan]:
+        """Every service and action server of this world: its own, then its plugins', in plan order."""
+        return [*self.world_services, *(s for r in self.robots for p in r.plugins for s in p.services)]
 
     def topics(self) -> list[TopicPlan]:
         """Every topic of the run, once per key and direction; a key several plugins publish on (a

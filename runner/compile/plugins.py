@@ -12,12 +12,13 @@ from pydantic import ValidationError
 from runner.compile.gazebo import DescribedPlugin
 from runner.compile.urdf import RobotModel
 from runner.errors import Location, Problem, Problems, ScenarioError
-from runner.plan import PluginPlan, TopicPlan
-from runner.plugin import BuildContext, PluginConfigError
+from runner.plan import PluginPlan, ServicePlan, TopicPlan
+from runner.plugin import BuildContext, PluginConfigError, Service, Topic
 from runner.plugin.registry import PluginLookupError, drive_frames, load
 from runner.scenario.loader import Document, PathKey, non_finite
 from runner.scenario.schema import Robot, Scenario
 from runner.scenario.validate import validate_model
+from runner.wire import interfaces
 from runner.wire.transport import topic_key
 
 
@@ -128,30 +129,62 @@ def build_plugins(
                 topics = cls.build(params, ctx, entry.name)
             except PluginConfigError as e:
                 raise fail(str(e), e.param, e.hint) from None
-            rate = cls.rate_of(params)
+            declared = list(topics)
+            bad = _check_services(declared)
+            if bad is not None:
+                raise fail(f"the plugin offers a service of an unknown type: {bad}", None, None)
             plans.append(
                 PluginPlan(
                     type=entry.type,
                     name=entry.name,
                     params=params.model_dump(mode="json"),
-                    rate=rate,
+                    rate=cls.rate_of(params),
                     control_rate=cls.control_rate_of(params),
                     source_file=str(src.file) if src is not None and src.file else None,
                     source_line=src.line if src is not None else None,
                     added=entry.added,
-                    topics=[
-                        TopicPlan(
-                            key=topic_key(sc.name, robot.ns, t.name),
-                            type=t.type,
-                            rate=t.rate,
-                            direction=t.direction,
-                            owner=f"{robot.ns}/{entry.name}",
-                        )
-                        for t in topics
-                    ],
+                    **_endpoints(declared, sc.name, robot.ns, f"{robot.ns}/{entry.name}"),
                 )
             )
     return plans
+
+
+def _endpoints(declared: list[Any], run: str, ns: str, owner: str) -> dict[str, Any]:
+    """A plugin's topics and services, as its plan holds them (an action's topics among the topics)."""
+    services = [
+        ServicePlan(key=topic_key(run, ns, s.name), type=s.type, kind=s.kind, owner=owner)
+        for s in declared
+        if isinstance(s, Service)
+    ]
+    topics = [
+        TopicPlan(
+            key=topic_key(run, ns, t.name), type=t.type, rate=t.rate, direction=t.direction, owner=owner
+        )
+        for t in declared
+        if isinstance(t, Topic)
+    ]
+    return {"topics": topics + action_topics(services), "services": services}
+
+
+def action_topics(services: list[ServicePlan]) -> list[TopicPlan]:
+    """The topics of each action server (rcl_action's `_action/feedback` and `_action/status`)."""
+    out = []
+    for s in services:
+        if s.kind == "action":
+            for suffix, type_name in interfaces.action_parts(s.type)[1]:
+                out.append(TopicPlan(key=f"{s.key}/{suffix}", type=type_name, direction="pub", owner=s.owner))
+    return out
+
+
+def _check_services(declared: list[Any]) -> str | None:
+    """What is wrong with the services a plugin's `build` declared (a type nobody knows), or None."""
+    for s in declared:
+        if isinstance(s, Service):
+            try:
+                (interfaces.action_type if s.kind == "action" else interfaces.service_type)(s.type)
+            except KeyError as e:
+                return f"{s.name}: {e.args[0]}"
+    return None
 
 
 def _check_finite(entry: _Entry, doc: Document, here: PathKey, fail: Any) -> None:

@@ -171,6 +171,8 @@ class Bridge:
                 rel = e.key[len(self.run) + 1 :] if e.key.startswith(self.run + "/") else ""
                 if graph.processes.get(e.process) != "node" or not rel or hidden_topic(rel) or "*" in rel:
                     continue
+                if e.kind not in ("pub", "sub"):
+                    continue
                 if not e.type:
                     continue
                 if not msgs.is_known(e.type):

@@ -27,7 +27,11 @@ from runner.errors import closest
 from runner.plugin.handle import RobotHandle
 
 if TYPE_CHECKING:
+    from runner.plugin.actions import ActionServer, GoalHandle
     from runner.wire.cdr import Layout
+
+# `reply(response)`: what a service handler calls, once, with the response message
+Reply = Callable[[Any], None]
 
 
 # The most bytes a message from another process may have on a key a plugin takes, checked before it is
@@ -81,6 +85,18 @@ class Topic:
     type: str
     direction: Literal["pub", "sub"] = "pub"
     rate: float | None = None
+
+
+@dataclass(frozen=True)
+class Service:
+    """A service (`kind="service"`, `type` pkg/srv/Name) or action server (`kind="action"`, `type`
+    pkg/action/Name) a plugin offers, returned by `build` beside its topics. `name` is relative to the
+    robot's namespace unless it starts with '/'. An action's `_action/feedback` and `_action/status` topics
+    are added to the plan by the compiler: the plugin declares the action only."""
+
+    name: str
+    type: str
+    kind: Literal["service", "action"] = "service"
 
 
 @dataclass
@@ -181,6 +197,7 @@ class RuntimeContext:
     run: str
     _make_publisher: Callable[[str, str], Publisher] = field(repr=False)
     _subscribe: Callable[..., None] = field(repr=False)
+    _serve: Callable[..., None] | None = field(default=None, repr=False)
 
     def publisher(self, topic: str, type_name: str) -> Publisher:
         return self._make_publisher(topic, type_name)
@@ -192,6 +209,29 @@ class RuntimeContext:
         another process holding a NaN or Inf, or larger than `max_bytes` (by default
         MAX_INBOUND_BYTES, 8 MiB), is dropped and counted before it reaches the callback."""
         self._subscribe(topic, type_name, callback, max_bytes=max_bytes)
+
+    def service(self, name: str, type_name: str, handler: Callable[[Any, Reply], None]) -> None:
+        """Offer the service `name` (declared by `build` as a `Service`): `handler(request, reply)` is
+        called in the sim loop, between physics steps, with the decoded `pkg/srv/Name_Request`; it calls
+        `reply(response)` once, at once or at a later step (an action's result). A request that does not
+        decode, or holds a NaN or Inf, is answered with an error before it reaches the handler."""
+        if self._serve is None:
+            raise RuntimeError("this world offers no services")
+        self._serve(name, type_name, handler)
+
+    def action_server(
+        self,
+        name: str,
+        type_name: str,
+        on_goal: Callable[[GoalHandle], bool],
+        on_cancel: Callable[[GoalHandle], bool] | None = None,
+    ) -> ActionServer:
+        """Offer the action `name` of type `type_name` (pkg/action/Name), as rclcpp_action's server does
+        (runner.plugin.actions): `on_goal(handle)` accepts (True) or rejects a goal; `on_cancel(handle)`
+        accepts a cancel request (the plugin then ends the goal with `handle.canceled(result)`)."""
+        from runner.plugin.actions import ActionServer
+
+        return ActionServer(self, name, type_name, on_goal, on_cancel)
 
 
 class Plugin:
@@ -216,7 +256,8 @@ class Plugin:
 
     @classmethod
     def build(cls, params: Any, ctx: BuildContext, name: str) -> list[Topic]:
-        """Compile time: change the robot's model, return the topics used."""
+        """Compile time: change the robot's model, return the topics used (and, as `Service`s, the
+        services and actions offered)."""
         return []
 
     @classmethod

@@ -42,6 +42,7 @@ from runner.sim.hardware import Hardware
 from runner.sim.links import Lockstep, RemoteRender
 from runner.sim.pubsub import PubSub
 from runner.sim.schedule import Hook, next_due, sleep_until
+from runner.sim.services import Services
 
 if TYPE_CHECKING:
     from runner.sim.events import Events
@@ -80,7 +81,7 @@ CTRL_MAX = 1e10
 _BADCTRL = int(mujoco.mjtWarning.mjWARN_BADCTRL)
 
 
-class World(PubSub):
+class World(PubSub, Services):
     """The simulated world of a plan. `role="world"` steps physics and runs every plugin, except, with
     `plan.renderers == "process"` on a Zenoh bus, the rendering ones: their frames are made by a renderer
     process (`role="renderer"`, see runner/sim/render.py) from the state this world sends it."""
@@ -98,6 +99,7 @@ class World(PubSub):
         self.now_ns = 0
         self.rng = np.random.default_rng(plan.seed)
         self._init_pubsub()
+        self._init_services()
         self._lockstep: Lockstep | None = None
         self.robots = [RobotHandle(self.model, r) for r in plan.robots]
         # the hardware's start state and gains come before any plugin (a controller reads its start there)
@@ -191,6 +193,7 @@ class World(PubSub):
             run=self.plan.name,
             _make_publisher=self._publisher_factory(handle.namespace),
             _subscribe=self._subscriber_factory(handle.namespace),
+            _serve=self._service_factory(handle.namespace),
         )
 
     # ------------------------------------------------------------------------------------------- loop
@@ -211,6 +214,7 @@ class World(PubSub):
             # the nodes' answers to the clocks published so far come before their next wait message
             self._lockstep.wait(self._clock_sent, self._should_stop)
         self._drain_inbox()
+        self._drain_requests()  # after the messages: a service sees what a controller sees
         events = self._events
         if events is not None and now >= events.next_ns:
             events.boundary(now)

@@ -7,7 +7,8 @@ query, and the tokens vanish with the process, whatever way it ends.
 
 Token keys, under the run's verbatim `@meta` chunk:
 - `<run>/@meta/graph/<process>/<role>` for the process;
-- `<run>/@meta/graph/<process>/<role>/<pub|sub>/<key>/<type>` for an endpoint,
+- `<run>/@meta/graph/<process>/<role>/<pub|sub|srv>/<key>/<type>` for an endpoint (`srv`: a service
+  it answers, its type `pkg/srv/Name`),
 where each part is percent-quoted into one chunk (a key's `/` and wildcards included) and `<type>` is the
 ROS 2 type or `-` when the endpoint does not say.
 """
@@ -34,7 +35,7 @@ def _q(text: str) -> str:
 @dataclass(frozen=True)
 class Endpoint:
     process: str
-    kind: str  # "pub" | "sub"
+    kind: str  # "pub" | "sub" | "srv"
     key: str  # a key expression (subscribers may use wildcards)
     type: str | None = None
 
@@ -53,7 +54,7 @@ class Graph:
         parts = [unquote(p) for p in token[len(prefix) :].split("/")]
         if len(parts) >= 2:
             self.processes.setdefault(parts[0], parts[1])
-        if len(parts) == 5 and parts[2] in ("pub", "sub"):
+        if len(parts) == 5 and parts[2] in ("pub", "sub", "srv"):
             self.endpoints.add(Endpoint(parts[0], parts[2], parts[3], None if parts[4] == "-" else parts[4]))
 
     def visible(self) -> Graph:
@@ -67,11 +68,15 @@ class Graph:
         """Every concrete key: published, or subscribed without wildcards; with its type when known."""
         out: dict[str, str | None] = {}
         for e in sorted(self.endpoints, key=lambda e: (e.key, e.kind != "pub")):
-            if "*" in e.key:
+            if "*" in e.key or e.kind == "srv":
                 continue
             if out.get(e.key) is None:
                 out[e.key] = e.type
         return out
+
+    def services(self) -> dict[str, str | None]:
+        """Every service key, with its type when known."""
+        return {e.key: e.type for e in sorted(self.endpoints, key=lambda e: e.key) if e.kind == "srv"}
 
     def publishers(self, key: str) -> list[str]:
         return sorted({e.process for e in self.endpoints if e.kind == "pub" and e.key == key})
@@ -116,6 +121,9 @@ class GraphTokens:
 
     def subscriber(self, key: str, type_name: str | None = None) -> None:
         self._declare(f"{self.base}/sub/{_q(key)}/{_q(type_name or '-')}")
+
+    def service(self, key: str, type_name: str | None = None) -> None:
+        self._declare(f"{self.base}/srv/{_q(key)}/{_q(type_name or '-')}")
 
     def withdraw_subscriber(self, key: str, type_name: str | None = None) -> None:
         token = self._tokens.pop(f"{self.base}/sub/{_q(key)}/{_q(type_name or '-')}", None)

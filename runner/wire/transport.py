@@ -16,6 +16,7 @@ import os
 import socket
 import struct
 import sys
+import threading
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
@@ -172,6 +173,16 @@ class Bus(Protocol):
     ) -> None: ...
 
 
+# `respond(payload, error)`: answers one request, once: `payload` (the response's CDR), or `error` (text)
+Respond = Callable[[bytes | None, str | None], None]
+# `on_request(payload, attachment, respond)`: a request to a service, on a Zenoh thread
+OnRequest = Callable[[bytes, bytes | None, Respond], None]
+
+
+def service_encoding(type_name: str) -> zenoh.Encoding:
+    return zenoh.Encoding.APPLICATION_CDR.with_schema(type_name)
+
+
 # Payloads at least this large (camera frames, point clouds) are copied once into Zenoh's shared memory
 # and sent from there: a subscriber on this host maps them, one on another host gets them over the network
 # as usual. Smaller ones are put as bytes (Zenoh copies them into its own buffer).
@@ -286,6 +297,42 @@ class ZenohBus:
             self.session.declare_subscriber(key, on_sample, allowed_origin=zenoh.Locality.REMOTE)
         )
 
+    def queryable(self, key: str, on_request: OnRequest, type_name: str) -> None:
+        """A service on `key` (a Zenoh queryable): each query's payload and attachment go to `on_request`
+        with a `respond` that replies once, now or later (the query stays open until then), with the
+        response's CDR (`<type>_Response` as its encoding's schema) or an error."""
+        if self.graph is not None:
+            self.graph.service(key, type_name)
+        encoding = service_encoding(f"{type_name}_Response")
+
+        def on_query(query: zenoh.Query) -> None:
+            lock = threading.Lock()
+            state = {"done": False}
+
+            def respond(payload: bytes | None, error: str | None) -> None:
+                with lock:
+                    if state["done"]:
+                        return
+                    state["done"] = True
+                try:
+                    if payload is not None:
+                        att = query.attachment
+                        query.reply(
+                            key, payload, encoding=encoding, attachment=att.to_bytes() if att else None
+                        )
+                    else:
+                        query.reply_err(error or "error")
+                except Exception as e:  # (the client gave up, the session is closing)
+                    print(f"world: {key}: could not answer a request: {zenoh_reason(e)}", file=sys.stderr)
+                finally:
+                    query.drop()
+
+            att = query.attachment
+            payload = query.payload.to_bytes() if query.payload is not None else b""
+            on_request(payload, att.to_bytes() if att else None, respond)
+
+        self._keep.append(self.session.declare_queryable(key, on_query, complete=True))
+
     def reject(self, key: str, why: str) -> None:
         """Count a dropped inbound sample; the first of each kind on a key is said on stderr."""
         first = count_reason(self.rejected.setdefault(key, {}), why)
@@ -315,6 +362,7 @@ class MemoryBus:
     def __init__(self) -> None:
         self.rejected: dict[str, dict[str, int]] = {}
         self.sent: list[tuple[str, str, bytes, bytes]] = []
+        self.services: dict[str, OnRequest] = {}
         self._subs: dict[str, list[Callable[[str, bytes, bytes | None], None]]] = {}
 
     def publisher(self, key: str, type_name: str) -> Callable[[bytes | bytearray, bytes], None]:
@@ -330,6 +378,17 @@ class MemoryBus:
 
     def reject(self, key: str, why: str) -> None:
         count_reason(self.rejected.setdefault(key, {}), why)
+
+    def queryable(self, key: str, on_request: OnRequest, type_name: str) -> None:
+        self.services[key] = on_request
+
+    def call(
+        self, key: str, payload: bytes, attachment: bytes | None = None
+    ) -> list[tuple[bytes | None, str | None]]:
+        """Send a request to the service on `key`; the list its answer is appended to (when it comes)."""
+        answers: list[tuple[bytes | None, str | None]] = []
+        self.services[key](payload, attachment, lambda p, e: answers.append((p, e)))
+        return answers
 
     def inject(self, key: str, payload: bytes, attachment: bytes | None = None) -> None:
         for cb in self._subs.get(key, []):
