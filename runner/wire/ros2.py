@@ -295,6 +295,11 @@ def entity_token(
     (rmw_zenoh_cpp/src/detail/rmw_service_data.cpp, rmw_client_data.cpp)."""
     if kind not in ("MP", "MS", "SS", "SC"):
         raise ValueError(f"entity kind must be one of MP, MS, SS, SC, not {kind!r}")
+    if kind in ("SS", "SC"):
+        try:
+            interfaces.service_type(ros_type)
+        except KeyError as e:
+            raise ValueError(f"a service's token needs a service type: {e.args[0]}") from None
     chunks = _node_chunks(domain, zid, node_id, entity_id, kind, namespace, node, enclave)
     topic = qualified_name(namespace, fq_topic)
     chunks += [mangle(topic), dds_type_name(ros_type), type_hash(ros_type), qos_chunk(qos)]
