@@ -37,6 +37,7 @@ import zenoh.ext
 from runner.plan import BridgePlan, Ros2Plan, ServiceBridgePlan
 from runner.wire import msgs, ros2
 from runner.wire.graph import GraphTokens
+from runner.wire.interfaces import known_service
 from runner.wire.transport import (
     encoding_for,
     hidden_topic,
@@ -156,7 +157,9 @@ class Bridge:
         self._lock = threading.Lock()
         for p in plans:
             self._add(p)
+        self._served: set[tuple[str, str]] = set()
         for sp in services:
+            self._served.add((sp.sim_key, "srv"))
             self._serve_ros(sp)
 
     def _add(self, p: BridgePlan) -> None:
@@ -170,8 +173,8 @@ class Bridge:
             (self._outbound if direction == "SIM_TO_ZENOH" else self._inbound)(p)
 
     def mirror_nodes(self, ros: Ros2Plan) -> None:
-        """`ros2: {topics: all}`: the topics nodes publish and subscribe to (announced in the run's graph as
-        the nodes start) appear to ROS 2 too, as `/<ns>/<topic>`."""
+        """`ros2: {topics: all}`: the topics nodes publish and subscribe to, and the services they answer
+        (announced in the run's graph as the nodes start) appear to ROS 2 too, as `/<ns>/<name>`."""
         from runner.wire.graph import Graph
 
         def on_token(sample: zenoh.Sample) -> None:
@@ -182,6 +185,20 @@ class Bridge:
             for e in graph.endpoints:
                 rel = e.key[len(self.run) + 1 :] if e.key.startswith(self.run + "/") else ""
                 if graph.processes.get(e.process) != "node" or not rel or hidden_topic(rel) or "*" in rel:
+                    continue
+                if e.kind == "srv":  # a service a node answers
+                    if e.type and known_service(e.type):
+                        sp = ServiceBridgePlan(
+                            where=f"ros2 (/{rel}, node {e.process})",
+                            sim_key=e.key,
+                            type=e.type,
+                            ros_name="/" + rel,
+                            ros2=ros,
+                        )
+                        with self._lock, contextlib.suppress(Exception):
+                            if (e.key, "srv") not in self._served:
+                                self._served.add((e.key, "srv"))
+                                self._serve_ros(sp)
                     continue
                 if e.kind not in ("pub", "sub"):
                     continue

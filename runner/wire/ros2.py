@@ -34,7 +34,7 @@ from functools import cache
 
 import xxhash
 
-from runner.wire import interfaces  # noqa: F401  (registers the service and action types hashed here)
+from runner.wire import interfaces  # (registers the service and action types hashed here)
 from runner.wire.msgs import TYPESTORE, normalize_type
 
 ADMIN_SPACE = "@ros2_lv"
