@@ -1,0 +1,66 @@
+"""flipper: a test plugin that offers a std_srvs/srv/SetBool service (`flip`) and a
+control_msgs/action/GripperCommand action (`grip`), for the tests of `scenario call`, `scenario action`
+and runner.node's clients (tests/test_service_tools.py registers it through the entry-point group, as a
+third-party package would be).
+
+`flip` answers `success = data` and says how many times it was called. A `grip` goal with a negative
+position is rejected; an accepted one runs for `command.position` seconds of sim time, publishing feedback
+(`position`: the seconds gone) every 0.1 s, then succeeds with `reached_goal`; a cancel request ends it
+at the next step, as canceled.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from runner.plugin import BuildContext, Plugin, PluginParams, Service
+from runner.plugin.actions import GoalHandle
+from runner.wire import msgs
+
+GRIP = "control_msgs/action/GripperCommand"
+
+
+class Flipper(Plugin):
+    Params = PluginParams
+
+    @classmethod
+    def build(cls, params: PluginParams, ctx: BuildContext, name: str) -> list[Any]:
+        return [Service("flip", "std_srvs/srv/SetBool"), Service("grip", GRIP, kind="action")]
+
+    def setup(self) -> None:
+        self.calls = 0
+        self.goals: list[tuple[GoalHandle, int]] = []  # (goal, next feedback's sim time)
+        self.ctx.service("flip", "std_srvs/srv/SetBool", self.on_flip)
+        self.ctx.action_server("grip", GRIP, self.on_goal)
+
+    def on_flip(self, request: Any, reply: Any) -> None:
+        self.calls += 1
+        reply(
+            msgs.T["std_srvs/srv/SetBool_Response"](
+                success=bool(request.data), message=f"call {self.calls}: data={bool(request.data)}"
+            )
+        )
+
+    def on_goal(self, handle: GoalHandle) -> bool:
+        if handle.goal.command.position < 0:
+            return False
+        self.goals.append((handle, handle.accepted_ns))
+        return True
+
+    def before_step(self, now_ns: int) -> None:
+        kept = []
+        for handle, next_ns in self.goals:
+            gone = (now_ns - handle.accepted_ns) / 1e9
+            result = msgs.from_data(f"{GRIP}_Result", {"position": gone})
+            if handle.is_cancel_requested:
+                handle.canceled(result)
+                continue
+            if gone >= handle.goal.command.position:
+                result.reached_goal = True
+                handle.succeed(result)
+                continue
+            if now_ns >= next_ns:
+                handle.publish_feedback(msgs.from_data(f"{GRIP}_Feedback", {"position": gone}))
+                next_ns += 100_000_000
+            kept.append((handle, next_ns))
+        self.goals = kept
