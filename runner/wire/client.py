@@ -236,6 +236,8 @@ class ActionClient:
                 self._feedback_sub.undeclare()
             self._feedback_sub = None
 
+    undeclare = close  # (sits among a node's other Zenoh entities)
+
 
 def status_name(status: int) -> str:
     return STATUS_NAMES[status] if 0 <= status < len(STATUS_NAMES) else str(status)
