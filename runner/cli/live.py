@@ -205,7 +205,7 @@ def topics(
     connect: ConnectOpt = None,
 ) -> None:
     """List the topics of a running scenario: type, publishers and subscribers (by process), rates (like
-    `ros2 topic list -t` and `ros2 topic info`); then its services and actions, with their types and
+    `ros2 topic list -t` and `ros2 topic info`). Then its services and actions, with their types and
     servers (like `ros2 service list -t`, `ros2 action list -t`).
 
     Example: scenario topics --seconds 2

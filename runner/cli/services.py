@@ -226,9 +226,8 @@ def action(
     the goal succeeded, 1 when it was rejected, aborted or canceled.
 
     Examples:
-      scenario action arm/gripper_controller/gripper_cmd '{command: {position: 0.02, max_effort: 10}}'
-      scenario action arm/arm_controller/follow_joint_trajectory control_msgs/action/FollowJointTrajectory \\
-        '{trajectory: {joint_names: [j1], points: [{positions: [0.5], time_from_start: {sec: 2}}]}}' -f
+      scenario action r1/gripper_cmd '{command: {position: 0.02, max_effort: 10}}' --feedback
+      scenario action r1/gripper_cmd control_msgs/action/GripperCommand '{command: {position: 0.0}}'
     """
     from runner.launch.announce import find_run, joined, key_of
     from runner.wire.graph import query_graph
