@@ -103,8 +103,11 @@ class ServiceClient:
                 else:
                     finish(None, text or "error")
 
-        def on_end() -> None:  # the query is over: a reply came, or nothing answers on `key`
-            finish(None, f"no service answers on {key}")
+        def on_end() -> None:  # the query is over: a reply came, its time ran out, or nothing answers
+            if time.monotonic() - started >= timeout * 0.9:
+                finish(None, f"no answer from {key} within {timeout:g} s")
+            else:
+                finish(None, f"no service answers on {key} (or its server dropped the request)")
 
         self.session.get(
             key,

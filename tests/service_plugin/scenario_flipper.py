@@ -3,7 +3,8 @@ control_msgs/action/GripperCommand action (`grip`), for the tests of `scenario c
 and runner.node's clients (tests/test_service_tools.py registers it through the entry-point group, as a
 third-party package would be).
 
-`flip` answers `success = data` and says how many times it was called. A `grip` goal with a negative
+`flip` answers `success = data` and says how many times it was called; `fail` (std_srvs/srv/Trigger)
+raises (the world answers with an error reply); `hang` (std_srvs/srv/Empty) never answers. A `grip` goal with a negative
 position is rejected; an accepted one runs for `command.position` seconds of sim time, publishing feedback
 (`position`: the seconds gone) every 0.1 s, then succeeds with `reached_goal`; a cancel request ends it
 at the next step, as canceled.
@@ -25,12 +26,20 @@ class Flipper(Plugin):
 
     @classmethod
     def build(cls, params: PluginParams, ctx: BuildContext, name: str) -> list[Any]:
-        return [Service("flip", "std_srvs/srv/SetBool"), Service("grip", GRIP, kind="action")]
+        return [
+            Service("flip", "std_srvs/srv/SetBool"),
+            Service("fail", "std_srvs/srv/Trigger"),
+            Service("hang", "std_srvs/srv/Empty"),
+            Service("grip", GRIP, kind="action"),
+        ]
 
     def setup(self) -> None:
         self.calls = 0
         self.goals: list[tuple[GoalHandle, int]] = []  # (goal, next feedback's sim time)
         self.ctx.service("flip", "std_srvs/srv/SetBool", self.on_flip)
+        self.ctx.service("fail", "std_srvs/srv/Trigger", self.on_fail)
+        self.held: list[Any] = []  # `hang`'s replies, kept (a reply dropped ends the request unanswered)
+        self.ctx.service("hang", "std_srvs/srv/Empty", lambda _request, reply: self.held.append(reply))
         self.ctx.action_server("grip", GRIP, self.on_goal)
 
     def on_flip(self, request: Any, reply: Any) -> None:
@@ -40,6 +49,9 @@ class Flipper(Plugin):
                 success=bool(request.data), message=f"call {self.calls}: data={bool(request.data)}"
             )
         )
+
+    def on_fail(self, request: Any, reply: Any) -> None:
+        raise RuntimeError("asked to fail")
 
     def on_goal(self, handle: GoalHandle) -> bool:
         if handle.goal.command.position < 0:
