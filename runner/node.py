@@ -24,9 +24,9 @@ A node started by `scenario run` (a `nodes:` entry) finds the run in its environ
 Callbacks run on the node's own thread, inside `sleep()`/`spin_once()` (and while `call()` or a goal's
 `result()` waits), in the order messages arrived (the clock included), never concurrently. `sleep()`
 returns once the sim clock reached its target: with `lockstep:` naming this node, the world waits for it
-at each step, so even a `rate: max` run is repeatable. While a lockstep node waits for a service's answer,
-the world goes on one step at a time (it answers requests at step boundaries): the answer comes at the
-first boundary after the request arrived.
+at each step, so even a `rate: max` run is repeatable. A lockstep node's `call()` is answered while the
+world waits for the node (within the step after the clock the node saw), however long the answer takes;
+while it waits for a goal's `result()`, the world goes on one step at a time, as in `sleep()`.
 """
 
 from __future__ import annotations
@@ -62,6 +62,8 @@ from runner.wire.transport import (
     topic_key,
     unpack_attachment,
 )
+
+TERMINAL = (4, 5, 6)  # action_msgs/msg/GoalStatus: SUCCEEDED, CANCELED, ABORTED
 
 __all__ = ["GoalResult", "Node", "NodeActionClient", "NodeGoal", "NodePublisher", "ServiceCallError"]
 
@@ -191,7 +193,9 @@ class Node:
 
     def subscribe(self, topic: str, type_name: str, callback: Callable[[Any], None]) -> None:
         """`callback(msg)` runs inside `sleep()`/`spin_once()`, on this node's thread."""
-        key = self.key(topic)
+        self._subscribe_key(self.key(topic), type_name, callback)
+
+    def _subscribe_key(self, key: str, type_name: str, callback: Callable[[Any], None]) -> None:
         type_name = msgs.normalize_type(type_name)
         first = key not in self._callbacks
         self._callbacks.setdefault(key, []).append((type_name, callback))
@@ -272,11 +276,6 @@ class Node:
         elif key == "@answer":
             number, response, error = payload
             self._answers[number] = (response, error)
-        elif key == "@feedback":
-            goal_id, feedback = payload
-            cb = self._feedback.get(goal_id)
-            if cb is not None:
-                cb(feedback)
         elif key == "@request":
             self._serve(*payload)
         else:
@@ -297,14 +296,33 @@ class Node:
         )
         return number
 
-    def answer(self, number: int, what: str) -> Any:
+    def answer(self, number: int, what: str, ended: Callable[[], bool] | None = None) -> Any:
         """Wait for request `number`'s response, running callbacks meanwhile; ServiceCallError when there
-        is none. In lockstep, the world is let on one step at a time (it answers at a step boundary)."""
-        while number not in self._answers:
+        is none. A lockstep world answers while it waits for this node (it does not step meanwhile).
+        `ended`: the answer needs sim time to pass (a goal's result): the world is let on clock by clock,
+        as in `sleep()`, until `ended()` (the goal's end seen on its status topic, in order with the clock
+        in lockstep), and then to the clock it was let on to, where it waits again: the instant this node
+        goes on at does not depend on when the answer's bytes arrive."""
+        target = self.now_ns
+        answered_at: float | None = None
+        while True:
+            done = number in self._answers
+            if ended is None:
+                if done:
+                    break
+            elif not ended():
+                target = max(target, self.now_ns + 1)  # one more clock
+                if done:  # (the end was not seen on the status topic: do not wait for it for ever)
+                    answered_at = answered_at or time.monotonic()
+                    if time.monotonic() - answered_at > 2.0:
+                        break
+            elif done and self.now_ns >= target:
+                break
             if not self.ok():
                 raise ServiceCallError(f"{what}: the run ended (or the node was stopped) before an answer")
-            # past the current instant: a lockstep world takes one more step, and answers at a boundary
-            self._wait_pub.put(self._waiting_message(self.now_ns + 1))
+            # `target` (the current instant, or the clock after it) is where a lockstep world waits next; an
+            # announcement of the current instant also lets it past its first wait, before any clock
+            self._wait_pub.put(self._waiting_message(target))
             self.spin_once(timeout=0.1)
         response, error = self._answers.pop(number)
         if error is not None:
@@ -423,7 +441,9 @@ class NodeGoal:
             node, parts = self.client.node, self.client.client.parts
             if self._asked is None:
                 self._asked = self.client._ask(self.client.client.get_result, self.goal_id, timeout)
-            response = node.answer(self._asked, parts.get_result[0])
+            response = node.answer(
+                self._asked, parts.get_result[0], ended=lambda: self.goal_id in self.client.ended
+            )
             self._result = GoalResult(int(response.status), response.result)
             self.client.node._feedback.pop(self.goal_id, None)
         return self._result
@@ -442,8 +462,20 @@ class NodeActionClient:
     def __init__(self, node: Node, key: str, type_name: str):
         self.node = node
         self.client = ActionClient(node._client, key, type_name)
-        self.client.watch_feedback(lambda gid, fb: node._inbox.put(("@feedback", (gid, fb))))
-        node._keep.append(self.client)
+        self.ended: set[bytes] = set()  # goals whose end the status topic told
+        # through the node's own subscriptions: in lockstep, in order with the clock
+        node._subscribe_key(*self.client.parts.feedback, self._on_feedback)
+        node._subscribe_key(*self.client.parts.status, self._on_status)
+
+    def _on_feedback(self, msg: Any) -> None:
+        callback = self.node._feedback.get(bytes(msg.goal_id.uuid))
+        if callback is not None:
+            callback(msg.feedback)
+
+    def _on_status(self, msg: Any) -> None:
+        for s in msg.status_list:
+            if int(s.status) in TERMINAL:
+                self.ended.add(bytes(s.goal_info.goal_id.uuid))
 
     @property
     def action(self) -> str:

@@ -114,7 +114,7 @@ def test_call_prints_the_response_as_yaml_and_errors_clearly(live: str) -> None:
     assert proc.returncode == 0, proc.stderr
     second = yaml.safe_load(proc.stdout)
     assert second["success"] is False and second["message"].endswith("data=False"), proc.stdout
-    n1, n2 = (int(re.match(r"call (\d+):", r["message"]).group(1)) for r in (first, second))  # type: ignore[union-attr]
+    n1, n2 = (int(re.match(r"call (\d+) ", r["message"]).group(1)) for r in (first, second))  # type: ignore[union-attr]
     assert n2 == n1 + 1  # the same service, answered by the world each time
     assert "calling svcrun/r1/flip (std_srvs/srv/SetBool)" in proc.stderr
     # the server's error reply
@@ -334,24 +334,29 @@ lockstep: [caller]
 
 
 @pytest.mark.timeout(180)
-def test_a_lockstep_node_asks_the_world_and_the_calls_are_recorded(
+def test_a_lockstep_node_is_answered_while_the_world_waits_for_it(
     flipper: Path, write_scenario, tmp_path
 ) -> None:
-    """A lockstep node's calls and goal are answered while the world waits for it (it lets the world on
-    step by step), and the run goes on to its end."""
+    """A lockstep node's calls are answered where the world waits for it (within the step after the
+    clock it saw), its goal while it lets the world on step by step; two rate: max runs get the same."""
     path = write_scenario(CALLER)
     shutil.copy(PLUGIN / "caller_node.py", path.parent)
-    mcap = tmp_path / "svclock.mcap"
-    proc = run_cli("run", str(path), "--record", str(mcap), "--no-judge", "-q", timeout=120)
-    assert proc.returncode == 0, proc.stderr
-    messages = read_mcap(mcap)
-    calls = [m.data for topic, _, _, m in messages if topic == "svclock/r1/calls"]
-    assert calls[:3] == ["True call 1: data=True", "False call 2: data=False", "True call 3: data=True"], (
-        calls
-    )
+    recorded = []
+    for i in range(2):
+        mcap = tmp_path / f"svclock{i}.mcap"
+        proc = run_cli("run", str(path), "--record", str(mcap), "--no-judge", "-q", timeout=120)
+        assert proc.returncode == 0, proc.stderr
+        recorded.append([(t, m.data) for topic, _, t, m in read_mcap(mcap) if topic == "svclock/r1/calls"])
+    calls = [data for _t, data in recorded[0]]
+    for i, data in enumerate(("True", "False", "True")):
+        # answered while the world waits for the node: at the first step boundary after the clock it saw
+        # (the scenario's step is 2 ms), not later however long the answer takes in wall time
+        got = re.fullmatch(rf"{data} call {i + 1} at (\d+): data={data} \(asked at (\d+)\)", calls[i])
+        assert got and 0 <= int(got.group(1)) - int(got.group(2)) <= 2_000_000, calls
     assert calls[3].startswith("error svclock/r1/fail: the service failed: RuntimeError: asked to fail"), (
         calls
     )
+    assert recorded[0] == recorded[1]  # rate: max, lockstep: the same answers at the same sim times
     assert calls[4] == "True SUCCEEDED True 3", calls  # feedback at 0.0, 0.1, 0.2 s of a 0.25 s goal
 
 

@@ -10,7 +10,7 @@ with Node() as node:
     for i in range(3):
         node.sleep(0.05)
         response = node.call("flip", "std_srvs/srv/SetBool", {"data": i % 2 == 0})
-        out.publish({"data": f"{response.success} {response.message}"})
+        out.publish({"data": f"{response.success} {response.message} (asked at {node.now_ns})"})
     try:
         node.call("fail", "std_srvs/srv/Trigger")
     except ServiceCallError as e:

@@ -3,7 +3,7 @@ control_msgs/action/GripperCommand action (`grip`), for the tests of `scenario c
 and runner.node's clients (tests/test_service_tools.py registers it through the entry-point group, as a
 third-party package would be).
 
-`flip` answers `success = data` and says how many times it was called; `fail` (std_srvs/srv/Trigger)
+`flip` answers `success = data` and says how many times it was called and at what sim time (ns); `fail` (std_srvs/srv/Trigger)
 raises (the world answers with an error reply); `hang` (std_srvs/srv/Empty) never answers. A `grip` goal with a negative
 position is rejected; an accepted one runs for `command.position` seconds of sim time, publishing feedback
 (`position`: the seconds gone) every 0.1 s, then succeeds with `reached_goal`; a cancel request ends it
@@ -46,7 +46,8 @@ class Flipper(Plugin):
         self.calls += 1
         reply(
             msgs.T["std_srvs/srv/SetBool_Response"](
-                success=bool(request.data), message=f"call {self.calls}: data={bool(request.data)}"
+                success=bool(request.data),
+                message=f"call {self.calls} at {round(float(self.ctx.data.time) * 1e9)}: data={bool(request.data)}",
             )
         )
 
