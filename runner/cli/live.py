@@ -241,7 +241,8 @@ def topics(
         if key.startswith(name + "/") and key not in seen:
             seen[key] = {"type": type_name or "?", "n": 0, "t": []}
     out.print(_topics_table(name, seen, graph, seconds, show_all))
-    offered = graph.offered(every=show_all)
+    # the run's own (a bridge's copies for ROS 2, under rmw_zenoh's keys, are the graph's to show)
+    offered = [o for o in graph.offered(every=show_all) if o.key.startswith(name + "/")]
     if offered:
         out.print(_services_table(name, offered))
 
