@@ -360,10 +360,22 @@ def test_a_lockstep_node_is_answered_while_the_world_waits_for_it(
     assert calls[4] == "True SUCCEEDED True 3", calls  # feedback at 0.0, 0.1, 0.2 s of a 0.25 s goal
 
 
-def test_the_graph_shows_an_action_once_by_its_name_and_draws_services(tmp_path: Path) -> None:
+def test_the_graph_shows_an_action_once_by_its_name_and_draws_services(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """In process, a graph as the tokens give it: an action's three services are one entry (its
-    send_goal's type without `_SendGoal`), hidden services stay hidden, the drawings take them all."""
-    from PIL import Image
+    send_goal's type without `_SendGoal`), hidden services stay hidden, the drawings take them all (the
+    PNG names them in the box of the process that answers them)."""
+    from PIL import Image, ImageDraw
+
+    drawn: list[str] = []
+    original = ImageDraw.ImageDraw.text
+
+    def text(self: Any, xy: Any, text: str, *args: Any, **kwargs: Any) -> Any:
+        drawn.append(text)
+        return original(self, xy, text, *args, **kwargs)
+
+    monkeypatch.setattr(ImageDraw.ImageDraw, "text", text)
 
     from runner.tools.graph_draw import render_png, summary_lines, to_dot
     from runner.wire.graph import Endpoint, Graph
@@ -404,5 +416,7 @@ def test_the_graph_shows_an_action_once_by_its_name_and_draws_services(tmp_path:
     assert 'label="r1/grip\\ncontrol_msgs/action/GripperCommand\\n(action)", shape=octagon' in dot
     assert '"service:run/r1/ping" -> "process:ctl" [style=dotted];' in dot
     assert "2 processes, 1 topics, 3 services and actions" in dot
-    render_png(shown, tmp_path / "g.png")  # the picture is drawn as before: topics and processes
+    render_png(shown, tmp_path / "g.png")
     assert Image.open(tmp_path / "g.png").size[0] > 100
+    assert "serves 2: r1/flip, r1/grip (action)" in drawn and "serves 1: r1/ping" in drawn, drawn
+    assert any("3 services and actions" in t for t in drawn), drawn

@@ -314,8 +314,8 @@ def graph(
 ) -> None:
     """Draw a running scenario's graph (like rqt_graph) as a Graphviz DOT file and a PNG. It shows the
     processes (worlds, renderers, nodes, bridges, the recorder, the tools), the topics, and who publishes
-    and subscribes to what (the DOT file also the services and actions, and who answers them); the topics,
-    services and actions are listed on the terminal too.
+    and subscribes to what, and the services and actions each process answers; the topics, services and
+    actions are listed on the terminal too.
 
     Examples:
       scenario graph
