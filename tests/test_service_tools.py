@@ -180,7 +180,8 @@ def test_ctrl_c_cancels_the_goal(live: str) -> None:
         env=dict(os.environ, PYTHONUNBUFFERED="1"),
     )
     lines: queue.SimpleQueue[str] = queue.SimpleQueue()
-    threading.Thread(target=lambda: [lines.put(line) for line in proc.stdout], daemon=True).start()  # type: ignore[union-attr]
+    reader = threading.Thread(target=lambda: [lines.put(line) for line in proc.stdout], daemon=True)  # type: ignore[union-attr]
+    reader.start()
     seen = []
     try:
         deadline = time.monotonic() + 40
@@ -196,13 +197,9 @@ def test_ctrl_c_cancels_the_goal(live: str) -> None:
         if proc.poll() is None:
             proc.kill()
     stderr = proc.stderr.read()  # type: ignore[union-attr]
-    time.sleep(0)  # (the reader thread has the rest of stdout)
-    deadline = time.monotonic() + 5
-    while time.monotonic() < deadline:
-        try:
-            seen.append(lines.get(timeout=0.2))
-        except queue.Empty:
-            break
+    reader.join(timeout=10)  # (it ends with the process's stdout)
+    while not lines.empty():
+        seen.append(lines.get())
     out = "".join(seen)
     assert proc.returncode == 130, (out, stderr)
     assert "Canceling goal..." in stderr and "Goal canceled." in stderr, stderr
