@@ -171,3 +171,20 @@ def spec_velocity_limit(spec: mujoco.MjSpec, joint: str) -> float | None:
         if velocity and a.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE:
             return float(min(-a.ctrlrange[0], a.ctrlrange[1]))
     return None
+
+
+def release(m: mujoco.MjModel, d: mujoco.MjData, a: int, position: float) -> None:
+    """A deactivated controller's command interface, released: gz_ros2_control's system stops that command
+    (perform_command_mode_switch, gz_system.cpp:572) and, with `hold_joints` (default true), sends the joint a
+    zero velocity command (write(), :675), which holds it where it is. A position servo's setpoint becomes
+    the joint's position now; a velocity servo's, zero; a motor's effort, zero (gz would hold that joint
+    with a velocity command; a motor has none: the joint is left free)."""
+    found = kind(
+        m.actuator_gaintype[a],
+        m.actuator_biastype[a],
+        m.actuator_dyntype[a],
+        m.actuator_gainprm[a, 0],
+        m.actuator_biasprm[a],
+    )
+    gear = float(m.actuator_gear[a, 0]) or 1.0
+    d.ctrl[a] = position * gear if found == "position" else 0.0

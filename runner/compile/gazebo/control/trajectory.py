@@ -167,7 +167,8 @@ def joint_trajectory_controller(ctx: ControlContext, spec: ControllerSpec) -> bo
         ctx.say(
             spec,
             f"{spec.name}: ROS 1 JointTrajectoryController runs as ros2_controllers' (the state topic "
-            "carries control_msgs/JointTrajectoryControllerState of ROS 2 Jazzy; no action server yet)",
+            "carries control_msgs/JointTrajectoryControllerState of ROS 2 Jazzy, follow_joint_trajectory "
+            "control_msgs/action/FollowJointTrajectory on ROS 2's wire)",
         )
     else:
         for key in _RUN:
@@ -194,11 +195,7 @@ def joint_trajectory_controller(ctx: ControlContext, spec: ControllerSpec) -> bo
                 )
         params["command_topic"] = ctx.topic(f"{spec.name}/joint_trajectory")
         params["state_topic"] = ctx.topic(f"{spec.name}/controller_state")
-        ctx.say(
-            spec,
-            f"{spec.name}: the follow_joint_trajectory action is not served yet; trajectories go to "
-            f"{params['command_topic']!r}",
-        )
+    params["action_name"] = ctx.topic(f"{spec.name}/follow_joint_trajectory")
     interfaces = params.get("command_interfaces") or ["position"]
     closed_loop = len(interfaces) == 1 and interfaces[0] in ("velocity", "effort")
     if params["gains"] and not closed_loop:
