@@ -35,8 +35,11 @@ from runner.plugin.actions import GoalHandle as ActionGoal
 from runner.wire import msgs
 
 if TYPE_CHECKING:
-    from plugins.joint_trajectory_controller import Feedback, JointTrajectoryController, TrajectoryResult
-    from plugins.joint_trajectory_controller import GoalHandle as ControllerGoal
+    # (not the controller's module: it imports this one) the controller, its goals, results and feedback
+    JointTrajectoryController = Any
+    ControllerGoal = Any
+    TrajectoryResult = Any
+    Feedback = Any
 
 log = logging.getLogger(__name__)
 

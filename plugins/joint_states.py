@@ -107,8 +107,18 @@ class JointStates(Plugin):
                 for name in self.names
             ] + [[0, 1, 2]] * len(extra)
             self.dynamic_names = self.names + extra
+        self.active = True
+
+    def activate(self) -> None:
+        """joint_state_broadcaster (the controller_manager plugin switches it): publishes while active."""
+        self.active = True
+
+    def deactivate(self) -> None:
+        self.active = False
 
     def after_step(self, now_ns: int) -> None:
+        if not self.active:
+            return
         d = self.ctx.data
         values = (d.qpos[self.qadr], d.qvel[self.vadr], d.qfrc_actuator[self.vadr])
         fields = [np.concatenate([v * self.mask[f], self.pad]) for f, v in enumerate(values)]
