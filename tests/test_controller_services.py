@@ -81,7 +81,7 @@ arm_controller:
       goal_time: 0.5
       shoulder: {{trajectory: 0.2, goal: 0.01}}
       elbow: {{trajectory: 0.2, goal: 0.01}}
-gripper_controller:
+{arm_extra}gripper_controller:
   ros__parameters:
     joint: finger_joint
 arm_forward:
@@ -104,8 +104,9 @@ def _scenario(
     gripper: str = "position_controllers/GripperActionController",
     spawn: str = "[joint_state_broadcaster, arm_controller, gripper_controller]",
     timeline: str = "",
+    arm_extra: str = "",
 ) -> Path:
-    (tmp_path / "control.yaml").write_text(CONTROL.format(gripper=gripper))
+    (tmp_path / "control.yaml").write_text(CONTROL.format(gripper=gripper, arm_extra=arm_extra))
     (tmp_path / "arm.urdf").write_text(ARM.format(params=tmp_path / "control.yaml"))
     path = tmp_path / "g.yaml"
     path.write_text(
@@ -373,7 +374,23 @@ def test_parallel_gripper_takes_one_position_and_rejects_other_sizes(tmp_path: P
 
 # ---------------------------------------------------------------------------------- controller manager
 def test_the_plan_declares_the_actions_and_the_controller_managers_services(tmp_path: Path) -> None:
-    plan, said = compile_with_notices(_scenario(tmp_path))
+    """Both actions and the six services are in the plan; the JTC's deceleration on cancel (Jazzy), which is
+    not run, is said, and so is a per-joint constraint the controller does not have."""
+    extra = "      decelerate_on_cancel: true\n"
+    path = _scenario(tmp_path, arm_extra=extra)
+    text = (
+        (tmp_path / "control.yaml")
+        .read_text()
+        .replace(
+            "elbow: {trajectory: 0.2, goal: 0.01}",
+            "elbow: {trajectory: 0.2, goal: 0.01, max_deceleration_on_cancel: 1.0, goals: 1}",
+        )
+    )
+    (tmp_path / "control.yaml").write_text(text)
+    plan, said = compile_with_notices(path)
+    assert "arm_controller: constraints.decelerate_on_cancel is not run: a cancel holds at once" in said
+    assert "arm_controller: constraints.elbow.goals is not a parameter; ignored" in said
+    assert "max_deceleration_on_cancel" not in said
     kinds = {s.key.removeprefix("g/bot/"): s.type for s in plan.services()}
     assert kinds["arm_controller/follow_joint_trajectory"] == FJT
     assert kinds["gripper_controller/gripper_cmd"] == GRIP

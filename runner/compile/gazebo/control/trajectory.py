@@ -93,12 +93,18 @@ def _constraints(ctx: ControlContext, spec: ControllerSpec, joints: list[str]) -
         c = {k: v for k, v in c.items() if v is not None}
         if c:
             out[j] = c
-    known = {"stopped_velocity_tolerance", "goal_time", *joints}
+    known = {"stopped_velocity_tolerance", "goal_time", "decelerate_on_cancel", *joints}
+    if param(p, "constraints.decelerate_on_cancel") is True:  # (Jazzy) with max_deceleration_on_cancel
+        ctx.say(spec, f"{spec.name}: constraints.decelerate_on_cancel is not run: a cancel holds at once")
     block = param(p, "constraints")
     if isinstance(block, dict):
-        for k in block:
+        for k, v in block.items():
             if k not in known:
                 ctx.say(spec, f"{spec.name}: constraints.{k} is not a parameter of the controller; ignored")
+            elif k in joints and isinstance(v, dict):
+                for jk in v:
+                    if jk not in ("trajectory", "goal", "max_deceleration_on_cancel"):
+                        ctx.say(spec, f"{spec.name}: constraints.{k}.{jk} is not a parameter; ignored")
     return out
 
 
