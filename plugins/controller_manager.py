@@ -41,6 +41,17 @@ BEST_EFFORT, STRICT = 1, 2
 State = Literal["active", "inactive", "unconfigured"]
 
 
+# (service, controller_manager_msgs/srv type, handler)
+_SERVICES = (
+    ("list_controllers", "ListControllers", "_list_controllers"),
+    ("list_hardware_interfaces", "ListHardwareInterfaces", "_list_hardware"),
+    ("switch_controller", "SwitchController", "_switch"),
+    ("load_controller", "LoadController", "_load"),
+    ("configure_controller", "ConfigureController", "_configure"),
+    ("unload_controller", "UnloadController", "_unload"),
+)
+
+
 class ControllerEntry(BaseModel):
     model_config = ConfigDict(extra="forbid")
     name: str = Field(description="The controller's name.")
@@ -88,21 +99,7 @@ class ControllerManager(Plugin):
     @classmethod
     def build(cls, params: ControllerManagerParams, ctx: BuildContext, name: str) -> list[Service]:
         m = params.manager.strip("/")
-        return [
-            Service(f"{m}/{s}", f"{SRV}{t}")
-            for s, t in (
-                ("list_controllers", "ListControllers"),
-                ("list_hardware_interfaces", "ListHardwareInterfaces"),
-                ("switch_controller", "SwitchController"),
-                ("load_controller", "LoadController"),
-                ("configure_controller", "ConfigureController"),
-                ("unload_controller", "UnloadController"),
-            )
-        ]
-
-    @classmethod
-    def rate_of(cls, params: PluginParams) -> float | None:
-        return None
+        return [Service(f"{m}/{service}", f"{SRV}{kind}") for service, kind, _ in _SERVICES]
 
     def setup(self) -> None:
         mine = {p.name: p for p in self.ctx.plugins()}
@@ -110,12 +107,8 @@ class ControllerManager(Plugin):
             e.name: Controller(e, [mine[n] for n in e.plugins if n in mine]) for e in self.params.controllers
         }
         m = self.params.manager.strip("/")
-        self.ctx.service(f"{m}/list_controllers", f"{SRV}ListControllers", self._list_controllers)
-        self.ctx.service(f"{m}/list_hardware_interfaces", f"{SRV}ListHardwareInterfaces", self._list_hardware)
-        self.ctx.service(f"{m}/switch_controller", f"{SRV}SwitchController", self._switch)
-        self.ctx.service(f"{m}/load_controller", f"{SRV}LoadController", self._load)
-        self.ctx.service(f"{m}/configure_controller", f"{SRV}ConfigureController", self._configure)
-        self.ctx.service(f"{m}/unload_controller", f"{SRV}UnloadController", self._unload)
+        for service, kind, handler in _SERVICES:
+            self.ctx.service(f"{m}/{service}", f"{SRV}{kind}", getattr(self, handler))
 
     def _loaded(self, name: str) -> Controller | None:
         c = self.controllers.get(name)
