@@ -173,7 +173,7 @@ def spec_velocity_limit(spec: mujoco.MjSpec, joint: str) -> float | None:
     return None
 
 
-def release(m: mujoco.MjModel, d: mujoco.MjData, a: int, position: float) -> None:
+def release(m: mujoco.MjModel, d: mujoco.MjData, a: int) -> None:
     """A deactivated controller's command interface, released: gz_ros2_control's system stops that command
     (perform_command_mode_switch, gz_system.cpp:572) and, with `hold_joints` (default true), sends the joint a
     zero velocity command (write(), :675), which holds it where it is. A position servo's setpoint becomes
@@ -186,5 +186,31 @@ def release(m: mujoco.MjModel, d: mujoco.MjData, a: int, position: float) -> Non
         m.actuator_gainprm[a, 0],
         m.actuator_biasprm[a],
     )
-    gear = float(m.actuator_gear[a, 0]) or 1.0
-    d.ctrl[a] = position * gear if found == "position" else 0.0
+    position = float(d.qpos[m.jnt_qposadr[int(m.actuator_trnid[a, 0])]])
+    d.ctrl[a] = position * (float(m.actuator_gear[a, 0]) or 1.0) if found == "position" else 0.0
+
+
+class Lifecycle:
+    """The active / inactive state of a ros2_control controller plugin, which the controller_manager plugin
+    switches (plugins/controller_manager.py). A controller starts active (the spawner activates it); its
+    hooks do nothing while inactive; `deactivate` releases the actuators `commanded()` names to the
+    hardware's hold (`release`); `on_activate` resets what the controller's on_activate resets."""
+
+    active: bool = True
+    ctx: Any
+
+    def commanded(self) -> list[int]:
+        """The actuators (command interfaces) the controller writes."""
+        return []
+
+    def on_activate(self) -> None:
+        """What the controller does when activated again (default: nothing)."""
+
+    def activate(self) -> None:
+        self.active = True
+        self.on_activate()
+
+    def deactivate(self) -> None:
+        self.active = False
+        for a in self.commanded():
+            release(self.ctx.model, self.ctx.data, int(a))

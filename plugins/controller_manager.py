@@ -19,9 +19,8 @@ names them; controller_manager.cpp at 9ffbf97 on jazzy):
   unconfigured, configure makes it inactive. A controller the controllers file has but the launch does not
   spawn is not built (its plugins would claim the joints): loading it answers ok=false, said on stderr.
 
-Controllers run as our plugins (joint_trajectory_controller, joint_controller, gripper_action_controller,
-joint_states) switch; drives and sensor broadcasters keep running: switching one is refused (as a controller
-that fails its transition is), said in the reply's message.
+Every controller plugin the control handlers add switches (plugins._actuators.Lifecycle); one that does not
+(none yet) is refused as a controller that fails its transition is, said in the reply's message.
 """
 
 from __future__ import annotations
@@ -31,6 +30,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from plugins._actuators import Lifecycle
 from runner.plugin import BuildContext, Plugin, PluginParams, Reply, Service
 from runner.wire import msgs
 
@@ -79,7 +79,7 @@ class Controller:
 
     @property
     def switchable(self) -> bool:
-        return bool(self.plugins) and all(hasattr(p, "deactivate") for p in self.plugins)
+        return bool(self.plugins) and all(isinstance(p, Lifecycle) for p in self.plugins)
 
     def interfaces(self) -> tuple[list[str], list[str] | None]:
         """(command, state) interfaces it requires; state None: all (joint_state_broadcaster's ALL)."""
@@ -343,10 +343,14 @@ class ControllerManager(Plugin):
 def interfaces_of(p: Plugin) -> tuple[list[str], list[str] | None]:
     """The command and state interfaces a controller plugin requires, as its ros2_controllers controller's
     command_ / state_interface_configuration names them (state None: ALL, the broadcaster's default)."""
+    from plugins.diff_drive import WheelDrive
     from plugins.gripper_action_controller import GripperActionController
     from plugins.joint_controller import JointController
     from plugins.joint_states import JointStates
     from plugins.joint_trajectory_controller import JointTrajectoryController
+    from plugins.mecanum_drive import MecanumDrive
+    from plugins.mecanum_drive import _joints as mecanum_wheels
+    from plugins.steering_drive import SteeringDrive
 
     q: Any = p.params
     if isinstance(p, JointTrajectoryController):
@@ -366,4 +370,17 @@ def interfaces_of(p: Plugin) -> tuple[list[str], list[str] | None]:
             for j in q.joints
             for i in (q.interfaces or {}).get(j, ("position", "velocity", "effort"))
         ]
-    return [], []
+    if isinstance(p, WheelDrive):  # diff_drive_controller: position feedback, unless from velocities
+        left, right = type(p).sides(q)
+        wheels = [j for j, _ in left + right]
+        state = "velocity" if q.odometry_source == "velocity" else "position"
+        return [f"{j}/velocity" for j in wheels], [f"{j}/{state}" for j in wheels]
+    if isinstance(p, MecanumDrive):
+        wheels = mecanum_wheels(q)
+        return [f"{j}/velocity" for j in wheels], [f"{j}/velocity" for j in wheels]
+    if isinstance(p, SteeringDrive):
+        traction, steering = q.traction_joints_names, q.steering_joints_names
+        command = [f"{j}/velocity" for j in traction] + [f"{j}/position" for j in steering]
+        # steering_controllers_library: traction velocity (position_feedback false, the default); steering
+        return command, [f"{j}/velocity" for j in traction] + [f"{j}/position" for j in steering]
+    return [], []  # the sensor broadcasters read sensors, not joints

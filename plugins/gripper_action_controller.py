@@ -46,7 +46,7 @@ from typing import Any, Literal
 import mujoco
 from pydantic import BaseModel, ConfigDict, Field, NonNegativeFloat, PositiveFloat
 
-from plugins._actuators import auto_gains, claim_actuator, find_actuator, release
+from plugins._actuators import Lifecycle, auto_gains, claim_actuator, find_actuator
 from runner.plugin import BuildContext, Plugin, PluginConfigError, PluginParams, Service, Topic
 from runner.plugin.actions import GoalHandle as ActionGoal
 from runner.wire import msgs
@@ -116,7 +116,7 @@ class GripperGoalHandle:
             c._end(self, "canceled")
 
 
-class GripperActionController(Plugin):
+class GripperActionController(Lifecycle, Plugin):
     Params = GripperActionControllerParams
     params: GripperActionControllerParams
 
@@ -189,7 +189,6 @@ class GripperActionController(Plugin):
         self.ctx.subscribe(
             self._topic(p, self.name), PARALLEL_TYPE if p.parallel else GRIPPER_TYPE, self._on_command
         )
-        self.active = True  # the controller_manager plugin switches it
         self.action = self.ctx.action_server(
             self._action_name(p, self.name), self._action_type(p), self._on_goal, self._on_cancel
         )
@@ -242,18 +241,16 @@ class GripperActionController(Plugin):
         (handle.succeed if goal.status == "succeeded" else handle.abort)(result)
 
     # ------------------------------------------------------------------------------------- lifecycle
-    def activate(self) -> None:
+    def on_activate(self) -> None:
         """on_activate: command the current position with the parameters' effort."""
-        self.active = True
         self.position = float(self.ctx.data.qpos[self.qadr])
         self.max_effort = self.params.max_effort
         self.integral = 0.0
 
-    def deactivate(self) -> None:
-        """on_deactivate releases the interfaces and leaves a goal as it is (it ends with a new goal or a
-        cancel); the hardware holds the joint where it is (plugins._actuators.release)."""
-        self.active = False
-        release(self.ctx.model, self.ctx.data, self.act, float(self.ctx.data.qpos[self.qadr]))
+    def commanded(self) -> list[int]:
+        """on_deactivate releases the interface (the hardware holds the joint where it is) and leaves a
+        goal as it is: it ends with a new goal or a cancel."""
+        return [self.act]
 
     def close(self) -> None:
         self.action.close()

@@ -29,7 +29,7 @@ import mujoco
 import numpy as np
 from pydantic import Field, NonNegativeFloat, PositiveFloat
 
-from plugins._actuators import auto_gains, claim_actuator, find_actuator, release
+from plugins._actuators import Lifecycle, auto_gains, claim_actuator, find_actuator
 from runner.plugin import BuildContext, Plugin, PluginConfigError, PluginParams, Topic
 
 log = logging.getLogger(__name__)
@@ -74,7 +74,7 @@ def _message_of(params: JointControllerParams) -> str:
     return params.message or ("float64" if len(params.joints) == 1 else "float64_array")
 
 
-class JointController(Plugin):
+class JointController(Lifecycle, Plugin):
     Params = JointControllerParams
     params: JointControllerParams
 
@@ -136,7 +136,6 @@ class JointController(Plugin):
             self.target = start
         else:
             self.target = np.array(p.initial, dtype=float) if p.initial else np.zeros(n)
-        self.active = True  # the spawner activates it (the controller_manager plugin switches it)
         for k in range(n):
             self._set(k, float(self.target[k]))
         message = _message_of(p)
@@ -144,19 +143,15 @@ class JointController(Plugin):
         callback = {"float64": self._on_float, "float64_array": self._on_array, "joint_state": self._on_state}
         self.ctx.subscribe(topic, _MESSAGE_TYPES[message], callback[message])
 
-    def activate(self) -> None:
+    def on_activate(self) -> None:
         """A forward command controller activated again (the controller_manager plugin): its command
         interfaces still hold its last command, which gz_ros2_control's system follows again."""
-        self.active = True
         for k in range(len(self.params.joints)):
             self._set(k, float(self.target[k]))
 
-    def deactivate(self) -> None:
-        """Commands are ignored; the hardware holds the joints where they are (plugins._actuators.release)."""
-        self.active = False
-        d = self.ctx.data
-        for k in range(len(self.params.joints)):
-            release(self.ctx.model, d, int(self.act[k]), float(d.qpos[self.qadr[k]]))
+    def commanded(self) -> list[int]:
+        """Deactivated, commands are ignored and the hardware holds the joints where they are."""
+        return self.act.tolist()
 
     def _set(self, k: int, value: float) -> None:
         if not math.isfinite(value):

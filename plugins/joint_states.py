@@ -15,6 +15,7 @@ import mujoco
 import numpy as np
 from pydantic import Field
 
+from plugins._actuators import Lifecycle
 from runner.plugin import BuildContext, Plugin, PluginConfigError, RatedParams, Topic
 from runner.wire import msgs
 
@@ -43,7 +44,7 @@ class JointStatesParams(RatedParams):
     )
 
 
-class JointStates(Plugin):
+class JointStates(Lifecycle, Plugin):  # joint_state_broadcaster: publishes while active
     Params = JointStatesParams
     params: JointStatesParams
 
@@ -107,14 +108,6 @@ class JointStates(Plugin):
                 for name in self.names
             ] + [[0, 1, 2]] * len(extra)
             self.dynamic_names = self.names + extra
-        self.active = True
-
-    def activate(self) -> None:
-        """joint_state_broadcaster (the controller_manager plugin switches it): publishes while active."""
-        self.active = True
-
-    def deactivate(self) -> None:
-        self.active = False
 
     def after_step(self, now_ns: int) -> None:
         if not self.active:

@@ -51,7 +51,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field, NonNegativeFloat, PositiveFloat
 
-from plugins._actuators import auto_gains, claim_actuator, find_actuator, release
+from plugins._actuators import Lifecycle, auto_gains, claim_actuator, find_actuator
 from plugins._follow_trajectory import ACTION, FollowJointTrajectoryServer, state_data
 from plugins._trajectory import (
     Constraints,
@@ -154,7 +154,7 @@ class GoalHandle:
             self.controller._cancel(self)
 
 
-class JointTrajectoryController(Plugin):
+class JointTrajectoryController(Lifecycle, Plugin):
     Params = JointTrajectoryControllerParams
     params: JointTrajectoryControllerParams
 
@@ -284,13 +284,11 @@ class JointTrajectoryController(Plugin):
         self.ctx.subscribe(
             self._command_topic(p, self.name), TRAJECTORY_TYPE, self._on_trajectory, max_bytes=64 << 20
         )
-        self.active = True  # the spawner activates it (the controller_manager plugin switches it)
         self.action = FollowJointTrajectoryServer(self, self._action_name(p, self.name))
         del d
 
-    def activate(self) -> None:
+    def on_activate(self) -> None:
         """on_activate: hold the current position, start again from the measured state."""
-        self.active = True
         self.pending = None
         self.last_cmd = None
         self.last_t = None
@@ -304,11 +302,11 @@ class JointTrajectoryController(Plugin):
         self._finish(
             TrajectoryResult(INVALID_GOAL, "Current goal cancelled during deactivate transition."), "aborted"
         )
-        self.active = False
         self.pending = None
-        d = self.ctx.data
-        for i, k in enumerate(self.cmd_index):
-            release(self.ctx.model, d, self.act[i], float(d.qpos[self.qadr[k]]))
+        super().deactivate()
+
+    def commanded(self) -> list[int]:
+        return self.act
 
     def close(self) -> None:
         self.action.close()

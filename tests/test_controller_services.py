@@ -599,3 +599,72 @@ def test_a_controller_whose_interfaces_another_active_one_claims_is_not_activate
             "is currently claimed by another controller."
         )
     assert switch(["arm_controller"], ["arm_forward"], 2).ok
+
+
+@pytest.mark.timeout(60)
+def test_a_diff_drive_controller_switched_off_stops_driving_and_publishing_and_drives_again_on(
+    tmp_path: Path,
+) -> None:
+    """diff_drive_controller (bench/mobile.py's diffbot, its controllers file): list_controllers gives its
+    wheels' velocity command and position state interfaces; deactivated at 1 s while TwistStamped commands
+    stream, it stops publishing odometry and its wheels are held (the robot stops); activated at 2 s, it
+    drives again."""
+    from bench.mobile import DIFF, control, diffbot, truth, write
+
+    timeline = "".join(
+        "  - {t: %.1f, topic: r1/diff_cont/cmd_vel, type: geometry_msgs/msg/TwistStamped, "
+        "data: {twist: {linear: {x: 0.2}}}}\n" % (0.1 * k)
+        for k in range(1, 30)
+    )
+    path = write(tmp_path, diffbot(control("CONTROL_YAML")), DIFF, 3.0, timeline)
+    bus = MemoryBus()
+    world = World(plan_of(path), bus)
+    client = Client(world, bus)
+
+    def manager(name: str, srv: str, data: dict[str, Any]) -> _Answer:
+        payload = msgs.encode(msgs.from_data(f"{SRV}{srv}_Request", data), f"{SRV}{srv}_Request")
+        return _Answer(bus.call(f"t/r1/controller_manager/{name}", payload), f"{SRV}{srv}_Response")
+
+    listed = client.at(0.5, lambda: manager("list_controllers", "ListControllers", {}))
+    off = client.at(
+        1.0,
+        lambda: manager("switch_controller", "SwitchController", {"deactivate_controllers": ["diff_cont"]}),
+    )
+    on = client.at(
+        2.0, lambda: manager("switch_controller", "SwitchController", {"activate_controllers": ["diff_cont"]})
+    )
+    world.run()
+    cont = {c.name: c for c in listed.value[0].controller}["diff_cont"]
+    assert list(cont.claimed_interfaces) == ["left_wheel_joint/velocity", "right_wheel_joint/velocity"]
+    assert list(cont.required_state_interfaces) == ["left_wheel_joint/position", "right_wheel_joint/position"]
+    assert off.value[0].ok and on.value[0].ok
+    t, pose = truth(bus)
+    x = {round(s, 2): float(p[0]) for s, p in zip(t, pose, strict=True)}
+    assert x[1.0] - x[0.5] > 0.05  # driving
+    assert abs(x[1.9] - x[1.3]) < 0.005, (x[1.3], x[1.9])  # held while inactive
+    assert x[2.9] - x[2.3] > 0.05  # driving again
+    stamps = [s / 1e9 for s, _ in messages(bus, "r1/diff_cont/odom")]
+    assert not [s for s in stamps if 1.05 < s < 1.95] and [s for s in stamps if s > 2.1]
+
+
+def test_a_ros1_trajectory_controller_gets_the_action_and_its_robot_the_managers_services(
+    tmp_path: Path,
+) -> None:
+    """ROS 1 (a gazebo_ros_control launch loads the file): position_controllers/JointTrajectoryController
+    gets `follow_joint_trajectory` as ros_controllers names it, on ROS 2's wire and type; the controller
+    manager's services are ROS 2's too."""
+    urdf = ARM.split("  <ros2_control")[0] + "</robot>\n"
+    (tmp_path / "arm.urdf").write_text(urdf)
+    (tmp_path / "ros1.yaml").write_text(
+        "arm_controller:\n  type: position_controllers/JointTrajectoryController\n  joints: [shoulder, elbow]\n"
+    )
+    path = tmp_path / "g.yaml"
+    path.write_text(
+        "name: g\nduration: 1\nrate: max\nrobots:\n  - name: bot\n    description: arm.urdf\n    fixed: true\n"
+        "    controllers: [ros1.yaml]\n"
+    )
+    plan, said = compile_with_notices(path)
+    kinds = {s.key.removeprefix("g/bot/"): s.type for s in plan.services()}
+    assert kinds["arm_controller/follow_joint_trajectory"] == FJT
+    assert kinds["controller_manager/switch_controller"] == SRV + "SwitchController"
+    assert "follow_joint_trajectory control_msgs/action/FollowJointTrajectory on ROS 2's wire" in said
