@@ -7,6 +7,10 @@ motor — with its gains, force limit and gear. A controller's `build` claims a 
 `claim_actuator`: the hardware's actuator of that kind is reused (its gains left alone unless the controller
 gives its own), or one is added; actuators of other kinds on that joint are disabled (gear 0), as a claimed
 command interface excludes the others in ros2_control. At run time `find_actuator` gives its index.
+
+A controller plugin's lifecycle (`Lifecycle`, switched by the controller_manager plugin): inactive, its
+hooks do nothing and its actuators are `release`d to the hardware's hold, as gz_ros2_control's system holds
+a joint no active controller commands.
 """
 
 from __future__ import annotations
