@@ -668,3 +668,74 @@ def test_a_ros1_trajectory_controller_gets_the_action_and_its_robot_the_managers
     assert kinds["arm_controller/follow_joint_trajectory"] == FJT
     assert kinds["controller_manager/switch_controller"] == SRV + "SwitchController"
     assert "follow_joint_trajectory control_msgs/action/FollowJointTrajectory on ROS 2's wire" in said
+
+
+def _zenoh_call(session: Any, key: str, srv: str, data: dict[str, Any], timeout: float = 30.0) -> Any:
+    """A request on the native service wire (a Zenoh query, CDR payload) from a session of the test's own."""
+    payload = msgs.encode(msgs.from_data(f"{srv}_Request", data), f"{srv}_Request")
+    replies = [r for r in session.get(key, payload=payload, timeout=timeout)]
+    assert len(replies) == 1 and replies[0].ok is not None, [r.err for r in replies]
+    return msgs.decode(replies[0].ok.payload.to_bytes(), f"{srv}_Response")
+
+
+@pytest.mark.timeout(120)
+def test_a_real_run_answers_the_controller_manager_and_a_goal_over_zenoh(tmp_path: Path) -> None:
+    """A real run (real time, its own Zenoh router): a client session queries controller_manager/
+    list_controllers, sends a FollowJointTrajectory goal and waits for its result with get_result (answered
+    when the arm got there), then switches the controller off."""
+    import subprocess
+    import threading
+
+    from runner.wire.transport import free_port
+    from tests.conftest import scenario_cmd
+    from tests.test_trajectory_controllers import _join
+
+    port = free_port()
+    path = _scenario(tmp_path, duration=30.0)
+    text = path.read_text().replace("name: g\n", "name: zc\n", 1)
+    path.write_text(text)
+    proc = subprocess.Popen(
+        scenario_cmd("run", str(path), "--no-judge", "--rate", "1", "--listen", f"tcp/127.0.0.1:{port}"),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        session = _join(port, "zc")
+        try:
+            flowing = threading.Event()  # the world steps: its services are declared (before the first step)
+            sub = session.declare_subscriber(
+                "zc/bot/arm_controller/controller_state", lambda _s: flowing.set()
+            )
+            assert flowing.wait(40), "the world did not start"
+            sub.undeclare()
+            listed = _zenoh_call(
+                session, "zc/bot/controller_manager/list_controllers", SRV + "ListControllers", {}
+            )
+            assert {c.name for c in listed.controller} == {
+                "joint_state_broadcaster", "arm_controller", "gripper_controller"
+            }  # fmt: skip
+            uuid = {"uuid": [7] * 16}
+            action = "zc/bot/arm_controller/follow_joint_trajectory/_action"
+            goal = {"trajectory": _trajectory([([0.5, -0.3], 1.0)])}
+            sent = _zenoh_call(
+                session, f"{action}/send_goal", f"{FJT}_SendGoal", {"goal_id": uuid, "goal": goal}
+            )
+            assert sent.accepted
+            result = _zenoh_call(session, f"{action}/get_result", f"{FJT}_GetResult", {"goal_id": uuid})
+            assert result.status == SUCCEEDED and result.result.error_string == "Goal successfully reached!"
+            off = _zenoh_call(
+                session,
+                "zc/bot/controller_manager/switch_controller",
+                SRV + "SwitchController",
+                {"deactivate_controllers": ["arm_controller"], "strictness": 2},
+            )
+            assert off.ok
+        finally:
+            session.close()
+    finally:
+        proc.terminate()
+        try:
+            proc.communicate(timeout=20)
+        finally:
+            proc.kill()
