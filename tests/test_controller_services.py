@@ -687,7 +687,7 @@ def test_a_real_run_answers_the_controller_manager_and_a_goal_over_zenoh(tmp_pat
     import threading
 
     from runner.wire.transport import free_port
-    from tests.conftest import scenario_cmd
+    from tests.conftest import read_mcap, scenario_cmd
     from tests.test_trajectory_controllers import _join
 
     port = free_port()
@@ -696,6 +696,7 @@ def test_a_real_run_answers_the_controller_manager_and_a_goal_over_zenoh(tmp_pat
     path.write_text(text)
     proc = subprocess.Popen(
         scenario_cmd("run", str(path), "--no-judge", "--rate", "1", "--listen", f"tcp/127.0.0.1:{port}"),
+        cwd=tmp_path,  # its recording goes there
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -739,3 +740,13 @@ def test_a_real_run_answers_the_controller_manager_and_a_goal_over_zenoh(tmp_pat
             proc.communicate(timeout=20)
         finally:
             proc.kill()
+    # the recording says what was asked and answered: REQUEST_RECEIVED then RESPONSE_SENT
+    events = [
+        m
+        for key, _t, _s, m in read_mcap(tmp_path / "runs" / "zc.mcap")
+        if key.endswith("switch_controller/_service_event")
+    ]
+    assert [e.info.event_type for e in events] == [1, 2]
+    assert (
+        list(events[0].request[0].deactivate_controllers) == ["arm_controller"] and events[1].response[0].ok
+    )
