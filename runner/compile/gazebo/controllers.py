@@ -439,7 +439,7 @@ def dispatch(ctx: ControlContext, specs: list[ControllerSpec], loaded: list[dict
     for spec in specs:
         if spawn is not None and spec.name not in spawn:
             ctx.g.notices.add(
-                f"controller {spec.name!r} is not spawned (the robot's `spawn:` leaves it out): not run",
+                f"controller {spec.name!r} is not spawned (`spawn:` leaves it out): not run (nor loadable)",
                 *spec.where,
             )
             continue
