@@ -158,9 +158,33 @@ class Bridge:
         for p in plans:
             self._add(p)
         self._served: set[tuple[str, str]] = set()
+        # a service is offered to ROS 2 once the world answers it (its graph token, declared after its
+        # queryable): a client that finds the SS token and calls at once is answered, not left waiting
+        self._pending: dict[str, ServiceBridgePlan] = {}
         for sp in services:
             self._served.add((sp.sim_key, "srv"))
-            self._serve_ros(sp)
+            self._pending[sp.sim_key] = sp
+        if self._pending:
+            key = meta_key(run, "graph", "**")
+            self._keep.append(session.liveliness().declare_subscriber(key, self._on_server, history=True))
+
+    def _on_server(self, sample: zenoh.Sample) -> None:
+        from runner.wire.graph import Graph
+
+        if sample.kind != zenoh.SampleKind.PUT:
+            return
+        graph = Graph(self.run)
+        graph.add_token(str(sample.key_expr))
+        for e in graph.endpoints:
+            if e.kind != "srv":
+                continue
+            with self._lock:
+                sp = self._pending.pop(e.key, None)
+                if sp is not None:
+                    try:
+                        self._serve_ros(sp)
+                    except Exception as err:  # (the session closing as the run ends)
+                        self.complain(sp.where, f"could not offer the service: {err}")
 
     def _add(self, p: BridgePlan) -> None:
         other = p.ros_topic if p.ros2 else p.key

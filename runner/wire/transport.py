@@ -301,8 +301,6 @@ class ZenohBus:
         """A service on `key` (a Zenoh queryable): each query's payload and attachment go to `on_request`
         with a `respond` that replies once, now or later (the query stays open until then), with the
         response's CDR (`<type>_Response` as its encoding's schema) or an error."""
-        if self.graph is not None:
-            self.graph.service(key, type_name)
         encoding = service_encoding(f"{type_name}_Response")
 
         def on_query(query: zenoh.Query) -> None:
@@ -332,6 +330,9 @@ class ZenohBus:
             on_request(payload, att.to_bytes() if att else None, respond)
 
         self._keep.append(self.session.declare_queryable(key, on_query, complete=True))
+        if self.graph is not None:
+            # announced once it answers: the bridge offers it to ROS 2 when it sees this token
+            self.graph.service(key, type_name)
 
     def reject(self, key: str, why: str) -> None:
         """Count a dropped inbound sample; the first of each kind on a key is said on stderr."""
