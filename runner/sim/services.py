@@ -79,6 +79,9 @@ class Services:
         """Answer requests to `key` (a full key) with `handler(request, reply)` in the sim loop."""
         st = interfaces.service_type(type_name)
         if key in self._services:
+            if getattr(self, "_rebuilding", False):  # a plugin made again by reset_simulation: its handler
+                self._services[key].handler = handler
+                return
             raise ValueError(f"two services on {key}")
         events = self.make_publisher(f"{key}/{EVENT_TOPIC}", f"{st.name}_Event")
         self._services[key] = _Service(key, st, handler, events)

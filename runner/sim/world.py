@@ -38,6 +38,7 @@ from runner.plan import RunPlan
 from runner.plugin import Plugin, RobotHandle, RuntimeContext, overrides
 from runner.plugin.registry import load
 from runner.sim.contacts import ContactWatch
+from runner.sim.control import Control
 from runner.sim.hardware import Hardware
 from runner.sim.links import Lockstep, RemoteRender
 from runner.sim.pubsub import PubSub
@@ -81,7 +82,7 @@ CTRL_MAX = 1e10
 _BADCTRL = int(mujoco.mjtWarning.mjWARN_BADCTRL)
 
 
-class World(PubSub, Services):
+class World(PubSub, Services, Control):
     """The simulated world of a plan. `role="world"` steps physics and runs every plugin, except, with
     `plan.renderers == "process"` on a Zenoh bus, the rendering ones: their frames are made by a renderer
     process (`role="renderer"`, see runner/sim/render.py) from the state this world sends it."""
@@ -97,11 +98,28 @@ class World(PubSub, Services):
         self._split = int(self.model.opt.integrator) != int(mujoco.mjtIntegrator.mjINT_RK4)
         self.step_ns = plan.step_ns
         self.now_ns = 0
-        self.rng = np.random.default_rng(plan.seed)
         self._init_pubsub()
         self._init_services()
+        self._init_control()
         self._lockstep: Lockstep | None = None
         self.robots = [RobotHandle(self.model, r) for r in plan.robots]
+        session = getattr(bus, "session", None)
+        self.remote_renders: dict[int, RemoteRender] = {}  # plugin index -> its renderer link
+        self.render_plugins: dict[int, Plugin] = {}  # in a renderer: plugin index -> plugin
+        if role == "world" and plan.lockstep and session is not None:
+            keys = self._remote_subscribed  # the same set: keys subscribed later count too
+            self._lockstep = Lockstep(session, plan.name, plan.lockstep, self._received, keys)
+        self._build(remote=role == "world" and plan.renderers == "process" and session is not None)
+        if role == "world":
+            self._serve_control()
+
+    def _build(self, remote: bool) -> None:
+        """Everything of the world that a run starts with beside the model: the hardware's start state,
+        the plugins and their hooks, the clock, the timeline, the events. Made again, the same way, by
+        `reset_simulation` (runner.sim.control), which is why it is apart from `__init__`: what it makes
+        from the seed and the plan alone comes out the same each time."""
+        plan = self.plan
+        self.rng = np.random.default_rng(plan.seed)
         # the hardware's start state and gains come before any plugin (a controller reads its start there)
         self.hardware = Hardware(self.model, self.data, plan.robots)
         self.plugins: list[Plugin] = []
@@ -110,23 +128,17 @@ class World(PubSub, Services):
         self._ended: str | None = None
         self._before: list[Hook] = []
         self._after: list[Hook] = []
-        session = getattr(bus, "session", None)
-        self.remote_renders: dict[int, RemoteRender] = {}  # plugin index -> its renderer link
-        self.render_plugins: dict[int, Plugin] = {}  # in a renderer: plugin index -> plugin
-        self._load_plugins(remote=role == "world" and plan.renderers == "process" and session is not None)
-        if role == "world" and plan.foxglove.scene:
+        self._load_plugins(remote=remote)
+        if self.role == "world" and plan.foxglove.scene:
             from runner.sim.scene import SceneFeed
 
             for fn, period in SceneFeed(self).hooks():
                 self._after.append(Hook(fn, period))
-        if role == "renderer":
+        if self.role == "renderer":
             for plugin in self.plugins:
                 plugin.setup()
             return
         self._clock_sent = -1  # the last clock value published
-        if plan.lockstep and session is not None:
-            keys = self._remote_subscribed  # the same set: keys subscribed later count too
-            self._lockstep = Lockstep(session, plan.name, plan.lockstep, self._received, keys)
         self._clock = self.make_publisher(plan.clock_key, "rosgraph_msgs/msg/Clock")
         self._clock_layout = Layout(
             self._clock.type, msgs.T[self._clock.type](clock=msgs.time_msg(0)), ["clock"]
@@ -161,7 +173,7 @@ class World(PubSub, Services):
                 if role == "renderer" and not cls.renders:
                     continue
                 if remote and cls.renders:
-                    link = RemoteRender(session, self.plan.name, index)
+                    link = self.remote_renders.get(index) or RemoteRender(session, self.plan.name, index)
                     self.remote_renders[index] = link
                     self._after.append(Hook(self._render_hook(link), period))
                     self._hooks_of[index] = [self._after[-1]]
@@ -332,6 +344,9 @@ class World(PubSub, Services):
         factor = {"realtime": 1.0, "max": None}.get(plan.rate, plan.rate)  # type: ignore[arg-type]
         wall0 = time.perf_counter()
         next_check = wall0
+        # the pacing's origin: sim time `pace_ns` at wall time `pace_wall` (moved on by a pause and a reset:
+        # the world never runs fast to catch up the time it stood still, or the sim time a reset took back)
+        pace_ns, pace_wall = self.now_ns, wall0
         steps = 0
         warnings = [d.warning[i] for i in _UNSTABLE]
         badctrl = d.warning[_BADCTRL]
@@ -340,12 +355,24 @@ class World(PubSub, Services):
         error = None
         while True:
             self._boundary()
+            if self._rewind is not None:
+                self._rewound()
+                pace_ns, pace_wall = 0, time.perf_counter()
+                continue  # the boundary at t = 0, as a fresh run's first
             # the hooks' controls, checked before physics takes them (a NaN fails `<=` too), in ~1 µs
             if nu and not np.abs(ctrl, out=abs_ctrl).max() <= CTRL_MAX and (error := self._bad_controls()):
                 break
             if self.now_ns >= end_ns or self._ended is not None:
                 break
+            if self.paused and not self.steps_left:
+                if not self._idle(should_stop):
+                    break
+                pace_ns, pace_wall = self.now_ns, time.perf_counter()
+                if self._rewind is not None:
+                    continue  # (the loop's top resets)
             target = self._next_boundary(end_ns)
+            if self.steps_left:  # step N while paused: stop there, paused again
+                target = min(target, self.now_ns + self.steps_left * self.step_ns)
             n = max(1, math.ceil((target - self.now_ns) / self.step_ns))
             if self._split:
                 mujoco.mj_step2(m, d)  # finish the step begun at the boundary, with the new controls
@@ -359,9 +386,11 @@ class World(PubSub, Services):
                 error = self._instability(self.now_ns, self.now_ns + n * self.step_ns)
                 break
             self.now_ns += n * self.step_ns
+            if self.steps_left:
+                self.steps_left = max(0, self.steps_left - n)
             wall = time.perf_counter()
             if factor is not None:
-                ahead = self.now_ns / 1e9 / factor - (wall - wall0)
+                ahead = (self.now_ns - pace_ns) / 1e9 / factor - (wall - pace_wall)
                 if ahead > 0:
                     sleep_until(wall + ahead)
                     wall = time.perf_counter()
@@ -371,6 +400,12 @@ class World(PubSub, Services):
                     on_progress(self.now_ns)
                 if should_stop():
                     break
+        return self._finish(steps, wall0, error, should_stop)
+
+    def _finish(
+        self, steps: int, wall0: float, error: str | None, should_stop: Callable[[], bool]
+    ) -> WorldStats:
+        """The loop is over: the last lockstep answers, renderers and plugins closed, the run's numbers."""
         if self._lockstep is not None:
             # their answers to the last clock are part of the run (recorded), as every earlier one
             self._lockstep.wait(self._clock_sent, should_stop)
@@ -395,6 +430,29 @@ class World(PubSub, Services):
             rejected=rejected,
             ended=self._ended,
         )
+
+    def _rewound(self) -> None:
+        """A reset_simulation asked at this boundary: done, and its askers answered (at t = 0)."""
+        answers, self._rewind = self._rewind or [], None
+        self.reset_simulation()
+        for answer in answers:
+            answer()
+
+    def _idle(self, should_stop: Callable[[], bool]) -> bool:
+        """Paused: take messages and answer services, sim time standing still, until unpaused, a step or a
+        reset is asked (True), or the run is stopped (False)."""
+        check = time.perf_counter()
+        while self.paused and not self.steps_left and self._rewind is None:
+            self._drain_inbox()
+            self._drain_requests()
+            if self._requests.empty() and self._inbox.empty():
+                time.sleep(0.001)
+            now = time.perf_counter()
+            if now >= check:
+                check = now + 0.05
+                if should_stop():
+                    return False
+        return True
 
     def _bad_controls(self) -> str | None:
         """Controls beyond CTRL_MAX: a NaN or Inf stops the run (the error, naming the actuator, its robot

@@ -1,0 +1,263 @@
+"""Simulation control (runner.sim.control): pause, step, reset, entity state, through the world's own
+services under gazebo_ros's and ros_gz's names, on a MemoryBus with real MuJoCo."""
+
+from __future__ import annotations
+
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from runner.sim.schedule import Hook
+from runner.sim.world import World
+from runner.wire import msgs
+from runner.wire.transport import MemoryBus, unpack_attachment
+from tests.helpers import plan_of, robot_scenario
+
+BOX = """<robot name="b"><link name="base"><inertial><mass value="1"/>
+<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link></robot>"""
+
+# a noisy IMU (a random stream), a falling box and a free world model (physics), a timeline entry
+PLUGINS = "[{type: imu, params: {linear_acceleration_stddev: 0.05, angular_velocity_stddev: 0.01}}]"
+WORLD = """  models:
+    - {name: crate, shape: box, size: [0.2, 0.2, 0.2], pose: {xyz: [1, 0, 0.6]}, static: false}"""
+TIMELINE = """  - {t: 0.1, topic: /note, type: std_msgs/msg/String, data: {data: hello}}"""
+
+
+def _world(tmp_path: Path, duration: float = 0.4) -> tuple[World, MemoryBus]:
+    path = robot_scenario(
+        tmp_path, BOX, plugins=PLUGINS, world=WORLD, timeline=TIMELINE, xyz=(0, 0, 0.5), duration=duration
+    )
+    bus = MemoryBus()
+    world = World(plan_of(path), bus)
+    world._should_stop = lambda: False
+    return world, bus
+
+
+def _call(bus: MemoryBus, key: str, srv: str, data: dict[str, Any] | None = None) -> list[Any]:
+    request = msgs.from_data(f"{srv}_Request", data or {})
+    return bus.call(key, msgs.encode(request, f"{srv}_Request"))
+
+
+def _answer(answers: list[Any], srv: str) -> Any:
+    assert answers and answers[0][1] is None, answers
+    return msgs.decode(answers[0][0], f"{srv}_Response")
+
+
+def _stamps(bus: MemoryBus, suffix: str) -> list[int]:
+    out = []
+    for key, _t, _p, att in bus.sent:
+        if key.endswith(suffix):
+            parsed = unpack_attachment(att)
+            assert parsed is not None
+            out.append(parsed[1])
+    return out
+
+
+def test_world_services_are_declared_under_both_names(tmp_path: Path) -> None:
+    world, _bus = _world(tmp_path)
+    keys = {s.key: s.type for s in world.plan.world_services}
+    assert keys["g/reset_simulation"] == "std_srvs/srv/Empty"
+    assert keys["g/get_entity_state"] == "gazebo_msgs/srv/GetEntityState"
+    assert keys["g/world/g/control"] == "ros_gz_interfaces/srv/ControlWorld"
+    assert keys["g/world/g/set_pose"] == "ros_gz_interfaces/srv/SetEntityPose"
+    assert all(s.owner == "world" for s in world.plan.world_services)
+    assert world.plan.services()[: len(keys)] == world.plan.world_services
+
+
+def test_get_and_set_entity_state(tmp_path: Path) -> None:
+    world, bus = _world(tmp_path)
+    srv = "gazebo_msgs/srv/GetEntityState"
+    got = _call(bus, "g/get_entity_state", srv, {"name": "crate"})
+    rel = _call(bus, "g/get_entity_state", srv, {"name": "crate", "reference_frame": "bot"})
+    link = _call(bus, "g/get_entity_state", srv, {"name": "bot::base"})
+    world._boundary()
+    state = _answer(got, srv)
+    assert state.success and state.state.name == "crate"
+    assert (state.state.pose.position.x, state.state.pose.position.z) == pytest.approx((1.0, 0.6))
+    relative = _answer(rel, srv)  # gazebo_ros_state.cpp:203-213: the pose minus the frame's
+    assert relative.header.frame_id == "bot"
+    assert (relative.state.pose.position.x, relative.state.pose.position.z) == pytest.approx((1.0, 0.1))
+    assert _answer(link, srv).state.pose.position.z == pytest.approx(0.5)
+
+    # set in the frame of the robot, yawed 90 degrees: +x of the frame is +y of the world
+    c, s = np.cos(np.pi / 4), np.sin(np.pi / 4)
+    world.set_entity_state("bot", (0, 0, 0.5), (c, 0, 0, s))
+    ss = "gazebo_msgs/srv/SetEntityState"
+    state_msg = {
+        "name": "crate",
+        "pose": {"position": {"x": 2.0, "z": 0.1}, "orientation": {"w": 1.0}},
+        "twist": {"linear": {"x": 0.5}, "angular": {"z": 1.0}},
+        "reference_frame": "bot",
+    }
+    done = _call(bus, "g/set_entity_state", ss, {"state": state_msg})
+    world._boundary()
+    assert _answer(done, ss).success
+    now = world.entity_state("crate")
+    assert [now["pose"]["position"][k] for k in "xyz"] == pytest.approx([0.0, 2.0, 0.6], abs=1e-9)
+    assert [now["twist"]["linear"][k] for k in "xyz"] == pytest.approx([0.0, 0.5, 0.0], abs=1e-9)
+    assert now["twist"]["angular"]["z"] == pytest.approx(1.0)
+
+    # ros_gz's SetEntityPose, by name
+    sp = "ros_gz_interfaces/srv/SetEntityPose"
+    moved = _call(
+        bus,
+        "g/world/g/set_pose",
+        sp,
+        {"entity": {"name": "crate"}, "pose": {"position": {"x": -1.0, "z": 1}}},
+    )
+    world._boundary()
+    assert _answer(moved, sp).success
+    assert world.entity_state("crate")["pose"]["position"]["x"] == pytest.approx(-1.0)
+
+
+def test_bad_requests_get_false_and_the_world_goes_on(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    world, bus = _world(tmp_path)
+    gs, ss, dl = (
+        "gazebo_msgs/srv/GetEntityState",
+        "gazebo_msgs/srv/SetEntityState",
+        "gazebo_msgs/srv/DeleteEntity",
+    )
+    unknown = _call(bus, "g/get_entity_state", gs, {"name": "ghost"})
+    bad_frame = _call(bus, "g/get_entity_state", gs, {"name": "crate", "reference_frame": "nowhere"})
+    set_unknown = _call(bus, "g/set_entity_state", ss, {"state": {"name": "ghost"}})
+    nan = msgs.from_data(
+        f"{ss}_Request", {"state": {"name": "crate", "pose": {"position": {"x": float("nan")}}}}
+    )
+    set_nan = bus.call("g/set_entity_state", msgs.encode(nan, f"{ss}_Request"))
+    garbage = bus.call("g/set_entity_state", b"\x00\x01\x02")
+    delete_unknown = _call(bus, "g/delete_entity", dl, {"name": "ghost"})
+    step_running = _call(
+        bus, "g/world/g/control", "ros_gz_interfaces/srv/ControlWorld", {"world_control": {"multi_step": 3}}
+    )
+    before = world.entity_state("crate")
+    world._boundary()
+    assert not _answer(unknown, gs).success
+    assert not _answer(bad_frame, gs).success
+    assert not _answer(set_unknown, ss).success
+    assert set_nan[0][0] is None and "not a finite number" in set_nan[0][1]
+    assert garbage[0][0] is None and "does not decode" in garbage[0][1]
+    deleted = _answer(delete_unknown, dl)
+    assert not deleted.success and deleted.status_message == "Entity [ghost] does not exist"
+    # a step asked while running: gz-sim's `pause: false` runs the world; the steps are not taken
+    assert _answer(step_running, "ros_gz_interfaces/srv/ControlWorld").success
+    assert not world.paused and world.steps_left == 0
+    with pytest.raises(ValueError, match="pause it first"):
+        world.step(3)
+    assert world.entity_state("crate") == before
+    err = capsys.readouterr().err
+    assert "entity [ghost] does not exist" in err and "reference entity [nowhere] not found" in err
+    stats = world.run()
+    assert stats.error is None and stats.sim_ns == world.plan.duration_ns
+
+
+def _run_in_thread(world: World) -> tuple[threading.Thread, dict[str, Any]]:
+    out: dict[str, Any] = {}
+    thread = threading.Thread(target=lambda: out.update(stats=world.run()), daemon=True)
+    thread.start()
+    return thread, out
+
+
+def _wait(cond: Any, timeout: float = 20.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not cond():
+        assert time.monotonic() < deadline, "timed out"
+        time.sleep(0.002)
+
+
+def test_pause_step_unpause_in_the_running_loop(tmp_path: Path) -> None:
+    world, bus = _world(tmp_path, duration=0.3)
+    world.pause()  # paused from the start: the loop waits at t = 0, answering services
+    thread, out = _run_in_thread(world)
+    em = "std_srvs/srv/Empty"
+    got = _call(bus, "g/get_entity_state", "gazebo_msgs/srv/GetEntityState", {"name": "bot"})
+    _wait(lambda: bool(got))
+    assert world.now_ns == 0 and _answer(got, "gazebo_msgs/srv/GetEntityState").success
+    clocks = len(_stamps(bus, "g/clock"))
+    time.sleep(0.05)  # (not waiting for anything: showing that nothing happens while paused)
+    assert world.now_ns == 0 and len(_stamps(bus, "g/clock")) == clocks
+    # 25 physics steps of 2 ms: sim time goes to 50 ms, then stands still again
+    cw = "ros_gz_interfaces/srv/ControlWorld"
+    stepped = _call(bus, "g/world/g/control", cw, {"world_control": {"pause": True, "multi_step": 25}})
+    _wait(lambda: bool(stepped) and world.steps_left == 0 and world.now_ns > 0)
+    assert _answer(stepped, cw).success
+    step_ns = world.step_ns
+    assert world.now_ns == 25 * step_ns
+    time.sleep(0.05)
+    assert world.now_ns == 25 * step_ns and thread.is_alive()
+    unpaused = _call(bus, "g/unpause_physics", em)
+    thread.join(timeout=60)
+    assert not thread.is_alive() and unpaused
+    assert out["stats"].sim_ns == world.plan.duration_ns and out["stats"].error is None
+    assert _stamps(bus, "g/pause_physics/_service_event") == []
+    assert len(_stamps(bus, "g/unpause_physics/_service_event")) == 2  # request and response
+
+
+def _published(bus: MemoryBus, start: int = 0) -> dict[str, list[tuple[int, bytes]]]:
+    """Per key (service events left out): (attachment stamp, payload) from bus.sent[start:]."""
+    out: dict[str, list[tuple[int, bytes]]] = {}
+    for key, _t, payload, att in bus.sent[start:]:
+        if "_service_event" in key:
+            continue
+        parsed = unpack_attachment(att)
+        assert parsed is not None
+        out.setdefault(key, []).append((parsed[1], bytes(payload)))
+    return out
+
+
+def test_reset_simulation_publishes_what_a_fresh_run_publishes(tmp_path: Path) -> None:
+    fresh, fresh_bus = _world(tmp_path)
+    fresh.run()
+    expected = _published(fresh_bus)
+    assert {"g/clock", "g/bot/imu", "g/note"} <= set(expected)
+
+    world, bus = _world(tmp_path)
+    at = 150_000_000  # the reset is asked at t = 0.15 s, from inside the world, as a service call
+    marks: list[int] = []
+
+    def ask(now: int) -> None:
+        if now == at:
+            world.request("g/reset_simulation", msgs.T["std_srvs/srv/Empty_Request"](), marks.append)
+
+    world._after.append(Hook(ask, at))
+    stats = world.run()
+    assert marks and world.resets == 1 and stats.error is None
+    events = [i for i, (k, *_r) in enumerate(bus.sent) if k == "g/reset_simulation/_service_event"]
+    assert len(events) == 2  # request at 0.15 s, response after the reset
+    req_stamp = unpack_attachment(bus.sent[events[0]][3])
+    assert req_stamp is not None and req_stamp[1] == at
+    after = _published(bus, events[1] + 1)
+    assert set(after) == set(expected)
+    for key, sent in expected.items():
+        # the same bytes, in the same order; the log time (the attachment's stamp) keeps going: + 0.15 s
+        assert [p for _s, p in after[key]] == [p for _s, p in sent], key
+        assert [s - at for s, _p in after[key]] == [s for s, _p in sent], key
+    response = msgs.decode(bus.sent[events[1]][2], "std_srvs/srv/Empty_Event")
+    assert response.info.stamp.sec == 0 and response.info.stamp.nanosec == 0  # answered at t = 0
+    before = _published(bus, 0)
+    assert all(a <= b for a, b in zip(_stamps(bus, "g/clock"), _stamps(bus, "g/clock")[1:], strict=False))
+    assert len(before["g/clock"]) > len(expected["g/clock"])
+
+
+def test_reset_world_puts_bodies_back_and_time_goes_on(tmp_path: Path) -> None:
+    world, bus = _world(tmp_path)
+    world.set_entity_state("crate", (3, 0, 2), (1, 0, 0, 0), (1, 0, 0), (0, 0, 0))
+    world.now_ns = 100_000_000
+    done = _call(bus, "g/reset_world", "std_srvs/srv/Empty")
+    world._boundary()
+    assert done and done[0][1] is None
+    state = world.entity_state("crate")
+    assert [state["pose"]["position"][k] for k in "xyz"] == pytest.approx([1, 0, 0.6])
+    assert state["twist"]["linear"]["x"] == 0.0
+    assert world.now_ns == 100_000_000 and world.resets == 0
+    # ros_gz's reset model_only is the same
+    world.set_entity_state("crate", (3, 0, 2), (1, 0, 0, 0))
+    cw = "ros_gz_interfaces/srv/ControlWorld"
+    reset = _call(bus, "g/world/g/control", cw, {"world_control": {"reset": {"model_only": True}}})
+    world._boundary()
+    assert _answer(reset, cw).success
+    assert world.entity_state("crate")["pose"]["position"]["x"] == pytest.approx(1.0)
