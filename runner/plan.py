@@ -119,8 +119,9 @@ class RobotPlan(BaseModel):
 class TimelinePlan(BaseModel):
     t_ns: int
     key: str
-    type: str
-    data: dict[str, Any]
+    type: str  # the message's, or with `call` the service's (pkg/srv/Name)
+    data: dict[str, Any]  # the message, or the request
+    call: bool = False  # a call of the world's service `key` (made once per run), not a message
 
 
 class ActorPlan(BaseModel):
@@ -299,7 +300,7 @@ class RunPlan(BaseModel):
                     seen[(t.key, "pub")] = t
                     out.append(t)
         for ev in self.timeline:
-            if (ev.key, "pub") not in seen:
+            if not ev.call and (ev.key, "pub") not in seen:
                 seen[(ev.key, "pub")] = TopicPlan(key=ev.key, type=ev.type, direction="pub", owner="timeline")
                 out.append(seen[(ev.key, "pub")])
         return out

@@ -3,6 +3,7 @@ services under gazebo_ros's and ros_gz's names, on a MemoryBus with real MuJoCo.
 
 from __future__ import annotations
 
+import re
 import threading
 import time
 from pathlib import Path
@@ -11,7 +12,6 @@ from typing import Any
 import numpy as np
 import pytest
 
-from runner.sim.schedule import Hook
 from runner.sim.world import World
 from runner.wire import msgs
 from runner.wire.transport import MemoryBus, unpack_attachment
@@ -215,17 +215,25 @@ def test_reset_simulation_publishes_what_a_fresh_run_publishes(tmp_path: Path) -
     expected = _published(fresh_bus)
     assert {"g/clock", "g/bot/imu", "g/note"} <= set(expected)
 
-    world, bus = _world(tmp_path)
-    at = 150_000_000  # the reset is asked at t = 0.15 s, from inside the world, as a service call
-    marks: list[int] = []
-
-    def ask(now: int) -> None:
-        if now == at:
-            world.request("g/reset_simulation", msgs.T["std_srvs/srv/Empty_Request"](), marks.append)
-
-    world._after.append(Hook(ask, at))
+    # the same scenario, with a reset asked at t = 0.15 s by the timeline (a call, made once per run)
+    at = 150_000_000
+    path = robot_scenario(
+        tmp_path,
+        BOX,
+        plugins=PLUGINS,
+        world=WORLD,
+        timeline=TIMELINE + "\n  - {t: 0.15, call: /reset_simulation}",
+        xyz=(0, 0, 0.5),
+        duration=0.4,
+        seed=1,
+        name="again",
+    )
+    plan = plan_of(path)
+    assert [(e.key, e.call) for e in plan.timeline] == [("g/note", False), ("g/reset_simulation", True)]
+    bus = MemoryBus()
+    world = World(plan, bus)
     stats = world.run()
-    assert marks and world.resets == 1 and stats.error is None
+    assert world.resets == 1 and stats.error is None and stats.sim_ns == plan.duration_ns
     events = [i for i, (k, *_r) in enumerate(bus.sent) if k == "g/reset_simulation/_service_event"]
     assert len(events) == 2  # request at 0.15 s, response after the reset
     req_stamp = unpack_attachment(bus.sent[events[0]][3])
@@ -238,9 +246,30 @@ def test_reset_simulation_publishes_what_a_fresh_run_publishes(tmp_path: Path) -
         assert [s - at for s, _p in after[key]] == [s for s, _p in sent], key
     response = msgs.decode(bus.sent[events[1]][2], "std_srvs/srv/Empty_Event")
     assert response.info.stamp.sec == 0 and response.info.stamp.nanosec == 0  # answered at t = 0
-    before = _published(bus, 0)
-    assert all(a <= b for a, b in zip(_stamps(bus, "g/clock"), _stamps(bus, "g/clock")[1:], strict=False))
-    assert len(before["g/clock"]) > len(expected["g/clock"])
+    clock = _stamps(bus, "g/clock")
+    assert clock == sorted(clock) and len(clock) > len(expected["g/clock"])
+    # the clock's own value went back to 0
+    values = [
+        msgs.decode(p, "rosgraph_msgs/msg/Clock").clock.sec for k, _t, p, _a in bus.sent if k == "g/clock"
+    ]
+    assert values[-1] == 0 and max(values) == 0
+
+
+def test_a_timeline_call_names_a_service_of_the_world(tmp_path: Path) -> None:
+    from runner.errors import ScenarioError
+
+    for entry, message in (
+        ("{t: 0.1, call: /reset_simulaton}", "did you mean '/reset_simulation'?"),
+        (
+            "{t: 0.1, call: /pause_physics, type: std_srvs/srv/Trigger}",
+            "/pause_physics is a std_srvs/srv/Empty",
+        ),
+        ("{t: 0.1, call: /world/g/control, data: {world_control: {pause: 3}}}", "expected true or false"),
+        ("{t: 0.1, topic: /x, call: /pause_physics}", "one of them"),
+    ):
+        path = robot_scenario(tmp_path, BOX, timeline=f"  - {entry}")
+        with pytest.raises(ScenarioError, match=re.escape(message)):
+            plan_of(path)
 
 
 def test_reset_world_puts_bodies_back_and_time_goes_on(tmp_path: Path) -> None:

@@ -153,7 +153,13 @@ def compile_events(
         return []
     model = mujoco.MjModel.from_xml_string(mjcf)
     published = {t.key: t.type for r in robots for p in r.plugins for t in p.topics if t.direction == "pub"}
-    published.update({f"{sc.name}/{e.topic.strip('/')}": msgs.normalize_type(e.type) for e in sc.timeline})
+    published.update(
+        {
+            f"{sc.name}/{e.topic.strip('/')}": msgs.normalize_type(e.type)
+            for e in sc.timeline
+            if e.topic is not None and e.type is not None
+        }
+    )
     for ev in sc.events:
         for act in ev.do:
             if act.publish is not None:

@@ -76,7 +76,8 @@ def compile_world(
         with problems.each():
             mjcf = compile_model(world, robots, sc, doc, notices)
             step = world.option.timestep
-    timeline = compile_timeline(sc, doc, robots, problems)
+    services = control_services(sc.name, world_name)
+    timeline = compile_timeline(sc, doc, robots, problems, services)
     events = compile_events(sc, doc, mjcf, robots, actors, problems)
     record = RecordPlan(enabled=False, path="", include=[], exclude=[])
     with problems.each():
@@ -116,7 +117,7 @@ def compile_world(
         hosts={name: h.endpoint for name, h in sc.hosts.items()},
         resources=sc.resources.model_dump() if sc.resources else None,
         host=host,
-        world_services=control_services(sc.name, world_name),
+        world_services=services,
     )
 
 
@@ -146,7 +147,13 @@ def _assertion_keys(
     # what the world publishes, and what someone else does: the topics its plugins take in (a node's
     # cmd_vel) and those nodes say they publish
     published = {t.key: t.type for r in robots for p in r.plugins for t in p.topics}
-    published.update({f"{sc.name}/{ev.topic.strip('/')}": msgs.normalize_type(ev.type) for ev in sc.timeline})
+    published.update(
+        {
+            f"{sc.name}/{ev.topic.strip('/')}": msgs.normalize_type(ev.type)
+            for ev in sc.timeline
+            if ev.topic is not None and ev.type is not None
+        }
+    )
     declared = declared_topics(sc)
     published.update({k: t for k, t in declared.items() if t is not None})
     unloaded = [*unloaded, *(k for k, t in declared.items() if t is None)]  # (the node's mistake, said there)

@@ -65,6 +65,7 @@ class Control:
         self.steps_left = 0  # physics steps still to run while paused (step N)
         self._rewind: list[Callable[[], None]] | None = None  # a reset_simulation due: who to answer then
         self.resets = 0  # reset_simulation done so far
+        self.calls_made: set[int] = set()  # the timeline's `call` entries made (once per run)
         self._start_qpos: np.ndarray | None = None
         self._rebuilding = False
 

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import mujoco
 import numpy as np
 
-from runner.plan import RunPlan
+from runner.plan import RunPlan, TimelinePlan
 from runner.plugin import Plugin, RobotHandle, RuntimeContext, overrides
 from runner.plugin.registry import load
 from runner.sim.contacts import ContactWatch
@@ -47,7 +47,7 @@ from runner.sim.services import Services
 
 if TYPE_CHECKING:
     from runner.sim.events import Events
-from runner.wire import msgs
+from runner.wire import interfaces, msgs
 from runner.wire.cdr import Layout, Peek
 from runner.wire.transport import Bus
 
@@ -144,9 +144,7 @@ class World(PubSub, Services, Control):
             self._clock.type, msgs.T[self._clock.type](clock=msgs.time_msg(0)), ["clock"]
         )
         self._clock_hook = Hook(self._publish_clock, round(1e9 / plan.clock_rate))
-        self._timeline = [
-            (ev.t_ns, ev.key, ev.type, msgs.from_data(ev.type, ev.data)) for ev in plan.timeline
-        ]
+        self._timeline = [(ev.t_ns, ev.key, ev.type, self._timeline_message(ev)) for ev in plan.timeline]
         self._timeline_i = 0
         if plan.contact_watch:
             for fn, period in ContactWatch(self, plan.contact_watch).hooks():
@@ -158,6 +156,12 @@ class World(PubSub, Services, Control):
             self._events = Events(self)
         for plugin in self.plugins:
             plugin.setup()
+
+    def _timeline_message(self, ev: TimelinePlan) -> Any:
+        """A timeline entry's message, or with `call` its request."""
+        if ev.call:
+            return msgs.from_data(interfaces.service_type(ev.type).request, ev.data)
+        return msgs.from_data(ev.type, ev.data)
 
     def _load_plugins(self, remote: bool) -> None:
         """Every robot's plugins, in plan order, and their hooks. In a renderer process only the rendering
@@ -220,7 +224,11 @@ class World(PubSub, Services, Control):
                 h.next_ns = next_due(h, now)
         while self._timeline_i < len(self._timeline) and self._timeline[self._timeline_i][0] <= now:
             _t, key, type_name, msg = self._timeline[self._timeline_i]
-            self.publish(self.make_publisher(key, type_name), msg, now)
+            if not self.plan.timeline[self._timeline_i].call:
+                self.publish(self.make_publisher(key, type_name), msg, now)
+            elif self._timeline_i not in self.calls_made:  # (once per run: not again after a reset)
+                self.calls_made.add(self._timeline_i)
+                self.request(key, msg)  # answered below, with the requests from outside
             self._timeline_i += 1
         if self._lockstep is not None:
             # the nodes' answers to the clocks published so far come before their next wait message
@@ -289,7 +297,7 @@ class World(PubSub, Services, Control):
         alone are read from the bytes (`Peek`), unless the message object is at hand."""
         plan = self.plan
         own = {t.key for r in plan.robots for p in r.plugins for t in p.topics if t.direction == "pub"}
-        own |= set(self._out) | {ev.key for ev in plan.timeline}
+        own |= set(self._out) | {ev.key for ev in plan.timeline if not ev.call}
         own |= {a["key"] for e in plan.events for a in e.do if a["kind"] == "publish"}
         own.add(f"{plan.name}/_contacts")  # (not a node's topic, though a node declares it: `publishes:`)
         if key in own:
