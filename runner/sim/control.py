@@ -27,6 +27,7 @@ that is not welded to the world, a world model that is not static) or an actor's
 
 from __future__ import annotations
 
+import copy
 import math
 import sys
 from collections.abc import Callable
@@ -61,6 +62,7 @@ class Control:
     _epoch: list[int]
 
     def _init_control(self) -> None:
+        self._model0 = copy.copy(self.model)  # as compiled (reset_simulation puts it back)
         self.paused = False
         self.steps_left = 0  # physics steps still to run while paused (step N)
         self._rewind: list[Callable[[], None]] | None = None  # a reset_simulation due: who to answer then
@@ -96,6 +98,9 @@ class Control:
         for subscribers in w._local.values():
             subscribers.clear()  # (the same lists as the publishers' `local`: emptied in place)
         m, d = self.model, self.data
+        # the model as compiled: the hardware and plugins change some of it as they start (armature,
+        # gains, damping), after the start's mj_forward; they change it again as they start again
+        restore_model(m, self._model0)
         mujoco.mj_resetData(m, d)
         mujoco.mj_forward(m, d)
         self._epoch[0] += self.now_ns
@@ -385,6 +390,35 @@ class Control:
     def _said(self, text: str) -> None:
         """A refused request, on stderr (as gazebo_ros logs RCLCPP_ERROR), at its sim time."""
         print(f"world: t = {self.now_ns / 1e9:.3f} s: {text}", file=sys.stderr)
+
+
+def restore_model(m: mujoco.MjModel, m0: mujoco.MjModel) -> None:
+    """Every number of `m` (arrays, options, visual, statistics) set back to `m0`'s, in place: plugins keep
+    the model they hold. (Both are the same compiled model: same sizes.)"""
+    for name in dir(m0):
+        if name.startswith("_"):
+            continue
+        value = getattr(m0, name, None)
+        if isinstance(value, np.ndarray) and value.size:
+            target = getattr(m, name)
+            if target.flags.writeable:
+                target[...] = value
+    for struct in ("opt", "vis", "stat"):
+        _restore_struct(getattr(m, struct), getattr(m0, struct))
+
+
+def _restore_struct(target: Any, source: Any, depth: int = 0) -> None:
+    """MjOption, MjVisual (nested), MjStatistic: their numbers and arrays, from `source`."""
+    for name in dir(source):
+        if name.startswith("_"):
+            continue
+        value = getattr(source, name)
+        if isinstance(value, np.ndarray):
+            getattr(target, name)[...] = value
+        elif isinstance(value, int | float):
+            setattr(target, name, value)
+        elif depth < 2 and type(value).__module__.startswith("mujoco") and not callable(value):
+            _restore_struct(getattr(target, name), value, depth + 1)
 
 
 def _xyz(v: Any) -> dict[str, float]:

@@ -63,6 +63,8 @@ class WorldStats:
     published: dict[str, int] = field(default_factory=dict)
     error: str | None = None  # why the world stopped early on its own (physics went unstable)
     ended: str | None = None  # an event ended the run (`end:`), and how
+    # the sim time run in all (`sim_ns` plus what reset_simulation took back): the recording's last log time
+    run_ns: int = 0
     rejected: dict[str, dict[str, int]] = field(default_factory=dict)  # inbound samples dropped: key, why
 
 
@@ -432,6 +434,7 @@ class World(PubSub, Services, Control):
         return WorldStats(
             steps=steps,
             sim_ns=self.now_ns,
+            run_ns=self._epoch[0] + self.now_ns,
             wall_s=wall_s,
             published=published,
             error=error,
