@@ -24,7 +24,8 @@ BOX = """<robot name="b"><link name="base"><inertial><mass value="1"/>
 # a noisy IMU (a random stream), a falling box and a free world model (physics), a timeline entry
 PLUGINS = "[{type: imu, params: {linear_acceleration_stddev: 0.05, angular_velocity_stddev: 0.01}}]"
 WORLD = """  models:
-    - {name: crate, shape: box, size: [0.2, 0.2, 0.2], pose: {xyz: [1, 0, 0.6]}, static: false}"""
+    - {name: crate, shape: box, size: [0.2, 0.2, 0.2], pose: {xyz: [1, 0, 0.6]}, static: false}
+    - {name: wall, shape: box, size: [0.1, 2, 1], pose: {xyz: [-2, 0, 0.5], rpy: [0, 0, 1.5707963267948966]}}"""
 TIMELINE = """  - {t: 0.1, topic: /note, type: std_msgs/msg/String, data: {data: hello}}"""
 
 
@@ -101,6 +102,17 @@ def test_get_and_set_entity_state(tmp_path: Path) -> None:
     assert [now["pose"]["position"][k] for k in "xyz"] == pytest.approx([0.0, 2.0, 0.6], abs=1e-9)
     assert [now["twist"]["linear"][k] for k in "xyz"] == pytest.approx([0.0, 0.5, 0.0], abs=1e-9)
     assert now["twist"]["angular"]["z"] == pytest.approx(1.0)
+
+    # a static model: its pose, in its frame as a reference too; it does not move
+    wall = world.entity_state("wall")
+    assert [wall["pose"]["position"][k] for k in "xyz"] == pytest.approx([-2, 0, 0.5])
+    seen = world.entity_state("crate", "wall")["pose"]["position"]  # the wall is turned 90 degrees
+    assert [seen[k] for k in "xyz"] == pytest.approx([2.0, -2.0, 0.1], abs=1e-9)
+    refused = _call(
+        bus, "g/set_entity_state", ss, {"state": {"name": "wall", "pose": {"position": {"x": 1}}}}
+    )
+    world._boundary()
+    assert not _answer(refused, ss).success
 
     # ros_gz's SetEntityPose, by name
     sp = "ros_gz_interfaces/srv/SetEntityPose"

@@ -151,12 +151,17 @@ class Control:
         known = [r.name for r in self.robots] + [
             n for b in range(1, m.nbody) if (n := m.body(b).name) and "/" not in n
         ]
+        known += [n for g in range(m.ngeom) if (n := m.geom(g).name) and self._static_geom(n) >= 0]
         raise EntityError(f"entity [{name}] does not exist (known: {', '.join(sorted(known)) or 'none'})")
 
     def _frame(self, reference: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
         """A reference frame's (pos, 3x3 rotation, linear and angular velocity), None for the world."""
         if reference in ("", "world"):
             return None
+        g = self._static_geom(reference)
+        if g >= 0:
+            d = self.data
+            return d.geom_xpos[g].copy(), d.geom_xmat[g].reshape(3, 3).copy(), np.zeros(3), np.zeros(3)
         try:
             b = self.body_of(reference)
         except EntityError:
@@ -170,12 +175,22 @@ class Control:
         mujoco.mj_objectVelocity(self.model, self.data, mujoco.mjtObj.mjOBJ_BODY, b, v, 0)
         return v[3:].copy(), v[:3].copy()
 
+    def _static_geom(self, name: str) -> int:
+        """A static world model (a shape of the world body, named as the model), or -1."""
+        g = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, name)
+        return g if g >= 0 and int(self.model.geom_bodyid[g]) == 0 and name != "ground" else -1
+
     def entity_state(self, name: str, reference: str = "") -> dict[str, Any]:
         """`{pose: {position, orientation}, twist: {linear, angular}}` (gazebo_msgs/EntityState's fields)."""
-        b = self.body_of(name)
         d = self.data
-        pos, rot = d.xpos[b].copy(), d.xmat[b].reshape(3, 3).copy()
-        lin, ang = self._velocity(b)
+        g = self._static_geom(name)
+        if g >= 0:
+            pos, rot = d.geom_xpos[g].copy(), d.geom_xmat[g].reshape(3, 3).copy()
+            lin, ang = np.zeros(3), np.zeros(3)
+        else:
+            b = self.body_of(name)
+            pos, rot = d.xpos[b].copy(), d.xmat[b].reshape(3, 3).copy()
+            lin, ang = self._velocity(b)
         frame = self._frame(reference)
         if frame is not None:  # gazebo_ros_state.cpp:203-213: pose - frame, velocities into the frame
             fpos, frot, flin, fang = frame
@@ -199,6 +214,8 @@ class Control:
     ) -> None:
         """Move an entity (gazebo_ros_state.cpp:241-312): a zero quaternion counts as no rotation, others
         are normalised; velocities are in the reference's frame (None: left as they are)."""
+        if self._static_geom(name) >= 0:
+            raise EntityError(f"entity [{name}] is a static model: it does not move")
         b = self.body_of(name)
         m, d = self.model, self.data
         pos = np.asarray(position, float)
@@ -332,10 +349,10 @@ class Control:
         reply(msgs.T["ros_gz_interfaces/srv/SetEntityPose_Response"](success=ok))
 
     def _srv_control(self, req: Any, reply: Reply) -> None:
-        """ros_gz ControlWorld (gz-sim's WorldControl): `reset.all` is reset_simulation, `reset.model_only`
-        reset_world; then `pause` sets the state (false runs the world, as in Gazebo Sim); `step` is one
-        step, `multi_step` that many, taken once paused. `time_only`, `seed` and `run_to_sim_time` are
-        refused (success false)."""
+        """ros_gz ControlWorld: `reset.all` is reset_simulation, `reset.model_only` reset_world; then
+        `pause` sets the state (WorldControl has no "as it is": false runs the world); `step` is one step,
+        `multi_step` that many, taken only with `pause: true`. `time_only`, `seed` and `run_to_sim_time`
+        are refused (success false). (Our mapping: gz-sim's handling was not read for it.)"""
         c = req.world_control
         response = msgs.T["ros_gz_interfaces/srv/ControlWorld_Response"]
         refused = [
