@@ -187,6 +187,17 @@ class BridgePlan(BaseModel):
     best_effort: bool = False  # the sim topic is best effort (`qos:`): its copy drops rather than blocks
 
 
+class ServiceBridgePlan(BaseModel):
+    """A service the world answers, offered to ROS 2 as rmw_zenoh offers one (an action is three of these,
+    and its two topics as ordinary `BridgePlan`s)."""
+
+    where: str
+    sim_key: str
+    type: str  # the service type: pkg/srv/Name, or an action's pkg/action/Name_SendGoal ...
+    ros_name: str  # fully qualified
+    ros2: Ros2Plan
+
+
 class FoxglovePlan(BaseModel):
     scene: bool = True  # geometry (foxglove.SceneUpdate), every link's tf, robot_description
     rate: float = 1.0  # scene, tf_static and robot_description are sent again this often (no latching)
@@ -231,6 +242,7 @@ class RunPlan(BaseModel):
     foxglove: FoxglovePlan = FoxglovePlan()  # what the world publishes for a 3D view
     best_effort: list[str] = []  # key expressions whose publishers drop rather than block (qos:)
     bridges: list[BridgePlan] = []  # run by the bridge process (a node of the run)
+    service_bridges: list[ServiceBridgePlan] = []  # services offered to ROS 2 by the bridge process
     world_services: list[ServicePlan] = []  # the world's own (simulation control), beside the plugins'
     ros2: Ros2Plan | None = None  # the run's rmw_zenoh settings, when it appears to ROS 2 as a whole
     # Several worlds: each its own plan, named `<run>/<world>` (so its keys are `<run>/<world>/<ns>/...`),

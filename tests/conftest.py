@@ -105,16 +105,40 @@ def run_cli(*args: str, timeout: float = 60, cwd: Path | None = None) -> subproc
     )
 
 
+def _decoder(factories: list[Any], encoding: str, schema: Any) -> Any:
+    from runner.wire import msgs
+
+    for factory in factories:
+        try:
+            decoder = factory.decoder_for(encoding, schema)
+        except Exception:
+            if "_" not in schema.name.rsplit("/", 1)[-1]:
+                raise
+            return lambda data, name=schema.name: msgs.decode(data, name)
+        if decoder is not None:
+            return decoder
+    raise AssertionError(f"no decoder for {schema.name} ({encoding})")
+
+
 def read_mcap(path: Path) -> list[tuple[str, str, int, Any]]:
     """(topic, type, log_time, decoded message) for every message, decoded by mcap_ros2 (an independent
-    decoder of the ros2msg/CDR format, not ours) or, for the Foxglove scene, mcap_protobuf."""
+    decoder of the ros2msg/CDR format, not ours) or, for the Foxglove scene, mcap_protobuf. A service's or
+    action's messages (`pkg/srv/Name_Event`, `pkg/action/Name_FeedbackMessage`), whose names mcap_ros2's
+    rosidl parser refuses (`^[A-Z][A-Za-z0-9]*$`, as it refuses those of rosbag2's own recordings), are
+    decoded by rosbags from the same bytes."""
     from mcap.reader import make_reader
     from mcap_protobuf.decoder import DecoderFactory as ProtobufDecoders
     from mcap_ros2.decoder import DecoderFactory
 
     out = []
+    factories = [DecoderFactory(), ProtobufDecoders()]
+    decoders: dict[int, Any] = {}
     with open(path, "rb") as f:
-        reader = make_reader(f, decoder_factories=[DecoderFactory(), ProtobufDecoders()])
-        for schema, channel, message, decoded in reader.iter_decoded_messages():
+        reader = make_reader(f)
+        for schema, channel, message in reader.iter_messages():
+            assert schema is not None
+            if schema.id not in decoders:
+                decoders[schema.id] = _decoder(factories, channel.message_encoding, schema)
+            decoded = decoders[schema.id](message.data)
             out.append((channel.topic, schema.name, message.log_time, decoded))
     return out

@@ -21,11 +21,12 @@ from typing import Any, NamedTuple
 
 import zenoh
 
+from runner.compile.plugins import action_topics as action_topics_of
 from runner.errors import Problem, ScenarioError, closest, did_you_mean
-from runner.plan import BridgePlan, NodePlan, Ros2Plan, RunPlan
+from runner.plan import BridgePlan, NodePlan, Ros2Plan, RunPlan, ServiceBridgePlan
 from runner.scenario.loader import Document, PathKey, load_file
 from runner.scenario.schema import Bridge, Ros2, Scenario
-from runner.wire import msgs
+from runner.wire import interfaces, msgs
 from runner.wire.transport import hidden_topic, topic_key
 
 _GZ_DIRECTIONS = {"GZ_TO_ROS": "SIM_TO_ZENOH", "ROS_TO_GZ": "ZENOH_TO_SIM", "BIDIRECTIONAL": "BIDIRECTIONAL"}
@@ -160,21 +161,25 @@ def attach_bridges(plan: RunPlan, sc: Scenario, doc: Document, unchecked: Sequen
     if problems:
         raise ScenarioError(problems)
     run_ros2 = _ros2_plan(sc.ros2, None, sc.name)
+    services: list[ServiceBridgePlan] = []
     if run_ros2 is not None and run_ros2.topics == "all":
         out += _mirror_all(topics, run_ros2, plan)
+        services = _mirror_services(plan, run_ros2)
     if plan.best_effort:
         drop = [zenoh.KeyExpr(e) for e in plan.best_effort]
         for b in out:
             b.best_effort = any(e.intersects(zenoh.KeyExpr(b.sim_key)) for e in drop)
     plan.bridges = out
+    plan.service_bridges = services
     plan.ros2 = run_ros2
-    if out:
+    if out or services:
         taken = {n.name for n in plan.nodes}
         name = next(n for n in ("bridge", "_bridge", "scenario_bridge") if n not in taken)
         spec = {
             "run": plan.name,
             "clocks": [p.clock_key for p in plan.parts()],
             "bridges": [b.model_dump(mode="json") for b in out],
+            "services": [s.model_dump(mode="json") for s in services],
             # nodes' topics are known once they run: the bridge mirrors them as they appear
             "mirror_nodes": run_ros2.model_dump(mode="json")
             if run_ros2 is not None and run_ros2.topics == "all"
@@ -189,6 +194,32 @@ def attach_bridges(plan: RunPlan, sc: Scenario, doc: Document, unchecked: Sequen
                 required=True,  # a bridge lost is a run that no longer does what it says
             )
         )
+
+
+def _mirror_services(plan: RunPlan, ros2: Ros2Plan) -> list[ServiceBridgePlan]:
+    """`ros2: {topics: all}`: every service the worlds answer as `/<ns>/<service>`, each action as its
+    three services (its topics are mirrored with the others)."""
+    out = []
+    for part in plan.parts():
+        for s in part.services():
+            rel = s.key[len(part.name) + 1 :]
+            pairs = (
+                [(f"{s.key}/{suffix}", t) for suffix, t in interfaces.action_parts(s.type)[0]]
+                if s.kind == "action"
+                else [(s.key, s.type)]
+            )
+            for key, type_name in pairs:
+                name = "/" + key[len(part.name) + 1 :]
+                out.append(
+                    ServiceBridgePlan(
+                        where=f"ros2 ({rel}, {s.owner})",
+                        sim_key=key,
+                        type=type_name,
+                        ros_name=name,
+                        ros2=ros2,
+                    )
+                )
+    return out
 
 
 def _check_type(
@@ -563,10 +594,13 @@ def _mirror_all(topics: _Topics, ros2: Ros2Plan, plan: RunPlan) -> list[BridgePl
                     key = topic_key(part.name, r.namespace, "robot_description")
                     table.setdefault(key, ("std_msgs/msg/String", {"pub"}))
     out = []
+    # an action's topics are under `_action/`, hidden as ROS 2 hides them from `ros2 topic list`, but its
+    # clients subscribe to them
+    action_topics = {t.key for part in plan.parts() for t in action_topics_of(part.services())}
     for key, (type_name, directions) in sorted(table.items()):
         rel = key[len(topics.run) + 1 :]
-        if hidden_topic(rel) or not msgs.is_known(type_name):  # (the Foxglove scene is not a ROS 2 type)
-            continue
+        if (hidden_topic(rel) and key not in action_topics) or not msgs.is_known(type_name):
+            continue  # (the Foxglove scene is not a ROS 2 type)
         direction = (
             "BIDIRECTIONAL"
             if directions == {"pub", "sub"}

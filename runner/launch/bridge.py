@@ -28,21 +28,23 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import zenoh
 import zenoh.ext
 
-from runner.plan import BridgePlan, Ros2Plan
+from runner.plan import BridgePlan, Ros2Plan, ServiceBridgePlan
 from runner.wire import msgs, ros2
 from runner.wire.graph import GraphTokens
+from runner.wire.interfaces import known_service
 from runner.wire.transport import (
     encoding_for,
     hidden_topic,
     make_config,
     meta_key,
     pack_attachment,
+    service_encoding,
     unpack_attachment,
 )
 
@@ -50,6 +52,7 @@ REMOTE = zenoh.Locality.REMOTE
 LINGER_QUIET_S = 0.2  # on stop, leave once nothing was forwarded for this long...
 LINGER_MAX_S = 0.8  # ...or after this (within the runner's STOP_GRACE_S)
 TF = "tf2_msgs/msg/TFMessage"
+SERVICE_TIMEOUT_S = 30.0  # how long a request waits for the world (a paused world answers at once)
 
 
 def _json_default(value: Any) -> Any:
@@ -87,7 +90,8 @@ class _RosNode:
         )
 
     def entity(self, kind: str, topic: str, type_name: str, qos: ros2.Qos) -> tuple[Any, bytes]:
-        """A publisher ("MP") or subscription ("MS") token; returns it and the entity's GID."""
+        """A publisher ("MP"), subscription ("MS") or service server ("SS") token; returns it and the
+        entity's GID."""
         key = ros2.entity_token(
             self.plan.domain,
             self.zid,
@@ -129,7 +133,14 @@ class _RosOut:
 
 
 class Bridge:
-    def __init__(self, session: zenoh.Session, run: str, clocks: list[str], plans: list[BridgePlan]):
+    def __init__(
+        self,
+        session: zenoh.Session,
+        run: str,
+        clocks: list[str],
+        plans: list[BridgePlan],
+        services: Sequence[ServiceBridgePlan] = (),
+    ):
         self.session = session
         self.run = run
         self.sim_ns = 0
@@ -146,6 +157,10 @@ class Bridge:
         self._lock = threading.Lock()
         for p in plans:
             self._add(p)
+        self._served: set[tuple[str, str]] = set()
+        for sp in services:
+            self._served.add((sp.sim_key, "srv"))
+            self._serve_ros(sp)
 
     def _add(self, p: BridgePlan) -> None:
         other = p.ros_topic if p.ros2 else p.key
@@ -158,8 +173,8 @@ class Bridge:
             (self._outbound if direction == "SIM_TO_ZENOH" else self._inbound)(p)
 
     def mirror_nodes(self, ros: Ros2Plan) -> None:
-        """`ros2: {topics: all}`: the topics nodes publish and subscribe to (announced in the run's graph as
-        the nodes start) appear to ROS 2 too, as `/<ns>/<topic>`."""
+        """`ros2: {topics: all}`: the topics nodes publish and subscribe to, and the services they answer
+        (announced in the run's graph as the nodes start) appear to ROS 2 too, as `/<ns>/<name>`."""
         from runner.wire.graph import Graph
 
         def on_token(sample: zenoh.Sample) -> None:
@@ -170,6 +185,20 @@ class Bridge:
             for e in graph.endpoints:
                 rel = e.key[len(self.run) + 1 :] if e.key.startswith(self.run + "/") else ""
                 if graph.processes.get(e.process) != "node" or not rel or hidden_topic(rel) or "*" in rel:
+                    continue
+                if e.kind == "srv":  # a service a node answers
+                    if e.type and known_service(e.type):
+                        sp = ServiceBridgePlan(
+                            where=f"ros2 (/{rel}, node {e.process})",
+                            sim_key=e.key,
+                            type=e.type,
+                            ros_name="/" + rel,
+                            ros2=ros,
+                        )
+                        with self._lock, contextlib.suppress(Exception):
+                            if (e.key, "srv") not in self._served:
+                                self._served.add((e.key, "srv"))
+                                self._serve_ros(sp)
                     continue
                 if e.kind not in ("pub", "sub"):
                     continue
@@ -388,6 +417,73 @@ class Bridge:
 
         self._keep.append(session.declare_subscriber(key, on_sample, allowed_origin=REMOTE))
 
+    # ---------------------------------------------------------------------------------- ROS 2 services
+    def _serve_ros(self, sp: ServiceBridgePlan) -> None:
+        """A service the world answers, offered as rmw_zenoh's ServiceData offers one
+        (rmw_zenoh_cpp/src/detail/rmw_service_data.cpp, rolling 2025): a queryable on the service's key
+        declared `complete`, an `SS` liveliness token, and each reply carrying the request's sequence
+        number, a new source timestamp and the client's GID (attachment_helpers.cpp). The request goes on
+        to the world's queryable as it came (CDR, and the client's attachment, which the world records);
+        the world's reply comes back the same way. An error from the world (a request that does not
+        decode, a handler that failed) is a Zenoh error reply, which rmw_zenoh's client logs and drops."""
+        node = self._ros_node(sp.ros2)
+        token, _gid = node.entity("SS", sp.ros_name, sp.type, ros2.Qos())
+        self._keep.append(token)
+        key = ros2.topic_key(sp.ros2.domain, sp.ros_name, sp.type)
+        # get_result waits for the end of the goal (rmw_zenoh's client waits for ever there, too)
+        timeout = 10 * 365 * 86400.0 if sp.ros_name.endswith("/_action/get_result") else SERVICE_TIMEOUT_S
+        session = self.session
+
+        def on_query(query: zenoh.Query) -> None:
+            att = query.attachment.to_bytes() if query.attachment is not None else None
+            parsed = ros2.unpack_attachment(att)
+            if parsed is None:
+                self.complain(sp.where, f"a request on {key} without rmw_zenoh's attachment")
+                query.reply_err("rmw_zenoh requests carry an attachment (sequence number, timestamp, GID)")
+                query.drop()
+                return
+            seq, _stamp, gid = parsed
+            payload = query.payload.to_bytes() if query.payload is not None else b""
+            state = {"answered": False}
+            lock = threading.Lock()
+
+            def answer(reply: zenoh.Reply | None) -> None:
+                with lock:
+                    if state["answered"]:
+                        return
+                    state["answered"] = True
+                try:
+                    if reply is not None and reply.ok is not None:
+                        out = reply.ok.payload.to_bytes()
+                        query.reply(key, out, attachment=ros2.pack_attachment(seq, time.time_ns(), gid))
+                    else:
+                        why = (
+                            reply.err.payload.to_string() if reply is not None and reply.err else "no answer"
+                        )
+                        query.reply_err(why)
+                except Exception as e:  # (the client went away)
+                    self.complain(sp.where, f"could not answer a request: {e}")
+                finally:
+                    query.drop()
+                self.last_forward = time.monotonic()
+
+            def on_reply(reply: zenoh.Reply) -> None:
+                answer(reply)
+
+            session.get(
+                sp.sim_key,
+                zenoh.handlers.Callback(on_reply, lambda: answer(None)),
+                payload=payload,
+                attachment=att,
+                timeout=timeout,
+                target=zenoh.QueryTarget.ALL_COMPLETE,
+                consolidation=zenoh.ConsolidationMode.NONE,
+                encoding=service_encoding(f"{sp.type}_Request"),
+            )
+
+        self._keep.append(session.declare_queryable(key, on_query, complete=True))
+        self.graph.service(key, sp.type)
+
     def close(self) -> None:
         for ent in reversed(self._keep):
             with contextlib.suppress(Exception):
@@ -411,19 +507,23 @@ def main() -> int:
         )
         return 2
     plans = [BridgePlan.model_validate(b) for b in spec["bridges"]]
-    routers = sorted({p.ros2.router for p in plans if p.ros2 is not None and p.ros2.router})
+    services = [ServiceBridgePlan.model_validate(s) for s in spec.get("services", [])]
+    routers = sorted(
+        {p.ros2.router for p in plans if p.ros2 is not None and p.ros2.router}
+        | {s.ros2.router for s in services if s.ros2.router}
+    )
     stop = threading.Event()
     signal.signal(signal.SIGINT, lambda *_: stop.set())
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     parent = os.getppid()
     # a peer joins several routers (the run's and a ROS 2 one); a client only the first it reaches
     conf = make_config("peer" if routers else "client", connect=[endpoint, *routers])
-    if any(p.ros2 is not None for p in plans) or spec.get("mirror_nodes"):
+    if any(p.ros2 is not None for p in plans) or services or spec.get("mirror_nodes"):
         # zenoh-ext's advanced publisher (TRANSIENT_LOCAL topics) stamps its samples, as rmw_zenoh's
         # sessions do (its default config enables timestamping)
         conf.insert_json5("timestamping/enabled", "true")
     with zenoh.open(conf) as session:
-        bridge = Bridge(session, spec["run"], list(spec["clocks"]), plans)
+        bridge = Bridge(session, spec["run"], list(spec["clocks"]), plans, services)
         if spec.get("mirror_nodes"):
             bridge.mirror_nodes(Ros2Plan.model_validate(spec["mirror_nodes"]))
         ready = session.liveliness().declare_token(meta_key(spec["run"], "bridge", "alive"))

@@ -50,7 +50,7 @@ class GoalHandle:
         self.goal_id = goal_id
         self.goal = goal
         self.accepted_ns = accepted_ns
-        self.status = ACCEPTED
+        self.status = UNKNOWN  # until `on_goal` accepts it: a rejected goal never becomes active
         self.result: Any = None
         self.ended_ns: int | None = None
         self._waiting: list[Reply] = []  # get_result requests that wait for the end
@@ -167,8 +167,7 @@ class ActionServer:
         if not self.on_goal(handle):
             reply(response(accepted=False, stamp=msgs.time_msg(now)))
             return
-        if handle.status == ACCEPTED:
-            handle.status = EXECUTING
+        handle.status = EXECUTING
         self.goals[goal_id] = handle
         reply(response(accepted=True, stamp=msgs.time_msg(now)))
         self._publish_status()

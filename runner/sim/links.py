@@ -150,10 +150,16 @@ class Lockstep:
                 )
             self._cond.notify_all()
 
-    def wait(self, clock_sent: int, should_stop: Callable[[], bool]) -> None:
+    def wait(
+        self, clock_sent: int, should_stop: Callable[[], bool], serve: Callable[[], None] | None = None
+    ) -> None:
+        """Until every node answered the clock; `serve()` answers the requests that arrive meanwhile (a
+        lockstep node that asks the world something in its turn waits for the answer before it answers)."""
         deadline = time.monotonic() + self.TIMEOUT_S
-        with self._cond:
-            while True:
+        while True:
+            if serve is not None:
+                serve()
+            with self._cond:
                 late = [n for n in self.names if not self._answered(n, clock_sent)]
                 if not late or should_stop():
                     return

@@ -88,6 +88,9 @@ class Services:
 
         def on_request(payload: bytes, attachment: bytes | None, respond: Respond) -> None:
             self._requests.put(_Request(key, payload, attachment, respond))
+            lockstep = getattr(self, "_lockstep", None)
+            if lockstep is not None:
+                lockstep.poke()  # (a lockstep node may be waiting for this answer in its turn)
 
         queryable = getattr(self.bus, "queryable", None)
         if queryable is not None:

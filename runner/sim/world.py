@@ -234,7 +234,7 @@ class World(PubSub, Services, Control):
             self._timeline_i += 1
         if self._lockstep is not None:
             # the nodes' answers to the clocks published so far come before their next wait message
-            self._lockstep.wait(self._clock_sent, self._should_stop)
+            self._lockstep.wait(self._clock_sent, self._should_stop, self._drain_requests)
         self._drain_inbox()
         self._drain_requests()  # after the messages: a service sees what a controller sees
         events = self._events

@@ -25,7 +25,7 @@ from typing import Any
 from rosbags.typesys import get_types_from_msg
 from rosbags.typesys.base import Nodetype
 
-from runner.wire.msgs import TYPESTORE, normalize_type
+from runner.wire.msgs import TYPESTORE
 
 # messages the services and actions below refer to that the Jazzy store lacks
 _MESSAGES = {
@@ -329,9 +329,7 @@ _register()
 def service_type(name: str) -> ServiceType:
     """`std_srvs/srv/Empty` (or `std_srvs/Empty`, or an action's `pkg/action/Name_SendGoal`) as a
     ServiceType; KeyError for a service this module does not know."""
-    full = normalize_type(name) if name.count("/") == 1 else name
-    if full.count("/") == 1:
-        full = full.replace("/", "/srv/", 1)
+    full = name.replace("/", "/srv/", 1) if name.count("/") == 1 else name
     if f"{full}_Request" not in TYPESTORE.fielddefs or full not in TYPESTORE.fielddefs:
         known = ", ".join(sorted(SERVICES))
         raise KeyError(f"unknown service type {name!r} (known: {known})")

@@ -159,9 +159,62 @@ def decode(data: bytes | memoryview, type_name: str) -> Any:
 
 @cache
 def msgdef(type_name: str) -> str:
-    """The `ros2msg` schema text of a type, with its dependencies (as MCAP and Foxglove expect)."""
-    text, _ = TYPESTORE.generate_msgdef(type_name, ros_version=2)
-    return text
+    """The `ros2msg` schema text of a type, with its dependencies (as MCAP and Foxglove expect). A service's
+    or action's messages (`pkg/srv/Name_Event`, `pkg/action/Name_FeedbackMessage`), which rosbags' writer
+    refuses, are written the same way."""
+    if "/msg/" in type_name and all("/msg/" in t for t in _dependencies(type_name)):
+        text, _ = TYPESTORE.generate_msgdef(type_name, ros_version=2)
+        return text
+    parts = [_definition(type_name)]
+    for dep in _dependencies(type_name):
+        parts.append(f"{'=' * 80}\nMSG: {_short(dep)}\n{_definition(dep)}")
+    return "\n".join(parts)
+
+
+def _short(name: str) -> str:
+    """`pkg/msg/Name` -> `pkg/Name`, as ros2msg dependency headers and field types write messages; a
+    service's or action's message too (`pkg/srv/Name_Request` -> `pkg/Name_Request`): readers of the
+    format (rosidl_adapter's parser in mcap_ros2, Foxglove's) take `pkg/Name` only."""
+    pkg, _kind, short = name.split("/")
+    return f"{pkg}/{short}"
+
+
+def _dependencies(type_name: str) -> list[str]:
+    """Every type `type_name` refers to, depth first, each once."""
+    out: list[str] = []
+    todo = [type_name]
+    while todo:
+        name = todo.pop(0)
+        for _f, (kind, detail) in TYPESTORE.fielddefs[name][1]:
+            if kind == Nodetype.BASE:
+                continue
+            ref = detail if kind == Nodetype.NAME else detail[0][1]
+            if isinstance(ref, str) and ref not in out and ref != type_name:
+                out.append(ref)
+                todo.append(ref)
+    return out
+
+
+def _definition(name: str) -> str:
+    consts, fields = TYPESTORE.fielddefs[name]
+    lines = [f"{ctype} {cname}={value}" for cname, ctype, value in consts]
+    for fname, node in fields:
+        lines.append(f"{_field_text(node)} {fname}")
+    return "\n".join(lines) + "\n"
+
+
+def _field_text(node: tuple[Any, Any]) -> str:
+    kind, detail = node
+    if kind == Nodetype.BASE:
+        base, bound = detail
+        return f"{base}<={bound}" if bound else base
+    if kind == Nodetype.NAME:
+        return _short(detail)
+    inner, length = detail
+    text = _field_text(inner)
+    if kind == Nodetype.ARRAY:
+        return f"{text}[{length}]"
+    return f"{text}[<={length}]" if length else f"{text}[]"
 
 
 def time_msg(ns: int) -> Any:
@@ -359,3 +412,8 @@ def path_text(path: tuple[str | int, ...]) -> str:
     for part in path:
         text += f"[{part}]" if isinstance(part, int) else (f".{part}" if text else part)
     return text
+
+
+# the service and action types (and their messages) are registered with the messages: every process that
+# decodes one (the recorder, `scenario echo`, a report) knows them
+from runner.wire import interfaces as _interfaces  # noqa: E402, F401

@@ -34,6 +34,7 @@ from functools import cache
 
 import xxhash
 
+from runner.wire import interfaces  # (registers the service and action types hashed here)
 from runner.wire.msgs import TYPESTORE, normalize_type
 
 ADMIN_SPACE = "@ros2_lv"
@@ -145,7 +146,8 @@ def qualified_name(namespace: str, name: str) -> str:
 
 
 def topic_key(domain: int, fq_name: str, ros_type: str) -> str:
-    """`<domain>/<name without leading slash>/<dds type>/<type hash>`, the key a topic's data goes on."""
+    """`<domain>/<name without leading slash>/<dds type>/<type hash>`, the key a topic's data goes on; for a
+    service type (`pkg/srv/Name`, `pkg/action/Name_SendGoal`), the key its queryable is declared on."""
     _check_domain(domain)
     inner = fq_name.strip("/")
     if not inner:
@@ -233,6 +235,9 @@ def topic_qos(fq_topic: str) -> Qos:
     `robot_description` (at any namespace), depth 100 for `tf`, the default (reliable, volatile, depth 10)
     otherwise."""
     last = fq_topic.rstrip("/").rsplit("/", 1)[-1]
+    if fq_topic.rstrip("/").endswith("/_action/status"):
+        # rcl_action's rcl_action_qos_profile_status_default: reliable, TRANSIENT_LOCAL, keep last 1
+        return Qos(durability="transient_local", depth=1)
     if last in LATCHED_TOPICS:
         return Qos(durability="transient_local", depth=1)
     if last == "tf":
@@ -282,11 +287,19 @@ def entity_token(
     qos: Qos = Qos(),  # frozen, so one shared default is safe
     enclave: str = "",
 ) -> str:
-    """The liveliness token key of a publisher (`MP`) or subscription (`MS`): the node's chunks with the
-    entity id, then `<mangled topic>/<dds type>/<type hash>/<qos>`. A relative `fq_topic` is resolved in
-    the node's namespace."""
-    if kind not in ("MP", "MS"):
-        raise ValueError(f"entity kind must be 'MP' or 'MS', not {kind!r}")
+    """The liveliness token key of a publisher (`MP`), subscription (`MS`), service server (`SS`) or client
+    (`SC`): the node's chunks with the entity id, then `<mangled name>/<dds type>/<type hash>/<qos>`. A
+    relative `fq_topic` is resolved in the node's namespace. For a service, `ros_type` is the service type
+    (`std_srvs/srv/Empty`, an action's `pkg/action/Name_SendGoal`): its DDS name without `Request_` /
+    `Response_` and its service hash, as rmw_zenoh's ServiceData / ClientData::make write them
+    (rmw_zenoh_cpp/src/detail/rmw_service_data.cpp, rmw_client_data.cpp)."""
+    if kind not in ("MP", "MS", "SS", "SC"):
+        raise ValueError(f"entity kind must be one of MP, MS, SS, SC, not {kind!r}")
+    if kind in ("SS", "SC"):
+        try:
+            interfaces.service_type(ros_type)
+        except KeyError as e:
+            raise ValueError(f"a service's token needs a service type: {e.args[0]}") from None
     chunks = _node_chunks(domain, zid, node_id, entity_id, kind, namespace, node, enclave)
     topic = qualified_name(namespace, fq_topic)
     chunks += [mangle(topic), dds_type_name(ros_type), type_hash(ros_type), qos_chunk(qos)]
