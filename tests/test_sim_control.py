@@ -350,3 +350,50 @@ def test_a_recorded_run_after_reset_simulation_is_a_fresh_runs_recording(tmp_pat
         before = [m for m in sent if m[0] <= at]
         again = [(t + at, p) for t, p in sent]
         assert reset[topic] == before + again, topic
+
+
+CAMERAS = """
+name: cams
+duration: 0.6
+rate: max
+seed: 3
+renderers: process
+robots:
+  - name: r1
+    description: {{file: "{{diffbot}}"}}
+    pose: {{xyz: [0, 0, 0.06]}}
+    plugins:
+      - {{type: diff_drive}}
+      - {{type: camera, params: {{link: lidar_link, width: 32, height: 24, rate: 20, noise_stddev: 2.0}}}}
+timeline:
+  - {{t: 0.1, topic: r1/cmd_vel, type: geometry_msgs/msg/Twist, data: {{angular: {{z: 1.0}}}}}}
+{extra}"""
+
+
+@pytest.mark.timeout(180)
+def test_a_renderer_process_is_reset_with_its_world(write_scenario: Any, tmp_path: Path) -> None:
+    """Cameras rendered in a renderer process: after a reset their frames (noise included) are a fresh
+    run's again, and their log times go on, as the world's own topics'."""
+    from mcap.reader import make_reader
+
+    from tests.conftest import run_cli
+
+    def frames(path: Path) -> list[tuple[int, bytes]]:
+        with open(path, "rb") as f:
+            return [
+                (m.log_time, bytes(m.data))
+                for _s, ch, m in make_reader(f).iter_messages(log_time_order=False)
+                if ch.topic == "cams/r1/camera/image_raw"
+            ]
+
+    runs = {}
+    for name, extra in (("fresh", ""), ("reset", "  - {t: 0.3, call: /reset_simulation}")):
+        path = write_scenario(CAMERAS.format(extra=extra), f"{name}.yaml")
+        mcap = tmp_path / f"{name}.mcap"
+        proc = run_cli("run", str(path), "--record", str(mcap), "-q", "--no-judge", timeout=150)
+        assert proc.returncode == 0, proc.stderr
+        runs[name] = frames(mcap)
+    fresh, reset = runs["fresh"], runs["reset"]
+    at = 300_000_000
+    assert len(fresh) >= 10
+    assert reset == [m for m in fresh if m[0] <= at] + [(t + at, p) for t, p in fresh]

@@ -112,6 +112,24 @@ class Control:
         finally:
             self._rebuilding = False
 
+    def renderer_reset(self, epoch_ns: int) -> None:
+        """In a renderer process: the world it renders for was reset (`reset_simulation`), its sim time run
+        before that now `epoch_ns`: the rendering plugins made again from the model as compiled."""
+        w: Any = self
+        for plugin in w.plugins:
+            plugin.close()
+        for subscribers in w._local.values():
+            subscribers.clear()
+        restore_model(self.model, self._model0)
+        mujoco.mj_resetData(self.model, self.data)
+        mujoco.mj_forward(self.model, self.data)
+        self._epoch[0] = epoch_ns
+        self._rebuilding = True
+        try:
+            w._build(remote=False)
+        finally:
+            self._rebuilding = False
+
     def reset_world(self) -> None:
         """Bodies back to their start poses, at rest; time and plugins go on."""
         m, d = self.model, self.data

@@ -253,7 +253,7 @@ class World(PubSub, Services, Control):
     # ---------------------------------------------------------------------------- renderer processes
     def _render_hook(self, link: RemoteRender) -> Callable[[int], None]:
         def send(now: int) -> None:
-            link.send(now, self._state_bytes(), self._should_stop)
+            link.send(now, self._state_bytes(), self._should_stop, self._epoch[0])
 
         return send
 
@@ -271,8 +271,12 @@ class World(PubSub, Services, Control):
             time.sleep(0.02)
         return True
 
-    def render(self, index: int, now_ns: int, state: bytes) -> None:
-        """In a renderer process: pose the world as the state says and run the plugin's hook."""
+    def render(self, index: int, now_ns: int, state: bytes, epoch_ns: int = 0) -> None:
+        """In a renderer process: pose the world as the state says and run the plugin's hook. A new
+        `epoch_ns`: the world was reset (reset_simulation): the rendering plugins are made again, as the
+        world's own are (their noise streams from the start), and stamp their messages' log time on."""
+        if epoch_ns != self._epoch[0]:
+            self.renderer_reset(epoch_ns)
         m, d = self.model, self.data
         nq, nm = m.nq, m.nmocap
         values = np.frombuffer(state, dtype=np.float64)
