@@ -397,3 +397,20 @@ def test_a_renderer_process_is_reset_with_its_world(write_scenario: Any, tmp_pat
     at = 300_000_000
     assert len(fresh) >= 10
     assert reset == [m for m in fresh if m[0] <= at] + [(t + at, p) for t, p in fresh]
+
+
+def test_after_a_pause_the_pacing_does_not_catch_up(tmp_path: Path) -> None:
+    """rate: realtime: 0.3 s of sim after 0.3 s paused still take 0.3 s of wall time (the pacing starts
+    again where it stood; it would otherwise run the paused time's worth at full speed)."""
+    world, bus = _world(tmp_path, duration=0.3)
+    world.plan.rate = "realtime"
+    world.pause()
+    thread, out = _run_in_thread(world)
+    time.sleep(0.3)  # (the pause being measured, not a wait for something)
+    assert world.now_ns == 0
+    start = time.perf_counter()
+    _call(bus, "g/unpause_physics", "std_srvs/srv/Empty")
+    thread.join(timeout=30)
+    took = time.perf_counter() - start
+    assert not thread.is_alive() and out["stats"].sim_ns == 300_000_000
+    assert took >= 0.25, f"0.3 s of sim ran in {took:.3f} s of wall time after the pause"
