@@ -414,3 +414,56 @@ def test_after_a_pause_the_pacing_does_not_catch_up(tmp_path: Path) -> None:
     took = time.perf_counter() - start
     assert not thread.is_alive() and out["stats"].sim_ns == 300_000_000
     assert took >= 0.25, f"0.3 s of sim ran in {took:.3f} s of wall time after the pause"
+
+
+def test_an_event_calls_a_service_once_per_run(tmp_path: Path) -> None:
+    """An event's `call` resets the world in the step it fires; the event, made again by the reset, fires
+    again at its time but does not call again (it would reset for ever); what follows is a fresh run's."""
+    fresh, fresh_bus = _world(tmp_path)
+    fresh.run()
+    expected = _published(fresh_bus)
+
+    path = robot_scenario(
+        tmp_path,
+        BOX,
+        plugins=PLUGINS,
+        world=WORLD,
+        timeline=TIMELINE,
+        xyz=(0, 0, 0.5),
+        duration=0.4,
+        name="ev",
+    )
+    with path.open("a") as f:
+        f.write(
+            "\nevents:\n  - {name: again, when: {at: 0.15}, do: [{call: {service: /reset_simulation}}]}\n"
+        )
+    plan = plan_of(path)
+    assert plan.events[0].do[0] == {
+        "kind": "call",
+        "key": "g/reset_simulation",
+        "type": "std_srvs/srv/Empty",
+        "data": {},
+        "service": "/reset_simulation",
+    }
+    bus = MemoryBus()
+    world = World(plan, bus)
+    stats = world.run()
+    assert world.resets == 1 and stats.run_ns == 150_000_000 + plan.duration_ns
+    said = [msgs.decode(p, "std_msgs/msg/String").data for k, _t, p, _a in bus.sent if k == "g/_events"]
+    assert len(said) == 2 and "called /reset_simulation" in said[0] and "already called" in said[1]
+    events = [i for i, (k, *_r) in enumerate(bus.sent) if k == "g/reset_simulation/_service_event"]
+    req = unpack_attachment(bus.sent[events[0]][3])
+    assert len(events) == 2 and req is not None and req[1] == 150_000_000  # asked and answered in its step
+    after = _published(bus, events[1] + 1)
+    after.pop("g/_events")
+    assert set(after) == set(expected)
+    for key, sent in expected.items():
+        assert [p for _s, p in after[key]] == [p for _s, p in sent], key
+
+    bad = robot_scenario(tmp_path, BOX, name="bad")
+    with bad.open("a") as f:
+        f.write("\nevents:\n  - {name: x, when: {at: 0.1}, do: [{call: {service: /pause_physic}}]}\n")
+    from runner.errors import ScenarioError
+
+    with pytest.raises(ScenarioError, match=re.escape("did you mean '/pause_physics'?")):
+        plan_of(bad)

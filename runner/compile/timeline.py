@@ -22,11 +22,7 @@ def compile_timeline(
 ) -> list[TimelinePlan]:
     """The timeline's entries checked (each on its own: its mistakes to `problems`), in time order. A
     `call` must name one of the world's services (`world_services`, the plugins' of `robots`)."""
-    services = {
-        s.key: s.type
-        for s in [*(world_services or []), *(s for r in robots for p in r.plugins for s in p.services)]
-        if s.kind == "service"
-    }
+    services = service_types(world_services or [], robots)
     ordered: list[tuple[int, TimelinePlan]] = []
     for i in range(len(sc.timeline)):
         with problems.each():
@@ -119,27 +115,40 @@ def timeline_entry(sc: Scenario, i: int, doc: Document) -> TimelinePlan:
     return TimelinePlan(t_ns=round(ev.t * 1e9), key=key, type=type_name, data=ev.data)
 
 
-def call_entry(sc: Scenario, i: int, doc: Document, services: dict[str, str]) -> TimelinePlan:
-    """A `call:` entry: the service (one of the world's), its request's fields checked."""
-    ev = sc.timeline[i]
-    assert ev.call is not None
-    key = f"{sc.name}/{ev.call.lstrip('/')}"
+def service_types(world_services: list[ServicePlan], robots: list[RobotPlan]) -> dict[str, str]:
+    """Key -> type of every service a `call` may name: the world's own and its plugins' (not actions)."""
+    plugins = [s for r in robots for p in r.plugins for s in p.services]
+    return {s.key: s.type for s in [*world_services, *plugins] if s.kind == "service"}
+
+
+def service_of(
+    sc: Scenario, doc: Document, name: str, services: dict[str, str], where: PathKey
+) -> tuple[str, str]:
+    """(key, type) of the service `name` (`/reset_simulation`) of the world; else a located error."""
+    key = f"{sc.name}/{name.lstrip('/')}"
     srv = services.get(key)
     if srv is None:
         names = sorted("/" + k.removeprefix(sc.name + "/") for k in services)
-        close = difflib.get_close_matches("/" + ev.call.lstrip("/"), names, n=1)
-        where: PathKey = ("timeline", i, "call")
+        close = difflib.get_close_matches("/" + name.lstrip("/"), names, n=1)
         raise ScenarioError(
             Problem(
-                f"the world has no service {ev.call!r}",
+                f"the world has no service {name!r}",
                 doc.locate(where),
                 where,
                 expected="one of: " + ", ".join(names),
                 hint=f"did you mean {close[0]!r}?" if close else "`scenario validate` lists the services",
             )
         )
+    return key, srv
+
+
+def call_entry(sc: Scenario, i: int, doc: Document, services: dict[str, str]) -> TimelinePlan:
+    """A `call:` entry: the service (one of the world's), its request's fields checked."""
+    ev = sc.timeline[i]
+    assert ev.call is not None
+    key, srv = service_of(sc, doc, ev.call, services, ("timeline", i, "call"))
     if ev.type is not None and interfaces.service_type(ev.type).name != srv:
-        where = ("timeline", i, "type")
+        where: PathKey = ("timeline", i, "type")
         raise ScenarioError(
             Problem(
                 f"{ev.call} is a {srv}",

@@ -78,7 +78,7 @@ def compile_world(
             step = world.option.timestep
     services = control_services(sc.name, world_name)
     timeline = compile_timeline(sc, doc, robots, problems, services)
-    events = compile_events(sc, doc, mjcf, robots, actors, problems)
+    events = compile_events(sc, doc, mjcf, robots, actors, problems, services)
     record = RecordPlan(enabled=False, path="", include=[], exclude=[])
     with problems.each():
         record = record_plan(sc, doc, record_path)

@@ -68,6 +68,7 @@ class Control:
         self._rewind: list[Callable[[], None]] | None = None  # a reset_simulation due: who to answer then
         self.resets = 0  # reset_simulation done so far
         self.calls_made: set[int] = set()  # the timeline's `call` entries made (once per run)
+        self.event_calls_made: set[tuple[int, int]] = set()  # (event, action) of events' calls made
         self._start_qpos: np.ndarray | None = None
         self._rebuilding = False
 

@@ -240,6 +240,8 @@ class World(PubSub, Services, Control):
         events = self._events
         if events is not None and now >= events.next_ns:
             events.boundary(now)
+            if self._asked:  # an event called a service: answered in this step, as the timeline's are
+                self._drain_requests()
         for h in self._before:
             if now >= h.next_ns:
                 h.fn(now)
