@@ -201,10 +201,18 @@ def test_pause_step_unpause_in_the_running_loop(tmp_path: Path) -> None:
     assert world.now_ns == 25 * step_ns
     time.sleep(0.05)
     assert world.now_ns == 25 * step_ns and thread.is_alive()
+    # a reset while paused: time back to 0, the t = 0 sensors published again, still paused
+    imu = len(_stamps(bus, "g/bot/imu"))
+    reset = _call(bus, "g/reset_simulation", em)
+    _wait(lambda: bool(reset))
+    assert world.resets == 1 and world.now_ns == 0 and world.paused
+    _wait(lambda: len(_stamps(bus, "g/bot/imu")) == imu + 1)
+    assert _stamps(bus, "g/bot/imu")[-1] == 25 * step_ns  # log time: 50 ms run before the reset, + 0
     unpaused = _call(bus, "g/unpause_physics", em)
     thread.join(timeout=60)
     assert not thread.is_alive() and unpaused
     assert out["stats"].sim_ns == world.plan.duration_ns and out["stats"].error is None
+    assert out["stats"].run_ns == 25 * step_ns + world.plan.duration_ns
     assert _stamps(bus, "g/pause_physics/_service_event") == []
     assert len(_stamps(bus, "g/unpause_physics/_service_event")) == 2  # request and response
 

@@ -384,8 +384,10 @@ class World(PubSub, Services, Control):
                 if not self._idle(should_stop):
                     break
                 pace_ns, pace_wall = self.now_ns, time.perf_counter()
-                if self._rewind is not None:
-                    continue  # (the loop's top resets)
+                if self._rewind is not None:  # asked while paused: reset now (it stays paused)
+                    self._rewound()
+                    pace_ns = 0
+                    continue  # the boundary at t = 0
             target = self._next_boundary(end_ns)
             if self.steps_left:  # step N while paused: stop there, paused again
                 target = min(target, self.now_ns + self.steps_left * self.step_ns)
