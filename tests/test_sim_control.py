@@ -475,3 +475,123 @@ def test_an_event_calls_a_service_once_per_run(tmp_path: Path) -> None:
 
     with pytest.raises(ScenarioError, match=re.escape("did you mean '/pause_physics'?")):
         plan_of(bad)
+
+
+SDK_CLIENT = Path(__file__).parent / "clients" / "ros2_sdk_services.py"
+
+ROS = """
+name: simctl
+duration: 3
+rate: max
+robots:
+  - name: r1
+    description: "{diffbot}"
+    pose: {xyz: [0, 0, 0.06]}
+    plugins: [{type: diff_drive}]
+world:
+  models:
+    - {name: ball, shape: sphere, size: [0.1], pose: {xyz: [0, -2, 0.1]}, static: false, mass: 0.5}
+timeline:
+  - {t: 0, call: /pause_physics}
+ros2: {domain: %d}
+"""
+
+
+@pytest.mark.timeout(240)
+def test_a_ros2_client_pauses_steps_moves_and_resets_the_world(write_scenario: Any, tmp_path: Path) -> None:
+    """zenoh-ros2-sdk (an rmw_zenoh client that is not ours) calls the gazebo_ros and ros_gz services of a
+    run through its ROS 2 side: the run, paused at t = 0 by its timeline, steps 50 physics steps, answers
+    entity states (an unknown one with success false), moves a model, resets to t = 0 (still paused), and
+    runs to its end once told to run."""
+    import json
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    from runner.wire.transport import free_port
+    from tests.test_bridges import start_run
+
+    domain = 40 + (os.getpid() + 7) % 150
+    port = free_port()
+    path = write_scenario(ROS % domain)
+    step_ns = plan_of(path).step_ns
+    # (std_srvs/Empty's services are listed, not called: the SDK cannot hash an empty request definition)
+    get, empty = "gazebo_msgs/srv/GetEntityState", "std_srvs/srv/Empty"
+    cw = "ros_gz_interfaces/srv/ControlWorld"
+    script = [
+        {"list": True, "wait_for": ["/reset_simulation", "/world/simctl/control", "/get_entity_state"]},
+        {"call": "/get_entity_state", "type": get, "request": {"name": "r1", "reference_frame": ""}},
+        {
+            "call": "/world/simctl/control",
+            "type": cw,
+            "request": {"world_control": {"pause": True, "multi_step": 50}},
+        },
+        {"call": "/get_entity_state", "type": get, "request": {"name": "r1", "reference_frame": ""}},
+        {"call": "/get_entity_state", "type": get, "request": {"name": "nobody", "reference_frame": ""}},
+        {
+            "call": "/set_entity_state",
+            "type": "gazebo_msgs/srv/SetEntityState",
+            "request": {"state": {"name": "ball", "pose": {"position": {"x": 1.5, "z": 0.1}}}},
+        },
+        {"call": "/get_entity_state", "type": get, "request": {"name": "ball", "reference_frame": ""}},
+        {
+            "call": "/world/simctl/control",
+            "type": cw,
+            "request": {"world_control": {"pause": True, "reset": {"all": True}}},
+        },
+        {"call": "/get_entity_state", "type": get, "request": {"name": "ball", "reference_frame": ""}},
+        {"call": "/world/simctl/control", "type": cw, "request": {"world_control": {"pause": False}}},
+    ]
+    (tmp_path / "script.json").write_text(json.dumps(script))
+    out, mcap = tmp_path / "sdk.json", tmp_path / "run.mcap"
+    run = start_run(path, "--record", str(mcap), "--no-judge", "--listen", f"tcp/127.0.0.1:{port}")
+    try:
+        client = subprocess.run(
+            [
+                sys.executable,
+                str(SDK_CLIENT),
+                str(port),
+                str(domain),
+                str(tmp_path / "script.json"),
+                str(out),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=180,
+        )
+        assert client.returncode == 0 and out.exists(), client.stderr[-3000:]
+        _stdout, stderr = run.communicate(timeout=120)  # unpaused: the run goes to its end on its own
+    finally:
+        if run.poll() is None:
+            run.send_signal(signal.SIGINT)
+            run.communicate(timeout=60)
+    assert run.returncode == 0, stderr[-3000:]
+    log = json.loads(out.read_text())
+    services = {n: t for n, t in log[0]["services"]}
+    assert services.get("/pause_physics") == [empty] and services.get("/set_pose") is None
+    assert services.get("/world/simctl/set_pose") == ["ros_gz_interfaces/srv/SetEntityPose"]
+    r = [step.get("response") for step in log[1:]]
+
+    def stamp(resp: dict[str, Any]) -> int:
+        return int(resp["header"]["stamp"]["sec"]) * 10**9 + int(resp["header"]["stamp"]["nanosec"])
+
+    assert r[0]["success"] and stamp(r[0]) == 0 and r[0]["state"]["pose"]["position"]["z"] > 0
+    assert r[1]["success"] is True
+    assert r[2]["success"] and 0 < stamp(r[2]) <= 50 * step_ns  # (the steps may still be under way)
+    assert r[3]["success"] is False
+    assert r[4]["success"] is True
+    assert r[5]["success"] and r[5]["state"]["pose"]["position"]["x"] == pytest.approx(1.5, abs=1e-3)
+    assert r[6]["success"] is True
+    assert r[7]["success"] and stamp(r[7]) == 0  # reset, still paused
+    assert r[7]["state"]["pose"]["position"]["x"] == pytest.approx(0.0, abs=1e-9)  # back at its start
+    with open(mcap, "rb") as f:
+        from mcap.reader import make_reader
+
+        summary = make_reader(f).get_summary()
+        assert summary is not None and summary.statistics is not None
+        topics = {
+            c.topic: summary.statistics.channel_message_counts.get(c.id, 0) for c in summary.channels.values()
+        }
+    for name, calls in (("pause_physics", 1), ("world/simctl/control", 3), ("get_entity_state", 5)):
+        assert topics.get(f"simctl/{name}/_service_event", 0) == 2 * calls, sorted(topics)

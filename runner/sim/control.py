@@ -107,6 +107,7 @@ class Control:
         self._epoch[0] += self.now_ns
         self.now_ns = 0
         self.resets += 1
+        self.steps_left = 0  # (steps asked before the reset are not taken after it; paused stays paused)
         self._rebuilding = True
         try:
             w._build(remote=bool(w.remote_renders))
