@@ -7,6 +7,10 @@ motor — with its gains, force limit and gear. A controller's `build` claims a 
 `claim_actuator`: the hardware's actuator of that kind is reused (its gains left alone unless the controller
 gives its own), or one is added; actuators of other kinds on that joint are disabled (gear 0), as a claimed
 command interface excludes the others in ros2_control. At run time `find_actuator` gives its index.
+
+A controller plugin's lifecycle (`Lifecycle`, switched by the controller_manager plugin): inactive, its
+hooks do nothing and its actuators are `release`d to the hardware's hold, as gz_ros2_control's system holds
+a joint no active controller commands.
 """
 
 from __future__ import annotations
@@ -171,3 +175,46 @@ def spec_velocity_limit(spec: mujoco.MjSpec, joint: str) -> float | None:
         if velocity and a.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE:
             return float(min(-a.ctrlrange[0], a.ctrlrange[1]))
     return None
+
+
+def release(m: mujoco.MjModel, d: mujoco.MjData, a: int) -> None:
+    """A deactivated controller's command interface, released: gz_ros2_control's system stops that command
+    (perform_command_mode_switch, gz_system.cpp:572) and, with `hold_joints` (default true), sends the joint a
+    zero velocity command (write(), :675), which holds it where it is. A position servo's setpoint becomes
+    the joint's position now; a velocity servo's, zero; a motor's effort, zero (gz would hold that joint
+    with a velocity command; a motor has none: the joint is left free)."""
+    found = kind(
+        m.actuator_gaintype[a],
+        m.actuator_biastype[a],
+        m.actuator_dyntype[a],
+        m.actuator_gainprm[a, 0],
+        m.actuator_biasprm[a],
+    )
+    position = float(d.qpos[m.jnt_qposadr[int(m.actuator_trnid[a, 0])]])
+    d.ctrl[a] = position * (float(m.actuator_gear[a, 0]) or 1.0) if found == "position" else 0.0
+
+
+class Lifecycle:
+    """The active / inactive state of a ros2_control controller plugin, which the controller_manager plugin
+    switches (plugins/controller_manager.py). A controller starts active (the spawner activates it); its
+    hooks do nothing while inactive; `deactivate` releases the actuators `commanded()` names to the
+    hardware's hold (`release`); `on_activate` resets what the controller's on_activate resets."""
+
+    active: bool = True
+    ctx: Any
+
+    def commanded(self) -> list[int]:
+        """The actuators (command interfaces) the controller writes."""
+        return []
+
+    def on_activate(self) -> None:
+        """What the controller does when activated again (default: nothing)."""
+
+    def activate(self) -> None:
+        self.active = True
+        self.on_activate()
+
+    def deactivate(self) -> None:
+        self.active = False
+        for a in self.commanded():
+            release(self.ctx.model, self.ctx.data, int(a))

@@ -16,6 +16,7 @@ from typing import Any, ClassVar, Literal
 
 from pydantic import Field
 
+from plugins._actuators import Lifecycle
 from plugins._common import OdometryWriter, TransformWriter
 from runner.plugin import Plugin, PluginParams, Topic
 
@@ -220,7 +221,7 @@ def reference_usable(cmd: Command, timeout: float, now_ns: int) -> bool:
     return cmd.age_s(now_ns) <= timeout
 
 
-class ReferenceDrive(Plugin):
+class ReferenceDrive(Lifecycle, Plugin):
     """What mecanum_drive_controller and the steering controllers run alike (`ReferenceParams`): their rates,
     the reference they subscribe, and the odometry, TF and controller state they publish. A subclass names
     its state message (`STATE_TYPE`) and the covariances it publishes when none are given."""
@@ -253,6 +254,10 @@ class ReferenceDrive(Plugin):
                 Topic(params.state_topic or f"{name}/controller_state", cls.STATE_TYPE, "pub", rate)
             )
         return topics
+
+    def on_activate(self) -> None:
+        """Activated again (the controller_manager plugin): odometry goes on from the next update."""
+        self.last_ns = None
 
     def setup_reference(self) -> None:
         """Subscribe the reference (`self.command`) and make the odometry, TF and state publishers."""

@@ -290,6 +290,20 @@ class Tolerances:
     goal_time: float
 
 
+def within(err: Point, k: int, tol: Tol) -> bool:
+    """tolerances.hpp:check_state_tolerance_per_joint: a tolerance of 0 is not checked."""
+    assert err.positions is not None and err.velocities is not None
+    ok_p = not (tol.position > 0.0 and abs(err.positions[k]) > tol.position)
+    ok_v = not (tol.velocity > 0.0 and abs(err.velocities[k]) > tol.velocity)
+    return ok_p and ok_v
+
+
+def copy_point(p: Point) -> Point:
+    return Point(
+        p.t, *(None if v is None else v.copy() for v in (p.positions, p.velocities, p.accelerations))
+    )
+
+
 def resolve_tolerance(default: float, value: float) -> float:
     """tolerances.hpp:resolve_tolerance_source: >0 the goal's, -1 erased (0), 0 the default."""
     if value > 0.0:

@@ -19,7 +19,7 @@ import mujoco
 import numpy as np
 from pydantic import Field, PositiveFloat
 
-from plugins._actuators import claim_actuator, find_actuator
+from plugins._actuators import Lifecycle, claim_actuator, find_actuator
 from plugins._common import BaseDriveParams, OdometryWriter, TransformWriter, drive_topics, tf_transforms
 from plugins._mobile import COMMAND_TYPES, AxisLimits, Command, CommandType, PlanarOdometry, SpeedLimiter
 from runner.geometry import quat_to_yaw, wheel_radius
@@ -141,7 +141,7 @@ class DiffDriveParams(WheelDriveParams):
     right_joint: str = Field("right_wheel_joint", description="Right wheel joint.")
 
 
-class WheelDrive(Plugin):
+class WheelDrive(Lifecycle, Plugin):
     """A drive with one or more wheel joints per side, each with its own velocity servo.
 
     Subclasses say which joints form each side (`sides`). Every wheel of a side gets the same target
@@ -373,7 +373,21 @@ class WheelDrive(Plugin):
             )
         return v, w
 
+    def commanded(self) -> list[int]:
+        """diff_drive_controller deactivated (the controller_manager plugin): its wheels are released."""
+        return self.act.tolist()
+
+    def on_activate(self) -> None:
+        """on_activate: odometry goes on from here; the wheels' ramps and integrals start from zero."""
+        self.last_ns = None
+        self.last_q = tuple(self._side_means(self.qpos[self.qadr]).tolist())
+        self.ctrl[:] = [0.0] * len(self.ctrl)
+        self.integral[:] = [0.0] * len(self.integral)
+        self.yaw_integral = 0.0
+
     def before_step(self, now_ns: int) -> None:
+        if not self.active:  # switched off by the controller_manager plugin
+            return
         # A few wheels: plain floats beat numpy's per-call overhead by 3x here.
         p = self.params
         v, w = self._commanded(now_ns)
@@ -444,6 +458,8 @@ class WheelDrive(Plugin):
         return w + self.yaw_integral
 
     def after_step(self, now_ns: int) -> None:
+        if not self.active:  # switched off by the controller_manager plugin
+            return
         if self.params.odometry_source != "world":
             o = self.odom
             self.yaw = o.heading

@@ -9,6 +9,7 @@ from __future__ import annotations
 import mujoco
 from pydantic import Field
 
+from plugins._actuators import Lifecycle
 from plugins._common import MountPose, add_site, pick_link
 from runner.plugin import BuildContext, Plugin, RatedParams, Topic
 from runner.wire import msgs
@@ -25,7 +26,7 @@ class ForceTorqueParams(RatedParams):
     frame_id: str | None = Field(None, description="Frame id in the header (default: <ns>/<link>).")
 
 
-class ForceTorque(Plugin):
+class ForceTorque(Lifecycle, Plugin):
     Params = ForceTorqueParams
     params: ForceTorqueParams
 
@@ -51,6 +52,8 @@ class ForceTorque(Plugin):
         self.frame_id = self.params.frame_id or r.frame(link)
 
     def after_step(self, now_ns: int) -> None:
+        if not self.active:  # switched off by the controller_manager plugin
+            return
         sd = self.ctx.data.sensordata
         f, t = sd[self.force], sd[self.torque]
         T = msgs.T

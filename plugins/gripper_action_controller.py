@@ -3,8 +3,14 @@ effort_controllers/GripperActionController (gripper_controllers, Humble/Jazzy),
 parallel_gripper_action_controller/GripperActionController (Jazzy), and ROS 1 ros_controllers'
 position_controllers/ and effort_controllers/GripperActionController, on one joint.
 
-These controllers take goals only as actions (GripperCommand; ParallelGripperCommand), which the
-scenario runner does not serve yet. Until it does, a topic of ours gives a timeline the same goal:
+Action: `<name>/gripper_cmd` (control_msgs/action/GripperCommand; the parallel gripper's
+ParallelGripperCommand), as gripper_action_controller_impl.hpp (Jazzy) serves `~/gripper_cmd`: every goal is
+accepted (the parallel gripper rejects one whose command has not exactly one position), preempts the active
+goal (canceled, an empty result: preempt_active_goal), and ends with the result below; a cancel of the active
+goal holds the current position with the parameters' max_effort (set_hold_position) and ends it canceled
+with an empty result. The controllers send no feedback (their update never sets any), nor do we.
+
+A topic of ours gives a scenario's timeline (which publishes, but has no action client) the same goal:
 - `<name>/gripper_cmd` taking control_msgs/msg/GripperCommand (position, max_effort) for
   gripper_action_controller (ROS 1 and 2);
 - `<name>/gripper_cmd` taking sensor_msgs/msg/JointState for the parallel gripper (what the
@@ -40,13 +46,17 @@ from typing import Any, Literal
 import mujoco
 from pydantic import BaseModel, ConfigDict, Field, NonNegativeFloat, PositiveFloat
 
-from plugins._actuators import auto_gains, claim_actuator, find_actuator
-from runner.plugin import BuildContext, Plugin, PluginConfigError, PluginParams, Topic
+from plugins._actuators import Lifecycle, auto_gains, claim_actuator, find_actuator
+from runner.plugin import BuildContext, Plugin, PluginConfigError, PluginParams, Service, Topic
+from runner.plugin.actions import GoalHandle as ActionGoal
+from runner.wire import msgs
 
 log = logging.getLogger(__name__)
 
 GRIPPER_TYPE = "control_msgs/msg/GripperCommand"
 PARALLEL_TYPE = "sensor_msgs/msg/JointState"
+GRIPPER_ACTION = "control_msgs/action/GripperCommand"
+PARALLEL_ACTION = "control_msgs/action/ParallelGripperCommand"
 
 
 class GripperGains(BaseModel):
@@ -78,6 +88,7 @@ class GripperActionControllerParams(PluginParams):
     update_rate: PositiveFloat = Field(100.0, description="The controller manager's update rate, Hz.")
     ros1: bool = False
     command_topic: str | None = Field(None, description="Default `<name>/gripper_cmd` (ours, see docs).")
+    action_name: str | None = Field(None, description="Default `<name>/gripper_cmd`.")
 
 
 @dataclass
@@ -94,19 +105,25 @@ class GripperGoalHandle:
     status: str = "active"
     result: GripperResult | None = None
     on_result: Callable[[GripperResult], None] | None = None
+    on_end: Callable[[GripperGoalHandle], None] | None = None  # any end: succeeded, aborted, canceled
 
     def cancel(self) -> None:
-        if self.controller is not None and self.status == "active" and self.controller.goal is self:
-            self.controller.goal = None
-            self.status = "canceled"
+        """cancel_callback: the active goal is canceled and the current position held."""
+        c = self.controller
+        if c is not None and self.status == "active" and c.goal is self:
+            c.position = float(c.ctx.data.qpos[c.qadr])  # set_hold_position
+            c.max_effort = c.params.max_effort
+            c._end(self, "canceled")
 
 
-class GripperActionController(Plugin):
+class GripperActionController(Lifecycle, Plugin):
     Params = GripperActionControllerParams
     params: GripperActionControllerParams
 
     @classmethod
-    def build(cls, params: GripperActionControllerParams, ctx: BuildContext, name: str) -> list[Topic]:
+    def build(
+        cls, params: GripperActionControllerParams, ctx: BuildContext, name: str
+    ) -> list[Topic | Service]:
         joint = ctx.joint(params.joint, "joint")
         if joint.type not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
             raise PluginConfigError(f"joint {params.joint!r} is not revolute or prismatic", "joint")
@@ -114,7 +131,18 @@ class GripperActionController(Plugin):
             if jname != params.joint:
                 raise PluginConfigError(f"gains for {jname!r}, not the controller's joint", "gains")
         claim_actuator(ctx.spec, name, joint, cls._mode(params))
-        return [Topic(cls._topic(params, name), PARALLEL_TYPE if params.parallel else GRIPPER_TYPE, "sub")]
+        return [
+            Topic(cls._topic(params, name), PARALLEL_TYPE if params.parallel else GRIPPER_TYPE, "sub"),
+            Service(cls._action_name(params, name), cls._action_type(params), kind="action"),
+        ]
+
+    @staticmethod
+    def _action_name(params: GripperActionControllerParams, name: str) -> str:
+        return params.action_name or f"{name}/gripper_cmd"
+
+    @staticmethod
+    def _action_type(params: GripperActionControllerParams) -> str:
+        return PARALLEL_ACTION if params.parallel else GRIPPER_ACTION
 
     @staticmethod
     def _mode(params: GripperActionControllerParams) -> Literal["position", "effort"]:
@@ -161,6 +189,71 @@ class GripperActionController(Plugin):
         self.ctx.subscribe(
             self._topic(p, self.name), PARALLEL_TYPE if p.parallel else GRIPPER_TYPE, self._on_command
         )
+        self.action = self.ctx.action_server(
+            self._action_name(p, self.name), self._action_type(p), self._on_goal, self._on_cancel
+        )
+        self._goals: dict[bytes, GripperGoalHandle] = {}
+
+    # ------------------------------------------------------------------------------------------ action
+    def _on_goal(self, handle: ActionGoal) -> bool:
+        """goal_callback + accepted_callback."""
+        command = handle.goal.command
+        if self.params.parallel:
+            if len(command.position) != 1:
+                log.error(
+                    "%s: Received action goal with wrong number of position values, expects 1, got %d",
+                    self.name,
+                    len(command.position),
+                )
+                return False
+            ours = self.submit_goal(
+                float(command.position[0]),
+                max_effort=float(command.effort[0]) if len(command.effort) else None,
+                max_velocity=float(command.velocity[0]) if len(command.velocity) else None,
+            )
+        else:
+            ours = self.submit_goal(float(command.position), max_effort=float(command.max_effort))
+        ours.on_end = lambda g: self._ended(handle, g)
+        self._goals[handle.goal_id] = ours
+        return True
+
+    def _on_cancel(self, handle: ActionGoal) -> bool:
+        ours = self._goals.get(handle.goal_id)
+        if ours is not None:
+            ours.cancel()
+        return True
+
+    def _ended(self, handle: ActionGoal, goal: GripperGoalHandle) -> None:
+        self._goals.pop(handle.goal_id, None)
+        kind = self._action_type(self.params)
+        r = goal.result
+        if r is None:  # canceled or preempted: an empty result
+            handle.canceled(msgs.from_data(f"{kind}_Result", {}))
+            return
+        if self.params.parallel:
+            data: dict[str, Any] = {
+                "state": {"name": [self.params.joint], "position": [r.position], "effort": [r.effort]}
+            }
+        else:
+            data = {"position": r.position, "effort": r.effort}
+        data.update(stalled=r.stalled, reached_goal=r.reached_goal)
+        result = msgs.from_data(f"{kind}_Result", data)
+        (handle.succeed if goal.status == "succeeded" else handle.abort)(result)
+
+    # ------------------------------------------------------------------------------------- lifecycle
+    def on_activate(self) -> None:
+        """on_activate: command the current position with the parameters' effort."""
+        self.position = float(self.ctx.data.qpos[self.qadr])
+        self.max_effort = self.params.max_effort
+        self.integral = 0.0
+
+    def commanded(self) -> list[int]:
+        """on_deactivate releases the interface (the hardware holds the joint where it is) and leaves a
+        goal as it is: it ends with a new goal or a cancel."""
+        return [self.act]
+
+    def close(self) -> None:
+        self.action.close()
 
     def _on_command(self, msg: Any, stamp_ns: int) -> None:
         if self.params.parallel:
@@ -186,8 +279,7 @@ class GripperActionController(Plugin):
         """An accepted GripperCommand / ParallelGripperCommand goal (accepted_callback)."""
         p = self.params
         if self.goal is not None:  # preempt_active_goal: the old goal is canceled
-            self.goal.status = "canceled"
-            self.goal = None
+            self._end(self.goal, "canceled")
         self.position = position
         if p.parallel:
             self.max_effort = (
@@ -204,6 +296,8 @@ class GripperActionController(Plugin):
         return handle
 
     def before_step(self, now_ns: int) -> None:
+        if not self.active:
+            return
         d = self.ctx.data
         t = now_ns * 1e-9
         current = float(d.qpos[self.qadr])
@@ -245,8 +339,15 @@ class GripperActionController(Plugin):
             )
 
     def _finish(self, goal: GripperGoalHandle, result: GripperResult, status: str) -> None:
-        self.goal = None
-        goal.status = status
         goal.result = result
-        if goal.on_result is not None:
-            goal.on_result(result)
+        self._end(goal, status)
+
+    def _end(self, goal: GripperGoalHandle, status: str) -> None:
+        """The goal ends: `on_result` with its result (none when canceled), `on_end` in any case."""
+        if self.goal is goal:
+            self.goal = None
+        goal.status = status
+        if goal.on_result is not None and goal.result is not None:
+            goal.on_result(goal.result)
+        if goal.on_end is not None:
+            goal.on_end(goal)

@@ -24,6 +24,7 @@ import mujoco
 import numpy as np
 from pydantic import Field
 
+from plugins._actuators import Lifecycle
 from plugins._common import MountPose, add_site, pick_link
 from plugins._drift import DriftingBias
 from runner.plugin import BuildContext, Plugin, Publisher, RatedParams, Topic
@@ -91,7 +92,7 @@ class ImuParams(RatedParams):
     )
 
 
-class Imu(Plugin):
+class Imu(Lifecycle, Plugin):
     Params = ImuParams
     params: ImuParams
 
@@ -234,6 +235,8 @@ class Imu(Plugin):
         self.bias_pub.publish_cdr(self.bias_layout.encode(now_ns), now_ns)
 
     def after_step(self, now_ns: int) -> None:
+        if not self.active:  # switched off by the controller_manager plugin
+            return
         # three numbers each: plain floats and one struct pack per field beat numpy's per-call overhead
         p = self.params
         buf = self.layout.buf

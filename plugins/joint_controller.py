@@ -29,7 +29,7 @@ import mujoco
 import numpy as np
 from pydantic import Field, NonNegativeFloat, PositiveFloat
 
-from plugins._actuators import auto_gains, claim_actuator, find_actuator
+from plugins._actuators import Lifecycle, auto_gains, claim_actuator, find_actuator
 from runner.plugin import BuildContext, Plugin, PluginConfigError, PluginParams, Topic
 
 log = logging.getLogger(__name__)
@@ -74,7 +74,7 @@ def _message_of(params: JointControllerParams) -> str:
     return params.message or ("float64" if len(params.joints) == 1 else "float64_array")
 
 
-class JointController(Plugin):
+class JointController(Lifecycle, Plugin):
     Params = JointControllerParams
     params: JointControllerParams
 
@@ -143,9 +143,21 @@ class JointController(Plugin):
         callback = {"float64": self._on_float, "float64_array": self._on_array, "joint_state": self._on_state}
         self.ctx.subscribe(topic, _MESSAGE_TYPES[message], callback[message])
 
+    def on_activate(self) -> None:
+        """A forward command controller activated again (the controller_manager plugin): its command
+        interfaces still hold its last command, which gz_ros2_control's system follows again."""
+        for k in range(len(self.params.joints)):
+            self._set(k, float(self.target[k]))
+
+    def commanded(self) -> list[int]:
+        """Deactivated, commands are ignored and the hardware holds the joints where they are."""
+        return self.act.tolist()
+
     def _set(self, k: int, value: float) -> None:
         if not math.isfinite(value):
             self._warn("nan", f"{self.name}: ignoring a non-finite command for {self.params.joints[k]!r}")
+            return
+        if not self.active:
             return
         mode = self.params.mode
         if mode == "position":

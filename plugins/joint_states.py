@@ -15,6 +15,7 @@ import mujoco
 import numpy as np
 from pydantic import Field
 
+from plugins._actuators import Lifecycle
 from runner.plugin import BuildContext, Plugin, PluginConfigError, RatedParams, Topic
 from runner.wire import msgs
 
@@ -43,7 +44,7 @@ class JointStatesParams(RatedParams):
     )
 
 
-class JointStates(Plugin):
+class JointStates(Lifecycle, Plugin):  # joint_state_broadcaster: publishes while active
     Params = JointStatesParams
     params: JointStatesParams
 
@@ -109,6 +110,8 @@ class JointStates(Plugin):
             self.dynamic_names = self.names + extra
 
     def after_step(self, now_ns: int) -> None:
+        if not self.active:
+            return
         d = self.ctx.data
         values = (d.qpos[self.qadr], d.qvel[self.vadr], d.qfrc_actuator[self.vadr])
         fields = [np.concatenate([v * self.mask[f], self.pad]) for f, v in enumerate(values)]

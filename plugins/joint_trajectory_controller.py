@@ -27,24 +27,17 @@ What it does, as joint_trajectory_controller.cpp (Jazzy) does it, at the control
   only: the sampled velocity × ff_velocity_scale (+ effort) plus a PID on the error per `gains.<joint>`
   (all 0 by default: the joint is not driven, as in ros2_control); position+velocity: the position servo.
 
-Internal API, for an action server (FollowJointTrajectory); call it in the sim loop (e.g. from a
-subscription callback); callbacks run in the sim loop:
+Action (plugins/_follow_trajectory.py): `<name>/follow_joint_trajectory` (FollowJointTrajectory; ROS 1 too,
+as ros_controllers names it, on ROS 2's wire) runs its goals through `submit_goal(trajectory, path_tolerance=,
+goal_tolerance=, goal_time_tolerance=, on_feedback=, on_result=)` (sim loop): a GoalHandle whose `status` is
+"rejected" (`reason`: the log text), "active", "succeeded", "aborted" or "canceled"; `on_feedback(Feedback)`
+at `action_monitor_rate`, `on_result(TrajectoryResult)` once with the controller's error_code / error_string.
+A new goal preempts the active one (INVALID_GOAL); `handle.cancel()` holds the current position. A
+trajectory on the topic does not end an active goal (as in ros2_controllers).
 
-    handle = controller.submit_goal(trajectory, path_tolerance=[...], goal_tolerance=[...],
-                                    goal_time_tolerance=0.0, on_feedback=f, on_result=r)
-
-`trajectory` is a trajectory_msgs/JointTrajectory (a rosbags message object); tolerances are objects with
-`name`, `position`, `velocity`, `acceleration` (control_msgs/JointTolerance: 0 keeps the controller's
-default, -1 erases it, other negatives make the controller use its defaults). `handle.status` is
-"rejected" (the trajectory failed validation: `handle.reason` is the controller's log text; no callback),
-"active", "succeeded", "aborted" or "canceled". `on_feedback(Feedback)` runs at `action_monitor_rate`
-with the desired / actual / error points; `on_result(TrajectoryResult)` once, with `error_code` (SUCCESSFUL
-0, INVALID_GOAL -1, PATH_TOLERANCE_VIOLATED -4, GOAL_TOLERANCE_VIOLATED -5) and `error_string` as the
-controller sets them ("Goal successfully reached!", "Aborted due to path tolerance violation", "Aborted
-due to goal_time_tolerance exceeding by <s> seconds", "Current goal preempted by new incoming action.").
-A new goal preempts the active one (INVALID_GOAL); `handle.cancel()` cancels it (status "canceled", result
-code SUCCESSFUL with an empty string, as an empty Result) and holds the current position. A trajectory on
-the topic does not end an active goal (as in ros2_controllers).
+Lifecycle (the controller_manager plugin switches it): `deactivate()` aborts the goal, stops commanding and
+leaves the joints to the hardware, which holds them where they are (gz_system.cpp:675); while inactive,
+trajectories and goals are refused; `activate()` holds the current position (on_activate).
 """
 
 from __future__ import annotations
@@ -58,7 +51,8 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field, NonNegativeFloat, PositiveFloat
 
-from plugins._actuators import auto_gains, claim_actuator, find_actuator
+from plugins._actuators import Lifecycle, auto_gains, claim_actuator, find_actuator
+from plugins._follow_trajectory import ACTION, FollowJointTrajectoryServer, state_data
 from plugins._trajectory import (
     Constraints,
     Gains,
@@ -67,11 +61,13 @@ from plugins._trajectory import (
     Tol,
     Tolerances,
     Trajectory,
+    copy_point,
     goal_tolerances,
     seconds,
     validate_message,
+    within,
 )
-from runner.plugin import BuildContext, Plugin, PluginConfigError, PluginParams, Topic
+from runner.plugin import BuildContext, Plugin, PluginConfigError, PluginParams, Service, Topic
 from runner.wire import msgs
 
 log = logging.getLogger(__name__)
@@ -123,6 +119,7 @@ class JointTrajectoryControllerParams(PluginParams):
     ros1: bool = Field(False, description="ROS 1 JointTrajectoryController (topics command / state).")
     command_topic: str | None = Field(None, description="Default `<name>/joint_trajectory` (ROS 1: command).")
     state_topic: str | None = Field(None, description="Default `<name>/controller_state` (ROS 1: state).")
+    action_name: str | None = Field(None, description="Default `<name>/follow_joint_trajectory`.")
 
 
 @dataclass
@@ -157,12 +154,14 @@ class GoalHandle:
             self.controller._cancel(self)
 
 
-class JointTrajectoryController(Plugin):
+class JointTrajectoryController(Lifecycle, Plugin):
     Params = JointTrajectoryControllerParams
     params: JointTrajectoryControllerParams
 
     @classmethod
-    def build(cls, params: JointTrajectoryControllerParams, ctx: BuildContext, name: str) -> list[Topic]:
+    def build(
+        cls, params: JointTrajectoryControllerParams, ctx: BuildContext, name: str
+    ) -> list[Topic | Service]:
         joints = params.joints
         if len(set(joints)) != len(joints):
             raise PluginConfigError("a joint is named twice", "joints")
@@ -195,6 +194,7 @@ class JointTrajectoryController(Plugin):
         return [
             Topic(cls._command_topic(params, name), TRAJECTORY_TYPE, "sub"),
             Topic(cls._state_topic(params, name), STATE_TYPE, "pub", rate),
+            Service(cls._action_name(params, name), ACTION, kind="action"),
         ]
 
     @staticmethod
@@ -217,6 +217,10 @@ class JointTrajectoryController(Plugin):
     @staticmethod
     def _state_topic(params: JointTrajectoryControllerParams, name: str) -> str:
         return params.state_topic or f"{name}/{'state' if params.ros1 else 'controller_state'}"
+
+    @staticmethod
+    def _action_name(params: JointTrajectoryControllerParams, name: str) -> str:
+        return params.action_name or f"{name}/follow_joint_trajectory"
 
     @classmethod
     def control_rate_of(cls, params: PluginParams) -> float | None:
@@ -280,7 +284,32 @@ class JointTrajectoryController(Plugin):
         self.ctx.subscribe(
             self._command_topic(p, self.name), TRAJECTORY_TYPE, self._on_trajectory, max_bytes=64 << 20
         )
+        self.action = FollowJointTrajectoryServer(self, self._action_name(p, self.name))
         del d
+
+    def on_activate(self) -> None:
+        """on_activate: hold the current position, start again from the measured state."""
+        self.pending = None
+        self.last_cmd = None
+        self.last_t = None
+        self.integral[:] = 0.0
+        self.current = self._hold(self.ctx.data.qpos[self.qadr])
+
+    def deactivate(self) -> None:
+        """on_deactivate (joint_trajectory_controller.cpp:1255): the active goal is aborted; the command
+        interfaces are released, and gz_ros2_control's system then holds each joint with a zero velocity
+        command (gz_system.cpp:675, hold_joints): here its servo holds it where it is."""
+        self._finish(
+            TrajectoryResult(INVALID_GOAL, "Current goal cancelled during deactivate transition."), "aborted"
+        )
+        self.pending = None
+        super().deactivate()
+
+    def commanded(self) -> list[int]:
+        return self.act
+
+    def close(self) -> None:
+        self.action.close()
 
     def _default_tolerances(self) -> Tolerances:
         """tolerances.hpp:get_segment_tolerances (from the parameters)."""
@@ -358,6 +387,9 @@ class JointTrajectoryController(Plugin):
 
     def _on_trajectory(self, msg: Any, stamp_ns: int) -> None:
         """topic_callback: a valid trajectory replaces the current one at the next update."""
+        if not self.active:
+            log.error("%s: controller is not active: the trajectory is ignored", self.name)
+            return
         reason = self.validate(msg, self._now())
         if reason is not None:
             log.error("%s: %s", self.name, reason)
@@ -376,7 +408,7 @@ class JointTrajectoryController(Plugin):
         on_result: Callable[[TrajectoryResult], None] | None = None,
     ) -> GoalHandle:
         """A FollowJointTrajectory goal (see the module docstring)."""
-        reason = self.validate(trajectory, self._now())
+        reason = self.validate(trajectory, self._now()) if self.active else "Controller is not running."
         if reason is not None:
             log.error("%s: %s", self.name, reason)
             return GoalHandle(None, status="rejected", reason=reason)
@@ -420,6 +452,8 @@ class JointTrajectoryController(Plugin):
     # ---------------------------------------------------------------------------------------- update
     def before_step(self, now_ns: int) -> None:
         """joint_trajectory_controller.cpp:update (Jazzy lines 239-580)."""
+        if not self.active:
+            return
         t = now_ns * 1e-9
         period = self.period if self.last_t is None else t - self.last_t
         self.last_t = t
@@ -468,7 +502,7 @@ class JointTrajectoryController(Plugin):
         if goal is not None:
             if (on_feedback := goal.on_feedback) and now_ns >= goal._next_feedback_ns:
                 goal._next_feedback_ns = now_ns + round(1e9 / self.params.action_monitor_rate)
-                on_feedback(Feedback(now_ns, list(self.joints), desired, actual, self._copy(err)))
+                on_feedback(Feedback(now_ns, list(self.joints), desired, actual, copy_point(err)))
             if violated:
                 log.warning("%s: Aborted due to state tolerance violation", self.name)
                 self._finish(
@@ -502,9 +536,9 @@ class JointTrajectoryController(Plugin):
         violated = outside_goal = False
         within_goal_time = True
         for k in range(self.n):
-            if (before_last or first_sample) and not self.holding and not self._within(err, k, tol.state[k]):
+            if (before_last or first_sample) and not self.holding and not within(err, k, tol.state[k]):
                 violated = True
-            if not before_last and not self.holding and not self._within(err, k, tol.goal[k]):
+            if not before_last and not self.holding and not within(err, k, tol.goal[k]):
                 outside_goal = True
                 # ROS 2: goal_time 0 waits for the tolerance forever; ROS 1 (JointTrajectoryController's
                 # checkGoalTolerances): 0 means the goal must be met at the end time
@@ -518,20 +552,6 @@ class JointTrajectoryController(Plugin):
         held = Trajectory([Point(0.0, last.positions, last.velocities, last.accelerations, last.effort)])
         self.holding = True
         return held
-
-    @staticmethod
-    def _copy(p: Point) -> Point:
-        return Point(
-            p.t, *(None if v is None else v.copy() for v in (p.positions, p.velocities, p.accelerations))
-        )
-
-    @staticmethod
-    def _within(err: Point, k: int, tol: Tol) -> bool:
-        """tolerances.hpp:check_state_tolerance_per_joint: a tolerance of 0 is not checked."""
-        assert err.positions is not None and err.velocities is not None
-        ok_p = not (tol.position > 0.0 and abs(err.positions[k]) > tol.position)
-        ok_v = not (tol.velocity > 0.0 and abs(err.velocities[k]) > tol.velocity)
-        return ok_p and ok_v
 
     def _command(self, cmd: Sample, period: float) -> None:
         d = self.ctx.data
@@ -572,28 +592,4 @@ class JointTrajectoryController(Plugin):
         if self.state_every and t + 1e-9 < self.next_state:
             return
         self.next_state = t + self.state_every
-        desired = self.desired
-        n = self.n
-        ref = desired or Sample(actual.positions, np.zeros(n), np.zeros(n), np.zeros(n), 0)  # type: ignore[arg-type]
-        err = self.error
-        data: dict[str, Any] = {
-            "header": {"stamp": {"sec": now_ns // 1_000_000_000, "nanosec": now_ns % 1_000_000_000}},
-            "joint_names": list(self.joints),
-            "reference": {
-                "positions": ref.positions.tolist(),
-                "velocities": ref.velocities.tolist(),
-                "accelerations": ref.accelerations.tolist(),
-            },
-            "feedback": {"positions": actual.positions.tolist()},  # type: ignore[union-attr]
-            "error": {"positions": err.positions.tolist()},  # type: ignore[union-attr]
-            "output": {"effort": self.output.tolist()},
-            "speed_scaling_factor": 1.0,
-        }
-        if self.mode == "position":
-            data["output"] = {"positions": self.output.tolist()}
-        elif self.mode == "velocity":
-            data["output"] = {"velocities": self.output.tolist()}
-        if self.has_vel_state:
-            data["feedback"]["velocities"] = actual.velocities.tolist()  # type: ignore[union-attr]
-            data["error"]["velocities"] = err.velocities.tolist()  # type: ignore[union-attr]
-        self.pub.publish(msgs.from_data(STATE_TYPE, data), now_ns)
+        self.pub.publish(msgs.from_data(STATE_TYPE, state_data(self, now_ns, actual)), now_ns)

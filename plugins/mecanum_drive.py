@@ -257,7 +257,12 @@ class MecanumDrive(ReferenceDrive):
         self.y += (sh * bx + ch * by) * dt
         self.vel = (bx, by, wz)
 
+    def commanded(self) -> list[int]:
+        return list(self.act)
+
     def before_step(self, now_ns: int) -> None:
+        if not self.active:  # switched off by the controller_manager plugin
+            return
         p, d = self.params, self.ctx.data
         last, self.last_ns = self.last_ns, now_ns
         if last is not None:
@@ -289,6 +294,8 @@ class MecanumDrive(ReferenceDrive):
             d.ctrl[a] = w
 
     def after_step(self, now_ns: int) -> None:
+        if not self.active:  # switched off by the controller_manager plugin
+            return
         half = self.heading / 2.0
         quat = (math.cos(half), 0.0, 0.0, math.sin(half))
         pos = (self.x, self.y, 0.0)

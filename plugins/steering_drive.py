@@ -248,7 +248,12 @@ class SteeringDrive(ReferenceDrive):
         scale = 1.0 if delta < math.pi / 6 else 0.01 if delta > math.pi / 2 else math.cos(delta)
         return [ws * scale], [alpha]
 
+    def commanded(self) -> list[int]:
+        return [*self.t_act, *self.s_act]
+
     def before_step(self, now_ns: int) -> None:
+        if not self.active:  # switched off by the controller_manager plugin
+            return
         p, d = self.params, self.ctx.data
         usable = reference_usable(self.command, p.reference_timeout, now_ns)
         twist = self.command.twist
@@ -270,6 +275,8 @@ class SteeringDrive(ReferenceDrive):
             d.ctrl[a] = c
 
     def after_step(self, now_ns: int) -> None:
+        if not self.active:  # switched off by the controller_manager plugin
+            return
         o = self.odom
         pos, quat = (o.x, o.y, 0.0), o.quat()
         self.odom_out.publish(now_ns, pos, quat, (o.linear, 0.0, 0.0), (0.0, 0.0, o.angular))

@@ -95,6 +95,7 @@ class HardwareJoint(BaseModel):
     initial_position: float | None = None
     initial_velocity: float | None = None
     initial_effort: float | None = None  # the effort command until a controller sends one
+    state_interfaces: list[str] = []  # its <state_interface>s (the controller manager lists them)
 
 
 class RobotPlan(BaseModel):

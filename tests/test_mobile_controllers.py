@@ -205,7 +205,11 @@ def _compiled(tmp_path: Path, urdf: str, controllers: str, ros1: bool = False) -
         text = path.read_text().replace("    plugins: [", "    controllers: [control.yaml]\n    plugins: [")
         path.write_text(text)
     plan, said = compile_with_notices(path)
-    mine = [p for p in declared(plan.robots[0]) if p.type not in ("ground_truth", "joint_states")]
+    mine = [
+        p
+        for p in declared(plan.robots[0])
+        if p.type not in ("ground_truth", "joint_states", "controller_manager")
+    ]
     assert len(mine) == 1, [p.type for p in mine]
     return {"type": mine[0].type, "topics": sorted(t.key.removeprefix("t/r1/") for t in mine[0].topics),
             **mine[0].params}, said  # fmt: skip

@@ -78,7 +78,7 @@ def test_type_hash_golden(ros_type: str, expected: str) -> None:
 
 
 def test_type_hash_form_and_unknown_type() -> None:
-    # the project's extra types (runner.wire.msgs.EXTRA_TYPES) hash too, in the REP-2016 form
+    # the project's extra types (runner.wire.typestore.EXTRA_TYPES) hash too, in the REP-2016 form
     assert re.fullmatch(r"RIHS01_[0-9a-f]{64}", ros2.type_hash("gazebo_msgs/msg/ContactsState"))
     with pytest.raises(KeyError):
         ros2.type_hash("no_such_pkg/msg/Nothing")

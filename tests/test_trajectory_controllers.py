@@ -384,7 +384,7 @@ def test_unknown_and_unrun_parameters_are_said_at_the_controllers_file(tmp_path:
     assert "arm_controller: speed_scaling speed scaling is not run" in said
     assert "arm_controller: gains.elbow.kp is not a parameter of the controller; ignored" in said
     assert "gripper_controller: 'stall_timeot' is not a parameter of the gripper controller" in said
-    assert "our topic 'gripper_controller/gripper_cmd' (control_msgs/msg/GripperCommand)" in said
+    assert "gripper_cmd" not in said and "follow_joint_trajectory" not in said  # both actions are served
     types = [p.type for p in plan.robots[0].plugins]
     assert "joint_trajectory_controller" in types and "gripper_action_controller" in types
 

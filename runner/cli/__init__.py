@@ -2,8 +2,8 @@
 `main`, the entry point (`scenario = "runner.cli:main"`, `python -m runner.cli`).
 
 The commands live by group: `validate` (validate, schema), `run`, `test` (check, test), `recording` (info,
-report, render, recover), `live` (echo, pub, topics, graph), `teleop` and `bench`; the terminal and
-`fail` in `console`, the help's look in `help`.
+report, render, recover), `live` (echo, pub, topics, graph), `services` (call, action), `teleop` and
+`bench`; the terminal and `fail` in `console`, the help's look in `help`.
 
 User mistakes (`ScenarioError`, `RunError`) are printed without a traceback and exit 1; usage errors exit
 2; anything else is a bug and shows its traceback.
@@ -16,7 +16,7 @@ import sys
 import typer
 
 from runner import interrupts
-from runner.cli import bench, live, recording, run, teleop, test, validate
+from runner.cli import bench, live, recording, run, services, teleop, test, validate
 from runner.cli.console import err, out
 from runner.cli.help import Command, Group, first_sentence
 from runner.errors import ScenarioError
@@ -46,6 +46,8 @@ app.command(cls=Command)(live.echo)
 app.command(cls=Command)(live.pub)
 app.command(cls=Command)(live.topics)
 app.command(cls=Command)(live.graph)
+app.command(cls=Command)(services.call)
+app.command(cls=Command)(services.action)
 app.command(cls=Command)(teleop.teleop)
 app.command(cls=Command, context_settings={"allow_extra_args": True, "ignore_unknown_options": True})(
     bench.bench

@@ -205,7 +205,8 @@ def topics(
     connect: ConnectOpt = None,
 ) -> None:
     """List the topics of a running scenario: type, publishers and subscribers (by process), rates (like
-    `ros2 topic list -t` and `ros2 topic info`).
+    `ros2 topic list -t` and `ros2 topic info`). Then its services and actions, with their types and
+    servers (like `ros2 service list -t`, `ros2 action list -t`).
 
     Example: scenario topics --seconds 2
     """
@@ -240,6 +241,21 @@ def topics(
         if key.startswith(name + "/") and key not in seen:
             seen[key] = {"type": type_name or "?", "n": 0, "t": []}
     out.print(_topics_table(name, seen, graph, seconds, show_all))
+    # the run's own (a bridge's copies for ROS 2, under rmw_zenoh's keys, are the graph's to show)
+    offered = [o for o in graph.offered(every=show_all) if o.key.startswith(name + "/")]
+    if offered:
+        out.print(_services_table(name, offered))
+
+
+def _services_table(name: str, offered: list[Any]) -> Table:
+    """`topics`' second table: the services and actions answered in the run (like `ros2 service list -t`
+    and `ros2 action list -t`), each with its type and the process that answers it."""
+    table = Table("service / action", "type", "kind", "server", title=f"{name}: services and actions")
+    for o in offered:
+        table.add_row(o.key, o.type or "?", o.kind, ", ".join(o.servers) or "-")
+    table.caption = "`scenario call NAME` / `scenario action NAME GOAL` ask them"
+    table.caption_justify = "left"
+    return table
 
 
 def _topics_table(
@@ -298,7 +314,8 @@ def graph(
 ) -> None:
     """Draw a running scenario's graph (like rqt_graph) as a Graphviz DOT file and a PNG. It shows the
     processes (worlds, renderers, nodes, bridges, the recorder, the tools), the topics, and who publishes
-    and subscribes to what; the topics are listed on the terminal too.
+    and subscribes to what, and the services and actions each process answers; the topics, services and
+    actions are listed on the terminal too.
 
     Examples:
       scenario graph
@@ -325,8 +342,10 @@ def graph(
     render_png(g, png)
     for line in summary_lines(g):
         out.print(line, markup=False, highlight=False)
+    offered = g.offered()
+    served = f", {len(offered)} services and actions" if offered else ""
     out.print(
-        f"{len(g.processes)} processes, {len(g.topics())} topics -> {dot}, {png}",
+        f"{len(g.processes)} processes, {len(g.topics())} topics{served} -> {dot}, {png}",
         markup=False,
         highlight=False,
     )

@@ -1,6 +1,6 @@
 """Commands about the scenario format that run nothing: `validate` (check a scenario and print what would
-run, table by table: robots, their Gazebo parity, topics, nodes, bridges) and `schema` (the format's JSON
-Schema)."""
+run, table by table: robots, their Gazebo parity, topics, services and actions, nodes, bridges) and
+`schema` (the format's JSON Schema)."""
 
 from __future__ import annotations
 
@@ -30,7 +30,8 @@ def validate(
     as_json: Annotated[bool, typer.Option("--json", help="Print the compiled plan as JSON.")] = False,
     strict: StrictValidate = False,
 ) -> None:
-    """Check a scenario and print what would run: robots, plugins, topics with types and rates.
+    """Check a scenario and print what would run: robots, plugins, topics with types and rates,
+    services and actions.
 
     Example: scenario validate scenarios/two_robots.yaml
     """
@@ -53,6 +54,8 @@ def validate(
         for r in part.robots:
             _print_parity(r)
     out.print(_topics_table(parts))
+    if any(part.services() for part in parts):
+        out.print(_services_table(parts))
     if plan.nodes:
         out.print(_nodes_table(plan))
     if plan.bridges:
@@ -110,6 +113,16 @@ def _topics_table(parts: list[Any]) -> Table:
         for t in part.topics():
             topics.add_row(t.key, t.type, t.direction, f"{t.rate:g}" if t.rate else "-", t.owner)
     return topics
+
+
+def _services_table(parts: list[Any]) -> Table:
+    """Every service and action server the run answers (the world's own first): key, type, kind and who
+    answers it; an action's `_action/` services and topics are under its key."""
+    table = Table("key", "type", "kind", "from", title="Services and actions", title_justify="left")
+    for part in parts:
+        for s in part.services():
+            table.add_row(s.key, s.type, s.kind, s.owner or "-")
+    return table
 
 
 def _nodes_table(plan: Any) -> Table:

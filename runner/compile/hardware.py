@@ -52,6 +52,7 @@ def add_hardware(
         hj = HardwareJoint(joint=tr.joint, velocity_limit=model.velocity_limits.get(tr.joint))
         hj.initial_position, hj.initial_velocity = _initial(tr, joint, notices)
         hj.initial_effort = tr.initial.get("effort")
+        hj.state_interfaces = list(tr.states)
         if tr.mimic is not None and tr.mimic.joint and _mimic(spec, tr, notices):
             out.append(hj)  # its start state still counts; no actuator of its own
             continue

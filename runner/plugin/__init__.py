@@ -198,6 +198,7 @@ class RuntimeContext:
     _make_publisher: Callable[[str, str], Publisher] = field(repr=False)
     _subscribe: Callable[..., None] = field(repr=False)
     _serve: Callable[..., None] | None = field(default=None, repr=False)
+    _plugins: Callable[[], list[Plugin]] | None = field(default=None, repr=False)
 
     def publisher(self, topic: str, type_name: str) -> Publisher:
         return self._make_publisher(topic, type_name)
@@ -209,6 +210,11 @@ class RuntimeContext:
         another process holding a NaN or Inf, or larger than `max_bytes` (by default
         MAX_INBOUND_BYTES, 8 MiB), is dropped and counted before it reaches the callback."""
         self._subscribe(topic, type_name, callback, max_bytes=max_bytes)
+
+    def plugins(self) -> list[Plugin]:
+        """The plugins of this robot, in plan order (all made; `setup` runs in that order): a controller
+        manager finds the controllers it switches."""
+        return [] if self._plugins is None else self._plugins()
 
     def service(self, name: str, type_name: str, handler: Callable[[Any, Reply], None]) -> None:
         """Offer the service `name` (declared by `build` as a `Service`): `handler(request, reply)` is

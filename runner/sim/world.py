@@ -212,6 +212,7 @@ class World(PubSub, Services, Control):
             _make_publisher=self._publisher_factory(handle.namespace),
             _subscribe=self._subscriber_factory(handle.namespace),
             _serve=self._service_factory(handle.namespace),
+            _plugins=lambda: [p for p in self.plugins if p.ctx.robot is handle],
         )
 
     # ------------------------------------------------------------------------------------------- loop

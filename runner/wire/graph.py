@@ -40,6 +40,21 @@ class Endpoint:
     type: str | None = None
 
 
+# the service by which an action shows in the graph: rcl_action's `<name>/_action/send_goal`
+ACTION_FACE = "/_action/send_goal"
+
+
+@dataclass(frozen=True)
+class Offered:
+    """A service or an action server of the run: its key, type (pkg/srv/Name, pkg/action/Name; None when
+    its server did not say), kind ("service" | "action") and the processes that answer it."""
+
+    key: str
+    type: str | None
+    kind: str
+    servers: list[str]
+
+
 @dataclass
 class Graph:
     run: str
@@ -61,8 +76,14 @@ class Graph:
         """Without the run's own helper topics (`_truth`, `_contacts`: a chunk starting with `_`), which
         rqt_graph would hide as well."""
         prefix = self.run + "/"
-        shown = {e for e in self.endpoints if not hidden_topic(e.key.removeprefix(prefix))}
-        return Graph(self.run, dict(self.processes), shown)
+
+        def shown(e: Endpoint) -> bool:
+            rel = e.key.removeprefix(prefix)
+            if e.kind == "srv" and rel.endswith(ACTION_FACE):
+                rel = rel.removesuffix(ACTION_FACE)  # an action is shown by its send_goal service
+            return not hidden_topic(rel)
+
+        return Graph(self.run, dict(self.processes), {e for e in self.endpoints if shown(e)})
 
     def topics(self) -> dict[str, str | None]:
         """Every concrete key: published, or subscribed without wildcards; with its type when known."""
@@ -77,6 +98,28 @@ class Graph:
     def services(self) -> dict[str, str | None]:
         """Every service key, with its type when known."""
         return {e.key: e.type for e in sorted(self.endpoints, key=lambda e: e.key) if e.kind == "srv"}
+
+    def servers(self, key: str) -> list[str]:
+        return sorted({e.process for e in self.endpoints if e.kind == "srv" and e.key == key})
+
+    def offered(self, every: bool = False) -> list[Offered]:
+        """The services and actions answered in the run, by key. An action (rcl_action's three services
+        under `<name>/_action/`) is one entry, of its action type, named by its `send_goal` service;
+        `every`: each of its services as well, and the run's hidden ones (a chunk starting with `_`)."""
+        out = []
+        prefix = self.run + "/"
+        for key, type_name in self.services().items():
+            rel = key.removeprefix(prefix)
+            if rel.endswith(ACTION_FACE):
+                base = key.removesuffix(ACTION_FACE)
+                action = type_name.removesuffix("_SendGoal") if type_name else None
+                if every or not hidden_topic(base.removeprefix(prefix)):
+                    out.append(Offered(base, action, "action", self.servers(key)))
+                if not every:
+                    continue
+            if every or not hidden_topic(rel):
+                out.append(Offered(key, type_name, "service", self.servers(key)))
+        return sorted(out, key=lambda o: (o.key, o.kind))
 
     def publishers(self, key: str) -> list[str]:
         return sorted({e.process for e in self.endpoints if e.kind == "pub" and e.key == key})

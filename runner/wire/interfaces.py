@@ -25,7 +25,7 @@ from typing import Any
 from rosbags.typesys import get_types_from_msg
 from rosbags.typesys.base import Nodetype
 
-from runner.wire.msgs import TYPESTORE
+from runner.wire.typestore import TYPESTORE
 
 # messages the services and actions below refer to that the Jazzy store lacks
 _MESSAGES = {

@@ -4,6 +4,7 @@ implementation in Python), in a process of its own (the SDK keeps one session pe
     python ros2_sdk_services.py PORT DOMAIN SCRIPT.json OUT.json
 
 SCRIPT is a list of steps run in order, each one of:
+- `{"sleep": S}`: wait S wall seconds;
 - `{"list": true}`: the services `ros2 service list -t` shows (the SDK's graph discovery; the action
   services among them);
 - `{"call": NAME, "type": "pkg/srv/Name", "request": {...}}`: one call with the SDK's service client (it
@@ -397,6 +398,9 @@ def main() -> int:
                     break
                 time.sleep(0.2)
             log.append({"services": [[n, t] for n, t in found]})
+        elif "sleep" in step:
+            time.sleep(float(step["sleep"]))  # (wall time passing while the world is paused)
+            log.append({"slept": step["sleep"]})
         elif "call" in step:
             log.append(
                 {"call": step["call"], "response": c.call(step["call"], step["type"], step["request"])}

@@ -30,6 +30,7 @@ import yaml
 
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.control import ControlContext, ControllerSpec, Remap, fork_of, handler_for
+from runner.compile.gazebo.control import manager as manager_node
 from runner.compile.gazebo.control.params import Block
 from runner.compile.gazebo.info import Where
 from runner.compile.gazebo.tags import TagReader
@@ -429,15 +430,16 @@ def read_controllers(
     return specs
 
 
-def dispatch(ctx: ControlContext, specs: list[ControllerSpec]) -> int:
-    """Each controller to the handler of its type; returns how many run. With the scenario's `spawn:`, only
-    the controllers it names (what the launch's spawners start); the others are loaded by no spawner."""
+def dispatch(ctx: ControlContext, specs: list[ControllerSpec], loaded: list[dict[str, Any]]) -> int:
+    """Each controller to the handler of its type; returns how many run (each added to `loaded`, for the
+    controller manager). With the scenario's `spawn:`, only the controllers it names (what the launch's
+    spawners start); the others are loaded by no spawner."""
     count = 0
     spawn = ctx.g.spawn.names
     for spec in specs:
         if spawn is not None and spec.name not in spawn:
             ctx.g.notices.add(
-                f"controller {spec.name!r} is not spawned (the robot's `spawn:` leaves it out): not run",
+                f"controller {spec.name!r} is not spawned (`spawn:` leaves it out): not run (nor loadable)",
                 *spec.where,
             )
             continue
@@ -459,9 +461,11 @@ def dispatch(ctx: ControlContext, specs: list[ControllerSpec]) -> int:
             )
             continue
         ctx.node = spec.name
+        before = len(ctx.g.info.plugins)
         try:
             if handler(ctx, spec):
                 count += 1
+                loaded.append(manager_node.entry(spec, ctx.g.info.plugins[before:]))
         finally:
             ctx.node = None
     return count
@@ -482,6 +486,7 @@ def run_controller_files(g: ReaderBase) -> None:
     if not plugins and not scenario_files:
         return
     names: set[str] = set()
+    managers: set[str] = set()
     if not plugins:
         plugins = [ControlPlugin((scenario_files[0], None), "")]
     for k, plugin in enumerate(plugins):
@@ -495,7 +500,12 @@ def run_controller_files(g: ReaderBase) -> None:
         names |= {s.name for s in specs}
         # the rules as written (`~/` kept) replace the plugin's remap table, which has lost the `~/`
         ctx = ControlContext(g, plugin.where, {}, plugin.rules, plugin.namespace)
-        ran = dispatch(ctx, specs)
+        loaded: list[dict[str, Any]] = []
+        ran = dispatch(ctx, specs, loaded)
+        if ran:
+            spawn = g.spawn.names
+            unspawned = [s.name for s in specs if spawn is not None and s.name not in spawn]
+            manager_node.add_manager(ctx, plugin.where, plugin.manager, loaded, unspawned, managers)
         if ran or plugin.el is None:
             continue
         if g.spawn.names is not None and specs:

@@ -1,6 +1,7 @@
 """Where everything of the PNG drawing of a run's graph goes (`Layout`), in 1x units (the drawing
 multiplies by `SS`): three columns, processes that mostly publish on the left, the topics in the middle
-(grouped by namespace), processes that mostly subscribe on the right; each process near the topics it
+(grouped by namespace), processes that mostly subscribe on the right (a process that answers services
+names them in its box); each process near the topics it
 touches; each edge's ends spread along the box sides in an order that avoids needless crossings; the
 legend wrapped to the width.
 """
@@ -18,6 +19,7 @@ from runner.tools.graph_draw.model import (
     ROLE_COLORS,
     Edge,
     GraphModel,
+    relative_key,
     short_type,
 )
 
@@ -109,6 +111,10 @@ def process_lines(m: GraphModel, name: str, role: str) -> list[tuple[str, str]]:
         lines.append(("small", role if role != "?" else "(role unknown)"))
     if m.wildcards.get(name):
         lines.append(("small", "sub: " + ", ".join(m.wildcards[name])))
+    served = [s for s in m.services if name in s.servers]
+    if served:  # the services and actions it answers, named in its box (the drawing has no column for them)
+        names = [relative_key(m.run, s.key) + (" (action)" if s.kind == "action" else "") for s in served]
+        lines.append(("small", f"serves {len(served)}: " + ", ".join(names)))
     return lines
 
 
@@ -242,6 +248,7 @@ class Layout:
         self.counts = "  ·  ".join(
             [count(len(m.processes), "process", "processes"), count(len(m.topics), "topic", "topics")]
             + [count(len(m.edges), "connection", "connections")]
+            + ([count(len(m.services), "service or action", "services and actions")] if m.services else [])
             + ([f"{self.n_back} against the flow (orange)"] if self.n_back else [])
         )
         gap = min(GAP + 120, max(GAP, 0.15 * self.content_h))  # a taller fan gets a wider gap

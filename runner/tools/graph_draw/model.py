@@ -1,12 +1,13 @@
 """What the three drawings of a run's graph share: the topics (sorted, grouped by namespace), the
-processes with their roles, the edges publisher -> topic -> subscriber, and the colours of each role.
+processes with their roles, the edges publisher -> topic -> subscriber, the services and actions with
+the processes that answer them, and the colours of each role.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from runner.wire.graph import Graph
+from runner.wire.graph import Graph, Offered
 
 # role -> (fill, outline); anything else (a process only seen through its endpoints) is grey
 ROLE_COLORS: dict[str, tuple[str, str]] = {
@@ -51,6 +52,8 @@ class GraphModel:
     processes: dict[str, str]  # name -> role ("?" when unknown), sorted by name
     edges: list[Edge]
     wildcards: dict[str, list[str]] = field(default_factory=dict)  # process -> its wildcard subscriptions
+    # services and actions (an action once, by its name: `Graph.offered`), with the processes answering
+    services: list[Offered] = field(default_factory=list)
 
 
 def relative_key(run: str, key: str) -> str:
@@ -91,4 +94,4 @@ def build_model(graph: Graph) -> GraphModel:
     for e in sorted(graph.endpoints, key=lambda e: (e.process, e.key)):
         if e.kind == "sub" and "*" in e.key:
             wildcards.setdefault(e.process, []).append(relative_key(graph.run, e.key))
-    return GraphModel(graph.run, topics, processes, edges, wildcards)
+    return GraphModel(graph.run, topics, processes, edges, wildcards, graph.offered())

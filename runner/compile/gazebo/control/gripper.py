@@ -3,8 +3,8 @@ position_controllers/GripperActionController and effort_controllers/GripperActio
 (gripper_controllers), parallel_gripper_action_controller/GripperActionController (Jazzy), ROS 1's
 position_controllers/ and effort_controllers/GripperActionController (gripper_action_controller).
 
-They take goals as actions only; until the runner serves actions, our topic `<name>/gripper_cmd` takes the
-goal (said at the controller's line).
+They take goals as the action `~/gripper_cmd`; our topic of the same name takes the same goal from a
+scenario's timeline (plugins/gripper_action_controller.py, docs/ros2_control.md).
 """
 
 from __future__ import annotations
@@ -60,14 +60,8 @@ def _gripper(ctx: ControlContext, spec: ControllerSpec, *, parallel: bool) -> bo
             ctx.say(spec, f"{spec.name}: {key!r} is not a parameter of the gripper controller; ignored")
     rate = param(p, "update_rate") or spec.update_rate
     params["update_rate"] = float(rate) if isinstance(rate, (int, float)) else None
-    topic = ctx.topic(f"{spec.name}/gripper_cmd")
-    params["command_topic"] = topic
-    kind = "sensor_msgs/msg/JointState" if parallel else "control_msgs/msg/GripperCommand"
-    ctx.say(
-        spec,
-        f"{spec.name}: the gripper_cmd action is not served yet; our topic {topic!r} ({kind}) takes its goal",
-        hint="publish the goal on that topic from the scenario's timeline",
-    )
+    # the action `~/gripper_cmd`, and our topic of the same name (a timeline has no action client)
+    params["command_topic"] = params["action_name"] = ctx.topic(f"{spec.name}/gripper_cmd")
     ctx.add(spec, "gripper_action_controller", params)
     return True
 

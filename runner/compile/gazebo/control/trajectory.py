@@ -93,12 +93,18 @@ def _constraints(ctx: ControlContext, spec: ControllerSpec, joints: list[str]) -
         c = {k: v for k, v in c.items() if v is not None}
         if c:
             out[j] = c
-    known = {"stopped_velocity_tolerance", "goal_time", *joints}
+    known = {"stopped_velocity_tolerance", "goal_time", "decelerate_on_cancel", *joints}
+    if param(p, "constraints.decelerate_on_cancel") is True:  # (Jazzy) with max_deceleration_on_cancel
+        ctx.say(spec, f"{spec.name}: constraints.decelerate_on_cancel is not run: a cancel holds at once")
     block = param(p, "constraints")
     if isinstance(block, dict):
-        for k in block:
+        for k, v in block.items():
             if k not in known:
                 ctx.say(spec, f"{spec.name}: constraints.{k} is not a parameter of the controller; ignored")
+            elif k in joints and isinstance(v, dict):
+                for jk in v:
+                    if jk not in ("trajectory", "goal", "max_deceleration_on_cancel"):
+                        ctx.say(spec, f"{spec.name}: constraints.{k}.{jk} is not a parameter; ignored")
     return out
 
 
@@ -167,7 +173,8 @@ def joint_trajectory_controller(ctx: ControlContext, spec: ControllerSpec) -> bo
         ctx.say(
             spec,
             f"{spec.name}: ROS 1 JointTrajectoryController runs as ros2_controllers' (the state topic "
-            "carries control_msgs/JointTrajectoryControllerState of ROS 2 Jazzy; no action server yet)",
+            "carries control_msgs/JointTrajectoryControllerState of ROS 2 Jazzy, follow_joint_trajectory "
+            "control_msgs/action/FollowJointTrajectory on ROS 2's wire)",
         )
     else:
         for key in _RUN:
@@ -194,11 +201,7 @@ def joint_trajectory_controller(ctx: ControlContext, spec: ControllerSpec) -> bo
                 )
         params["command_topic"] = ctx.topic(f"{spec.name}/joint_trajectory")
         params["state_topic"] = ctx.topic(f"{spec.name}/controller_state")
-        ctx.say(
-            spec,
-            f"{spec.name}: the follow_joint_trajectory action is not served yet; trajectories go to "
-            f"{params['command_topic']!r}",
-        )
+    params["action_name"] = ctx.topic(f"{spec.name}/follow_joint_trajectory")
     interfaces = params.get("command_interfaces") or ["position"]
     closed_loop = len(interfaces) == 1 and interfaces[0] in ("velocity", "effort")
     if params["gains"] and not closed_loop:
