@@ -155,14 +155,15 @@ def test_bad_requests_get_false_and_the_world_goes_on(tmp_path: Path, capsys: py
     assert garbage[0][0] is None and "does not decode" in garbage[0][1]
     deleted = _answer(delete_unknown, dl)
     assert not deleted.success and deleted.status_message == "Entity [ghost] does not exist"
-    # a step asked while running: gz-sim's `pause: false` runs the world; the steps are not taken
-    assert _answer(step_running, "ros_gz_interfaces/srv/ControlWorld").success
+    # steps asked with `pause: false` (which would run the world): refused, nothing done
+    assert not _answer(step_running, "ros_gz_interfaces/srv/ControlWorld").success
     assert not world.paused and world.steps_left == 0
     with pytest.raises(ValueError, match="pause it first"):
         world.step(3)
     assert world.entity_state("crate") == before
     err = capsys.readouterr().err
     assert "entity [ghost] does not exist" in err and "reference entity [nowhere] not found" in err
+    assert "a step is taken only while paused" in err
     stats = world.run()
     assert stats.error is None and stats.sim_ns == world.plan.duration_ns
 

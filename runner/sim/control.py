@@ -371,8 +371,9 @@ class Control:
     def _srv_control(self, req: Any, reply: Reply) -> None:
         """ros_gz ControlWorld: `reset.all` is reset_simulation, `reset.model_only` reset_world; then
         `pause` sets the state (WorldControl has no "as it is": false runs the world); `step` is one step,
-        `multi_step` that many, taken only with `pause: true`. `time_only`, `seed` and `run_to_sim_time`
-        are refused (success false). (Our mapping: gz-sim's handling was not read for it.)"""
+        `multi_step` that many, only with `pause: true` (without it the request is refused, nothing done).
+        `time_only`, `seed` and `run_to_sim_time` are refused (success false). (Our mapping: gz-sim's
+        handling was not read for it.)"""
         c = req.world_control
         response = msgs.T["ros_gz_interfaces/srv/ControlWorld_Response"]
         refused = [
@@ -388,14 +389,19 @@ class Control:
             self._said(f"control: {', '.join(refused)} not supported")
             reply(response(success=False))
             return
+        steps = c.multi_step or (1 if c.step else 0)
+        if steps and not c.pause:
+            # (`pause: false` would run the world and the steps would never be taken: refused as a whole)
+            self._said("control: a step is taken only while paused: send `pause: true` with `multi_step`")
+            reply(response(success=False))
+            return
         if c.reset.model_only and not c.reset.all:
             self.reset_world()
         if c.pause:
             self.pause()
         else:
             self.unpause()
-        steps = c.multi_step or (1 if c.step else 0)
-        if steps and c.pause:
+        if steps:
             self.step(steps)
         if c.reset.all:
             self._rewind = [*(self._rewind or []), lambda: reply(response(success=True))]
