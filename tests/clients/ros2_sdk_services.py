@@ -197,8 +197,9 @@ class Client:
             self.clients[key] = ROS2ServiceClient(
                 name,
                 srv,
-                request_definition=req,
-                response_definition=res,
+                # (the SDK takes an empty part as "not given"; a comment is the empty definition it hashes)
+                request_definition=req if req.strip() else "# empty\n",
+                response_definition=res if res.strip() else "# empty\n",
                 type_hash=type_hash,
                 timeout=60.0,
                 **self.where,
@@ -207,9 +208,12 @@ class Client:
 
     def call(self, name: str, srv: str, request: dict[str, Any], type_hash: str | None = None) -> Any:
         client = self.service(name, srv, type_hash)
+        from rosbags.typesys.base import Nodetype
+
         store = client.session_mgr.store
         fields = dict(store.fielddefs[client.request_store_type][1])
-        response = client.call(**{k: _build(store, fields[k], v) for k, v in request.items()})
+        whole = _build(store, (Nodetype.NAME, client.request_store_type), request)  # (defaults filled in)
+        response = client.call(**{k: getattr(whole, k) for k in fields})
         if response is None:
             return None
         return _plain(response)
