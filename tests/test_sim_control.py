@@ -155,7 +155,7 @@ def test_bad_requests_get_false_and_the_world_goes_on(tmp_path: Path, capsys: py
     assert garbage[0][0] is None and "does not decode" in garbage[0][1]
     deleted = _answer(delete_unknown, dl)
     assert not deleted.success and deleted.status_message == "Entity [ghost] does not exist"
-    # steps asked with `pause: false` (which would run the world): refused, nothing done
+    # steps asked of a running world with `pause: false`: refused, nothing done
     assert not _answer(step_running, "ros_gz_interfaces/srv/ControlWorld").success
     assert not world.paused and world.steps_left == 0
     with pytest.raises(ValueError, match="pause it first"):
@@ -196,24 +196,28 @@ def test_pause_step_unpause_in_the_running_loop(tmp_path: Path) -> None:
     # 25 physics steps of 2 ms: sim time goes to 50 ms, then stands still again
     cw = "ros_gz_interfaces/srv/ControlWorld"
     stepped = _call(bus, "g/world/g/control", cw, {"world_control": {"pause": True, "multi_step": 25}})
-    _wait(lambda: bool(stepped) and world.steps_left == 0 and world.now_ns > 0)
+    _wait(lambda: bool(stepped))  # answered once the steps are taken
     assert _answer(stepped, cw).success
     step_ns = world.step_ns
-    assert world.now_ns == 25 * step_ns
+    assert world.now_ns == 25 * step_ns and world.steps_left == 0
     time.sleep(0.05)
     assert world.now_ns == 25 * step_ns and thread.is_alive()
+    # steps asked of a paused world without `pause: true` are steps too: it stays paused
+    more = _call(bus, "g/world/g/control", cw, {"world_control": {"multi_step": 5}})
+    _wait(lambda: bool(more))
+    assert _answer(more, cw).success and world.paused and world.now_ns == 30 * step_ns
     # a reset while paused: time back to 0, the t = 0 sensors published again, still paused
     imu = len(_stamps(bus, "g/bot/imu"))
     reset = _call(bus, "g/reset_simulation", em)
     _wait(lambda: bool(reset))
     assert world.resets == 1 and world.now_ns == 0 and world.paused
     _wait(lambda: len(_stamps(bus, "g/bot/imu")) == imu + 1)
-    assert _stamps(bus, "g/bot/imu")[-1] == 25 * step_ns  # log time: 50 ms run before the reset, + 0
+    assert _stamps(bus, "g/bot/imu")[-1] == 30 * step_ns  # log time: 60 ms run before the reset, + 0
     unpaused = _call(bus, "g/unpause_physics", em)
     thread.join(timeout=60)
     assert not thread.is_alive() and unpaused
     assert out["stats"].sim_ns == world.plan.duration_ns and out["stats"].error is None
-    assert out["stats"].run_ns == 25 * step_ns + world.plan.duration_ns
+    assert out["stats"].run_ns == 30 * step_ns + world.plan.duration_ns
     assert _stamps(bus, "g/pause_physics/_service_event") == []
     assert len(_stamps(bus, "g/unpause_physics/_service_event")) == 2  # request and response
 
@@ -593,7 +597,7 @@ def test_a_ros2_client_pauses_steps_moves_and_resets_the_world(write_scenario: A
 
     assert r[0]["success"] and stamp(r[0]) == 0 and r[0]["state"]["pose"]["position"]["z"] > 0
     assert r[1]["success"] is True
-    assert r[2]["success"] and 0 < stamp(r[2]) <= 50 * step_ns  # (the steps may still be under way)
+    assert r[2]["success"] and stamp(r[2]) == 50 * step_ns  # (the step's answer came once they were taken)
     assert r[3]["success"] is False
     assert r[4]["success"] is True
     assert r[5]["success"] and r[5]["state"]["pose"]["position"]["x"] == pytest.approx(1.5, abs=1e-3)

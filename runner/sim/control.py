@@ -66,6 +66,7 @@ class Control:
         self.paused = False
         self.steps_left = 0  # physics steps still to run while paused (step N)
         self._rewind: list[Callable[[], None]] | None = None  # a reset_simulation due: who to answer then
+        self._stepped: list[Callable[[], None]] = []  # step requests answered once their steps are taken
         self.resets = 0  # reset_simulation done so far
         self.calls_made: set[int] = set()  # the timeline's `call` entries made (once per run)
         self.event_calls_made: set[tuple[int, int]] = set()  # (event, action) of events' calls made
@@ -307,6 +308,12 @@ class Control:
             w.serve(sp.key, sp.type, handlers[sp.key.rsplit("/", 1)[1]])
         self.remember_start()
 
+    def _steps_taken(self) -> None:
+        """The steps asked are taken (or dropped by an unpause or a reset): their requests answered."""
+        answers, self._stepped = self._stepped, []
+        for answer in answers:
+            answer()
+
     def _empty(self, reply: Reply) -> None:
         reply(msgs.T["std_srvs/srv/Empty_Response"]())
 
@@ -371,7 +378,8 @@ class Control:
     def _srv_control(self, req: Any, reply: Reply) -> None:
         """ros_gz ControlWorld: `reset.all` is reset_simulation, `reset.model_only` reset_world; then
         `pause` sets the state (WorldControl has no "as it is": false runs the world); `step` is one step,
-        `multi_step` that many, only with `pause: true` (without it the request is refused, nothing done).
+        `multi_step` that many: taken while paused (the world stays paused whatever `pause` says), or with
+        `pause: true`; asked of a running world with `pause: false` the request is refused, nothing done.
         `time_only`, `seed` and `run_to_sim_time` are refused (success false). (Our mapping: gz-sim's
         handling was not read for it.)"""
         c = req.world_control
@@ -390,33 +398,41 @@ class Control:
             reply(response(success=False))
             return
         steps = c.multi_step or (1 if c.step else 0)
-        if steps and not c.pause:
-            # (`pause: false` would run the world and the steps would never be taken: refused as a whole)
+        if steps and not c.pause and not self.paused:
+            # (steps of a running world, which the request leaves running: refused as a whole)
             self._said("control: a step is taken only while paused: send `pause: true` with `multi_step`")
             reply(response(success=False))
             return
         if c.reset.model_only and not c.reset.all:
             self.reset_world()
-        if c.pause:
+        if c.pause or steps:  # (a step request keeps a paused world paused, whatever its `pause` says)
             self.pause()
         else:
             self.unpause()
-        if steps:
-            self.step(steps)
-        if c.reset.all:
-            self._rewind = [*(self._rewind or []), lambda: reply(response(success=True))]
+
+        def answer() -> None:
+            if steps:
+                self.step(steps)
+                # answered once the steps are taken (at the boundary they end at, its sensors published):
+                # a script that steps and then reads sees the world after the steps
+                self._stepped.append(lambda: reply(response(success=True)))
+            else:
+                reply(response(success=True))
+
+        if c.reset.all:  # the reset first (at the end of this step), then any steps from t = 0
+            self._rewind = [*(self._rewind or []), answer]
             return
-        reply(response(success=True))
+        answer()
 
     def _srv_spawn(self, _req: Any, reply: Reply) -> None:
-        why = "spawning is not supported: the world's model is compiled once (see docs/ros2.md)"
+        why = "spawning is not supported: the world's model is compiled once (docs/simulation_control.md)"
         self._said(f"spawn_entity: {why}")
         reply(msgs.T["gazebo_msgs/srv/SpawnEntity_Response"](success=False, status_message=why))
 
     def _srv_delete(self, req: Any, reply: Reply) -> None:
         try:
             self.body_of(req.name)
-            why = "deleting is not supported: the world's model is compiled once (see docs/ros2.md)"
+            why = "deleting is not supported: the world's model is compiled once (docs/simulation_control.md)"
         except EntityError as e:
             why = f"Entity [{req.name}] does not exist" if "does not exist" in str(e) else str(e)
         self._said(f"delete_entity: {why}")

@@ -376,6 +376,8 @@ class World(PubSub, Services, Control):
                 self._rewound()
                 pace_ns, pace_wall = 0, time.perf_counter()
                 continue  # the boundary at t = 0, as a fresh run's first
+            if self._stepped and not self.steps_left:
+                self._steps_taken()
             # the hooks' controls, checked before physics takes them (a NaN fails `<=` too), in ~1 µs
             if nu and not np.abs(ctrl, out=abs_ctrl).max() <= CTRL_MAX and (error := self._bad_controls()):
                 break
