@@ -28,6 +28,38 @@ class ServicePlan(BaseModel):
     owner: str = ""  # e.g. arm/arm_controller, or `world`
 
 
+# The world's simulation control services (runner.sim.control answers them), under the names scripts use:
+# gazebo_ros's (Gazebo Classic, ROS 2: gazebo_ros_init.cpp, gazebo_ros_factory.cpp, gazebo_ros_state.cpp
+# with no <ros><namespace>) at the top of the run, and ros_gz's (Gazebo Sim through ros_gz_bridge, which
+# keeps gz-transport's names: /world/<world>/control...) under `world/<world name>`. The world tells them
+# apart by the last part of the key.
+GAZEBO_ROS_SERVICES: tuple[tuple[str, str], ...] = (
+    ("reset_simulation", "std_srvs/srv/Empty"),
+    ("reset_world", "std_srvs/srv/Empty"),
+    ("pause_physics", "std_srvs/srv/Empty"),
+    ("unpause_physics", "std_srvs/srv/Empty"),
+    ("get_entity_state", "gazebo_msgs/srv/GetEntityState"),
+    ("set_entity_state", "gazebo_msgs/srv/SetEntityState"),
+    ("spawn_entity", "gazebo_msgs/srv/SpawnEntity"),
+    ("delete_entity", "gazebo_msgs/srv/DeleteEntity"),
+)
+ROS_GZ_SERVICES: tuple[tuple[str, str], ...] = (
+    ("control", "ros_gz_interfaces/srv/ControlWorld"),
+    ("set_pose", "ros_gz_interfaces/srv/SetEntityPose"),
+    ("create", "ros_gz_interfaces/srv/SpawnEntity"),
+    ("remove", "ros_gz_interfaces/srv/DeleteEntity"),
+)
+
+
+def control_services(run: str, world_name: str) -> list[ServicePlan]:
+    """The world's own services of a world plan named `run` whose Gazebo world name is `world_name`."""
+    out = [ServicePlan(key=f"{run}/{n}", type=t, owner="world") for n, t in GAZEBO_ROS_SERVICES]
+    out += [
+        ServicePlan(key=f"{run}/world/{world_name}/{n}", type=t, owner="world") for n, t in ROS_GZ_SERVICES
+    ]
+    return out
+
+
 class PluginPlan(BaseModel):
     type: str
     name: str
@@ -88,8 +120,9 @@ class RobotPlan(BaseModel):
 class TimelinePlan(BaseModel):
     t_ns: int
     key: str
-    type: str
-    data: dict[str, Any]
+    type: str  # the message's, or with `call` the service's (pkg/srv/Name)
+    data: dict[str, Any]  # the message, or the request
+    call: bool = False  # a call of the world's service `key` (made once per run), not a message
 
 
 class ActorPlan(BaseModel):
@@ -280,7 +313,7 @@ class RunPlan(BaseModel):
                     seen[(t.key, "pub")] = t
                     out.append(t)
         for ev in self.timeline:
-            if (ev.key, "pub") not in seen:
+            if not ev.call and (ev.key, "pub") not in seen:
                 seen[(ev.key, "pub")] = TopicPlan(key=ev.key, type=ev.type, direction="pub", owner="timeline")
                 out.append(seen[(ev.key, "pub")])
         return out

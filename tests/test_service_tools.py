@@ -291,7 +291,8 @@ def test_topics_graph_and_validate_list_the_services_and_actions(live: str, tmp_
     assert any(
         re.fullmatch(r"r1/grip\s+control_msgs/action/GripperCommand\s+action: world", line) for line in lines
     ), lines
-    assert ", 4 services and actions -> " in " ".join(proc.stdout.split()), proc.stdout
+    # the 4 of the robot's plugins, and the world's 12 simulation control services (runner.plan)
+    assert ", 16 services and actions -> " in " ".join(proc.stdout.split()), proc.stdout
     dot = (tmp_path / "g.dot").read_text()
     assert '"service:svcrun/r1/grip"' in dot and "shape=octagon" in dot and "shape=hexagon" in dot
     assert '"service:svcrun/r1/flip" -> "process:world" [style=dotted];' in dot

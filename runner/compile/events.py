@@ -16,14 +16,14 @@ from typing import Any
 import mujoco
 
 from runner.compile.nodes import declared_topics
-from runner.compile.timeline import message_of
+from runner.compile.timeline import message_of, service_of, service_types
 from runner.errors import Problem, Problems, ScenarioError, closest, did_you_mean
 from runner.geometry import rpy_to_quat
-from runner.plan import ActorPlan, EventPlan, RobotPlan
+from runner.plan import ActorPlan, EventPlan, RobotPlan, ServicePlan
 from runner.plugin.registry import load
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import Action, Event, Scenario
-from runner.wire import msgs
+from runner.wire import interfaces, msgs
 
 
 def _choices(names: list[str] | set[str], what: str) -> str:
@@ -44,6 +44,7 @@ class _World:
     taken: dict[str, str]  # key -> type of what the world's plugins subscribe (from nodes...)
     heard: dict[str, str]  # key -> type of what nodes say they publish (`publishes:`): message triggers
     assertions: list[str] = field(default_factory=list)
+    services: dict[str, str] = field(default_factory=dict)  # key -> type of the services a `call` may name
 
     def key(self, topic: str) -> str:
         return f"{self.sc.name}/{topic.strip('/')}"
@@ -147,13 +148,21 @@ def compile_events(
     robots: list[RobotPlan],
     actors: list[ActorPlan],
     problems: Problems,
+    world_services: list[ServicePlan] | None = None,
 ) -> list[EventPlan]:
-    """Every event checked (each on its own: its mistakes to `problems`), in the order a step plays them."""
+    """Every event checked (each on its own: its mistakes to `problems`), in the order a step plays them.
+    A `call` names one of `world_services` or a plugin's service."""
     if not sc.events or not mjcf:
         return []
     model = mujoco.MjModel.from_xml_string(mjcf)
     published = {t.key: t.type for r in robots for p in r.plugins for t in p.topics if t.direction == "pub"}
-    published.update({f"{sc.name}/{e.topic.strip('/')}": msgs.normalize_type(e.type) for e in sc.timeline})
+    published.update(
+        {
+            f"{sc.name}/{e.topic.strip('/')}": msgs.normalize_type(e.type)
+            for e in sc.timeline
+            if e.topic is not None and e.type is not None
+        }
+    )
     for ev in sc.events:
         for act in ev.do:
             if act.publish is not None:
@@ -161,6 +170,7 @@ def compile_events(
     taken = {t.key: t.type for r in robots for p in r.plugins for t in p.topics if t.direction == "sub"}
     heard = {k: t for k, t in declared_topics(sc).items() if t is not None}
     w = _World(sc, doc, model, robots, actors, published, taken, heard, [a.name for a in sc.assertions])
+    w.services = service_types(world_services or [], robots)
     names = [e.name for e in sc.events]
     out: list[EventPlan | None] = []
     for i, ev in enumerate(sc.events):
@@ -345,6 +355,10 @@ def _action(w: _World, act: Action, at: PathKey) -> dict[str, Any]:
         }
     if act.block is not None or act.cut is not None:
         return _joint(w, act, at)
+    if act.call is not None:
+        key, srv = service_of(w.sc, w.doc, act.call.service, w.services, (*at, "service"))
+        message_of(interfaces.service_type(srv).request, act.call.data, w.doc, at)
+        return {"kind": "call", "key": key, "type": srv, "data": act.call.data, "service": act.call.service}
     assert act.end is not None
     return {"kind": "end", "result": act.end.result, "message": act.end.message}
 

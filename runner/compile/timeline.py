@@ -3,23 +3,32 @@ type against the one its topic's subscriber takes."""
 
 from __future__ import annotations
 
+import difflib
 from typing import Any
 
 from runner.errors import Problem, Problems, ScenarioError
-from runner.plan import RobotPlan, TimelinePlan
+from runner.plan import RobotPlan, ServicePlan, TimelinePlan
 from runner.scenario.loader import Document, PathKey, non_finite
 from runner.scenario.schema import Scenario
-from runner.wire import msgs
+from runner.wire import interfaces, msgs
 
 
 def compile_timeline(
-    sc: Scenario, doc: Document, robots: list[RobotPlan], problems: Problems
+    sc: Scenario,
+    doc: Document,
+    robots: list[RobotPlan],
+    problems: Problems,
+    world_services: list[ServicePlan] | None = None,
 ) -> list[TimelinePlan]:
-    """The timeline's entries checked (each on its own: its mistakes to `problems`), in time order."""
+    """The timeline's entries checked (each on its own: its mistakes to `problems`), in time order. A
+    `call` must name one of the world's services (`world_services`, the plugins' of `robots`)."""
+    services = service_types(world_services or [], robots)
     ordered: list[tuple[int, TimelinePlan]] = []
     for i in range(len(sc.timeline)):
         with problems.each():
-            ordered.append((i, timeline_entry(sc, i, doc)))
+            entry = sc.timeline[i]
+            plan = timeline_entry(sc, i, doc) if entry.call is None else call_entry(sc, i, doc, services)
+            ordered.append((i, plan))
     with problems.each():
         check_timeline_types(ordered, robots, sc, doc)
     return sorted((ev for _, ev in ordered), key=lambda ev: ev.t_ns)
@@ -99,10 +108,59 @@ def _data_hint(message: str) -> str:
 
 def timeline_entry(sc: Scenario, i: int, doc: Document) -> TimelinePlan:
     ev = sc.timeline[i]
+    assert ev.topic is not None and ev.type is not None  # (TimelineEntry: a topic has a type)
     type_name = message_of(ev.type, ev.data, doc, ("timeline", i))
     topic = ev.topic
     key = f"{sc.name}/{topic.lstrip('/')}"
     return TimelinePlan(t_ns=round(ev.t * 1e9), key=key, type=type_name, data=ev.data)
+
+
+def service_types(world_services: list[ServicePlan], robots: list[RobotPlan]) -> dict[str, str]:
+    """Key -> type of every service a `call` may name: the world's own and its plugins' (not actions)."""
+    plugins = [s for r in robots for p in r.plugins for s in p.services]
+    return {s.key: s.type for s in [*world_services, *plugins] if s.kind == "service"}
+
+
+def service_of(
+    sc: Scenario, doc: Document, name: str, services: dict[str, str], where: PathKey
+) -> tuple[str, str]:
+    """(key, type) of the service `name` (`/reset_simulation`) of the world; else a located error."""
+    key = f"{sc.name}/{name.lstrip('/')}"
+    srv = services.get(key)
+    if srv is None:
+        names = sorted("/" + k.removeprefix(sc.name + "/") for k in services)
+        close = difflib.get_close_matches("/" + name.lstrip("/"), names, n=1)
+        raise ScenarioError(
+            Problem(
+                f"the world has no service {name!r}",
+                doc.locate(where),
+                where,
+                expected="one of: " + ", ".join(names),
+                hint=f"did you mean {close[0]!r}?" if close else "`scenario validate` lists the services",
+            )
+        )
+    return key, srv
+
+
+def call_entry(sc: Scenario, i: int, doc: Document, services: dict[str, str]) -> TimelinePlan:
+    """A `call:` entry: the service (one of the world's), its request's fields checked."""
+    ev = sc.timeline[i]
+    assert ev.call is not None
+    key, srv = service_of(sc, doc, ev.call, services, ("timeline", i, "call"))
+    if ev.type is not None and interfaces.service_type(ev.type).name != srv:
+        where: PathKey = ("timeline", i, "type")
+        raise ScenarioError(
+            Problem(
+                f"{ev.call} is a {srv}",
+                doc.locate(where),
+                where,
+                expected=srv,
+                found=ev.type,
+                hint="leave `type:` out: a call takes its service's type",
+            )
+        )
+    message_of(interfaces.service_type(srv).request, ev.data, doc, ("timeline", i))
+    return TimelinePlan(t_ns=round(ev.t * 1e9), key=key, type=srv, data=ev.data, call=True)
 
 
 def check_timeline_types(
@@ -119,7 +177,7 @@ def check_timeline_types(
     }
     problems = []
     for i, ev in timeline:  # (the index in the scenario, the entry)
-        wanted = takes.get(ev.key)
+        wanted = takes.get(ev.key) if not ev.call else None
         if wanted is not None and msgs.normalize_type(wanted[0]) != ev.type:
             where: PathKey = ("timeline", i, "type")
             problems.append(

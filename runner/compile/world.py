@@ -22,7 +22,7 @@ from runner.compile.timeline import compile_timeline
 from runner.compile.wheels import check_geometry
 from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError, missing_file_hint
 from runner.geometry import rpy_to_quat
-from runner.plan import NodePlan, RecordPlan, RobotPlan, RunPlan
+from runner.plan import NodePlan, RecordPlan, RobotPlan, RunPlan, control_services
 from runner.scenario.loader import Document, PathKey
 from runner.scenario.schema import NoCollision, Scenario, WorldModel
 from runner.wire import msgs
@@ -60,8 +60,12 @@ def compile_world(
     before anything uses it."""
     packages = _packages(sc, doc, problems)
     world, sdf_rate, actors = mujoco.MjSpec(), None, []
+    # the world's name in ros_gz's service names (/world/<name>/control): the SDF file's <world name>,
+    # else the scenario's name (with several worlds, the world's own)
+    world_name = sc.name.rsplit("/", 1)[-1]
     with problems.each():
-        world, sdf_rate = world_spec(sc, doc, packages, notices)
+        world, sdf_rate, sdf_name = world_spec(sc, doc, packages, notices)
+        world_name = sdf_name or world_name
         actors = add_actors(world, sc.world.actors, doc, problems)
     with problems.each():
         models = {m.name for m in sc.world.models} | {a.name for a in sc.world.actors}
@@ -72,8 +76,9 @@ def compile_world(
         with problems.each():
             mjcf = compile_model(world, robots, sc, doc, notices)
             step = world.option.timestep
-    timeline = compile_timeline(sc, doc, robots, problems)
-    events = compile_events(sc, doc, mjcf, robots, actors, problems)
+    services = control_services(sc.name, world_name)
+    timeline = compile_timeline(sc, doc, robots, problems, services)
+    events = compile_events(sc, doc, mjcf, robots, actors, problems, services)
     record = RecordPlan(enabled=False, path="", include=[], exclude=[])
     with problems.each():
         record = record_plan(sc, doc, record_path)
@@ -112,6 +117,7 @@ def compile_world(
         hosts={name: h.endpoint for name, h in sc.hosts.items()},
         resources=sc.resources.model_dump() if sc.resources else None,
         host=host,
+        world_services=services,
     )
 
 
@@ -141,7 +147,13 @@ def _assertion_keys(
     # what the world publishes, and what someone else does: the topics its plugins take in (a node's
     # cmd_vel) and those nodes say they publish
     published = {t.key: t.type for r in robots for p in r.plugins for t in p.topics}
-    published.update({f"{sc.name}/{ev.topic.strip('/')}": msgs.normalize_type(ev.type) for ev in sc.timeline})
+    published.update(
+        {
+            f"{sc.name}/{ev.topic.strip('/')}": msgs.normalize_type(ev.type)
+            for ev in sc.timeline
+            if ev.topic is not None and ev.type is not None
+        }
+    )
     declared = declared_topics(sc)
     published.update({k: t for k, t in declared.items() if t is not None})
     unloaded = [*unloaded, *(k for k, t in declared.items() if t is None)]  # (the node's mistake, said there)
@@ -260,8 +272,8 @@ def _compile_problem(e: ValueError, sc: Scenario, doc: Document, world: mujoco.M
 
 def world_spec(
     sc: Scenario, doc: Document, packages: PackageMap, notices: Notices
-) -> tuple[mujoco.MjSpec, float | None]:
-    """The world without robots, and the SDF's real-time factor if it gives one."""
+) -> tuple[mujoco.MjSpec, float | None, str | None]:
+    """The world without robots, the SDF's real-time factor if it gives one, and its <world name>."""
     spec = mujoco.MjSpec()
     spec.modelname = sc.name
     phys = sc.world.physics
@@ -283,7 +295,7 @@ def world_spec(
             rgba=list(ground.rgba),
             friction=[ground.friction, 0.005, 0.0001],
         )
-    rate = _load_sdf(spec, sc, doc, packages, notices) if sc.world.sdf else None
+    rate, name = _load_sdf(spec, sc, doc, packages, notices) if sc.world.sdf else (None, None)
     for i, m in enumerate(sc.world.models):
         try:
             _add_model(spec, m)
@@ -299,12 +311,12 @@ def world_spec(
                     + (" (`ground` is the ground plane's)" if m.name == "ground" else ""),
                 )
             ) from None
-    return spec, rate
+    return spec, rate, name
 
 
 def _load_sdf(
     spec: mujoco.MjSpec, sc: Scenario, doc: Document, packages: PackageMap, notices: Notices
-) -> float | None:
+) -> tuple[float | None, str | None]:
     assert sc.world.sdf is not None
     path = doc.base_dir / sc.world.sdf
     if not path.is_file():
@@ -345,7 +357,7 @@ def _load_sdf(
         spec.option.timestep = sdf.timestep
     if sdf.gravity and "gravity" not in explicit:
         spec.option.gravity = list(sdf.gravity)
-    return sdf.real_time_factor
+    return sdf.real_time_factor, sdf.name
 
 
 def _add_model(spec: mujoco.MjSpec, m: WorldModel) -> None:

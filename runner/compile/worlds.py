@@ -124,10 +124,7 @@ def _compile_one(
             "world": World.model_validate(world.model_dump(exclude={"name"})),
             "worlds": [],
             "robots": [sc.robots[i] for i in r_idx],
-            "timeline": [
-                sc.timeline[i].model_copy(update={"topic": _split_topic(sc.timeline[i].topic)[1]})
-                for i in t_idx
-            ],
+            "timeline": [_strip_entry(sc.timeline[i]) for i in t_idx],
             "assertions": [_strip_world(sc.assertions[i]) for i in a_idx],
             "nodes": [],
             "events": [],  # (one world's: refused with several, runner.scenario.validate)
@@ -229,12 +226,12 @@ def _topic_hint(first: str, names: list[str]) -> str:
 def _timeline_world(sc: Scenario, doc: Document, i: int, names: list[str], problems: list[Problem]) -> str:
     """The world of timeline entry `i`: its topic's first part (`arena/r1/cmd_vel`)."""
     entry = sc.timeline[i]
-    w, rest = _split_topic(entry.topic)
+    w, rest = _split_topic(entry.name)
     if w not in names or not rest:
-        where: PathKey = ("timeline", i, "topic")
+        where: PathKey = ("timeline", i, "topic" if entry.topic is not None else "call")
         problems.append(
             Problem(
-                f"{entry.topic!r} names no world" if w not in names else f"{entry.topic!r} names no topic",
+                f"{entry.name!r} names no world" if w not in names else f"{entry.name!r} names no topic",
                 doc.locate(where),
                 where,
                 expected=f"a topic starting with its world: {names[0]}/r1/cmd_vel",
@@ -304,6 +301,12 @@ def _assertion_world(
 def _strip_topic(entry: Any) -> Any:
     """A timeline entry or an assertion on a topic, as its world sees it: the topic without the world."""
     return entry.model_copy(update={"topic": _split_topic(entry.topic)[1]})
+
+
+def _strip_entry(entry: Any) -> Any:
+    """A timeline entry as its world sees it: its topic or service without the world."""
+    field = "topic" if entry.topic is not None else "call"
+    return entry.model_copy(update={field: _split_topic(entry.name)[1]})
 
 
 def _strip_world(a: Any) -> Any:

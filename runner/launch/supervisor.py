@@ -381,7 +381,8 @@ def _keys(plan: RunPlan) -> tuple[dict[str, str], set[str]]:
                     types.setdefault(t.key, msgs.normalize_type(t.type))
                     (subs if t.direction == "sub" else pubs).add(t.key)
         for ev in part.timeline:
-            types.setdefault(ev.key, ev.type)
+            if not ev.call:  # (a call's key is a service's)
+                types.setdefault(ev.key, ev.type)
     return types, subs - pubs
 
 

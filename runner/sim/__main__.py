@@ -126,7 +126,7 @@ def _announce_end(
         json.dumps(
             {
                 "reason": reason,
-                "sim_ns": stats.sim_ns,
+                "sim_ns": stats.run_ns,  # (the recording's time: it goes on over a reset_simulation)
                 "steps": stats.steps,
                 "wall_s": stats.wall_s,
                 "published": stats.published,

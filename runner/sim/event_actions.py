@@ -1,6 +1,7 @@
 """What an event does (`do:`), each action on the world at the step it fires, and said in words for the
 `<run>/_events` record: publish a message, start or stop an actor, teleport or push a body, change a
-plugin parameter, put a fault on a topic, block a joint or cut its motor, end the run."""
+plugin parameter, put a fault on a topic, block a joint or cut its motor, end the run, call a service of
+the world."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import mujoco
 import numpy as np
 
 from runner.sim.faults import Fault
+from runner.wire import interfaces, msgs
 
 BLOCK_FRICTION = 1e4  # N·m (or N) of dry friction on a blocked joint: no motor of a mobile robot turns it
 
@@ -47,7 +49,22 @@ def act(ev: Any, e: Any, a: dict[str, Any], now: int) -> str:
         return _fault(ev, e, a, now)
     if kind in ("block", "cut"):
         return _joint(m, a)
+    if kind == "call":
+        return _call(ev, e, a)
     return f"end: {a['result']}" + (f" ({a['message']})" if a["message"] else "")
+
+
+def _call(ev: Any, e: Any, a: dict[str, Any]) -> str:
+    """Ask the world's service (answered in this step, after the event); once per run: the events are made
+    again by a reset_simulation, and a reset that fired again would reset for ever."""
+    made = (e.index, next(i for i, x in enumerate(e.plan.do) if x is a))
+    world = ev.world
+    if made in world.event_calls_made:
+        return f"{a['service']} already called in this run (not again after a reset)"
+    world.event_calls_made.add(made)
+    msg = msgs.from_data(interfaces.service_type(a["type"]).request, a["data"])
+    world.request(a["key"], msg)
+    return f"called {a['service']}"
 
 
 def _teleport(ev: Any, a: dict[str, Any]) -> None:

@@ -14,7 +14,9 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-STATE_HEAD = struct.Struct("<qQ")  # the state a renderer gets: sim time ns, frame number (then the state)
+# the state a renderer gets: sim time ns, frame number, the sim time run before the last reset_simulation
+# (the renderer's epoch: runner.sim.pubsub.Outgoing.epoch), then the state
+STATE_HEAD = struct.Struct("<qQq")
 _WAIT = struct.Struct("<q")
 
 
@@ -71,9 +73,9 @@ class RemoteRender:
                     raise RuntimeError(f"the renderer process did not answer for {self.TIMEOUT_S:.0f} s")
                 self._cond.wait(0.05)
 
-    def send(self, now_ns: int, state: bytes, should_stop: Callable[[], bool]) -> None:
+    def send(self, now_ns: int, state: bytes, should_stop: Callable[[], bool], epoch_ns: int = 0) -> None:
         self._wait(self.sent - self.DEPTH + 1, should_stop)
-        self._pub.put(STATE_HEAD.pack(now_ns, self.sent) + state)
+        self._pub.put(STATE_HEAD.pack(now_ns, self.sent, epoch_ns) + state)
         self.sent += 1
 
     def finish(self, should_stop: Callable[[], bool]) -> None:

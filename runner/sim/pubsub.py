@@ -28,13 +28,15 @@ NONFINITE = "NaN or Inf values"
 # each message this process publishes (runner.wire.cdr.Peek), or None for the whole decoded message
 Local = tuple[str, Callable[[Any, int], None], Callable[[bytes], Any] | None]
 
+_NO_EPOCH = [0]
+
 
 class Outgoing:
     """One published key: sends CDR bytes with the (sequence, stamp) attachment and hands the message to
     subscribers inside this process (decoded only when there is one). While an event's fault is on the key
     (`fault`, runner.sim.faults), every message goes through it instead: dropped, held, replaced."""
 
-    __slots__ = ("fault", "key", "last", "local", "send", "seq", "type")
+    __slots__ = ("epoch", "fault", "key", "last", "local", "send", "seq", "type")
 
     def __init__(self, key: str, type_name: str, send: Callable[[bytes | bytearray, bytes], None]):
         self.key = key
@@ -44,6 +46,10 @@ class Outgoing:
         self.local: list[Local] = []
         self.fault: Any = None
         self.last: bytes | bytearray | None = None  # the last message sent (what a `freeze` fault repeats)
+        # added to the attachment's stamp (not to the message): the sim time run before the last
+        # `reset_simulation` (shared by a world's publishers), so that the recording's log time, the
+        # attachment's stamp, keeps going forward while the messages' own times start again from 0
+        self.epoch = _NO_EPOCH
 
     def publish(self, msg: Any, stamp_ns: int) -> None:
         self.publish_encoded(msgs.encode(msg, self.type), msg, stamp_ns)
@@ -64,7 +70,7 @@ class Outgoing:
     def deliver(self, payload: bytes | bytearray, msg: Any, stamp_ns: int) -> None:
         """Send, and hand to subscribers in this process (`msg`, or `payload` decoded when there is one);
         past any fault: what `publish` sends without one, and what a fault lets through or releases late."""
-        self.send(payload, _ATT.pack(self.seq, stamp_ns))
+        self.send(payload, _ATT.pack(self.seq, stamp_ns + self.epoch[0]))
         self.seq += 1
         # a borrowed buffer still holds this message when a fault starts (faults start between frames)
         self.last = payload
@@ -92,6 +98,7 @@ class PubSub:
 
     def _init_pubsub(self) -> None:
         self._out: dict[str, Outgoing] = {}
+        self._epoch = [0]  # sim ns run before the last reset_simulation (Outgoing.epoch)
         self._local: dict[str, list[Local]] = {}
         self._remote_subscribed: set[str] = set()
         self._inbox: queue.SimpleQueue[tuple[str, bytes, bytes | None]] = queue.SimpleQueue()
@@ -111,6 +118,7 @@ class PubSub:
         if out is None:
             out = Outgoing(key, type_name, self.bus.publisher(key, type_name))
             out.local = self._local.setdefault(key, [])
+            out.epoch = self._epoch
             self._out[key] = out
         elif out.type != type_name:
             raise ValueError(f"{key} is published as {out.type} and as {type_name}")

@@ -81,8 +81,8 @@ def main(argv: list[str] | None = None) -> int:
                 if what == "stop":
                     break
                 index = int(what)
-                now_ns, _frame = STATE_HEAD.unpack_from(payload)
-                world.render(index, now_ns, payload[STATE_HEAD.size :])
+                now_ns, _frame, epoch_ns = STATE_HEAD.unpack_from(payload)
+                world.render(index, now_ns, payload[STATE_HEAD.size :], epoch_ns)
                 frames[index] += 1
                 acks[index].put(json.dumps({"n": frames[index], "published": world.published()}).encode())
         except Exception as e:  # reported on stderr, which the runner shows

@@ -34,10 +34,11 @@ from typing import TYPE_CHECKING, Any, Literal
 import mujoco
 import numpy as np
 
-from runner.plan import RunPlan
+from runner.plan import RunPlan, TimelinePlan
 from runner.plugin import Plugin, RobotHandle, RuntimeContext, overrides
 from runner.plugin.registry import load
 from runner.sim.contacts import ContactWatch
+from runner.sim.control import Control
 from runner.sim.hardware import Hardware
 from runner.sim.links import Lockstep, RemoteRender
 from runner.sim.pubsub import PubSub
@@ -46,7 +47,7 @@ from runner.sim.services import Services
 
 if TYPE_CHECKING:
     from runner.sim.events import Events
-from runner.wire import msgs
+from runner.wire import interfaces, msgs
 from runner.wire.cdr import Layout, Peek
 from runner.wire.transport import Bus
 
@@ -62,6 +63,8 @@ class WorldStats:
     published: dict[str, int] = field(default_factory=dict)
     error: str | None = None  # why the world stopped early on its own (physics went unstable)
     ended: str | None = None  # an event ended the run (`end:`), and how
+    # the sim time run in all (`sim_ns` plus what reset_simulation took back): the recording's last log time
+    run_ns: int = 0
     rejected: dict[str, dict[str, int]] = field(default_factory=dict)  # inbound samples dropped: key, why
 
 
@@ -81,7 +84,7 @@ CTRL_MAX = 1e10
 _BADCTRL = int(mujoco.mjtWarning.mjWARN_BADCTRL)
 
 
-class World(PubSub, Services):
+class World(PubSub, Services, Control):
     """The simulated world of a plan. `role="world"` steps physics and runs every plugin, except, with
     `plan.renderers == "process"` on a Zenoh bus, the rendering ones: their frames are made by a renderer
     process (`role="renderer"`, see runner/sim/render.py) from the state this world sends it."""
@@ -97,11 +100,28 @@ class World(PubSub, Services):
         self._split = int(self.model.opt.integrator) != int(mujoco.mjtIntegrator.mjINT_RK4)
         self.step_ns = plan.step_ns
         self.now_ns = 0
-        self.rng = np.random.default_rng(plan.seed)
         self._init_pubsub()
         self._init_services()
+        self._init_control()
         self._lockstep: Lockstep | None = None
         self.robots = [RobotHandle(self.model, r) for r in plan.robots]
+        session = getattr(bus, "session", None)
+        self.remote_renders: dict[int, RemoteRender] = {}  # plugin index -> its renderer link
+        self.render_plugins: dict[int, Plugin] = {}  # in a renderer: plugin index -> plugin
+        if role == "world" and plan.lockstep and session is not None:
+            keys = self._remote_subscribed  # the same set: keys subscribed later count too
+            self._lockstep = Lockstep(session, plan.name, plan.lockstep, self._received, keys)
+        self._build(remote=role == "world" and plan.renderers == "process" and session is not None)
+        if role == "world":
+            self._serve_control()
+
+    def _build(self, remote: bool) -> None:
+        """Everything of the world that a run starts with beside the model: the hardware's start state,
+        the plugins and their hooks, the clock, the timeline, the events. Made again, the same way, by
+        `reset_simulation` (runner.sim.control), which is why it is apart from `__init__`: what it makes
+        from the seed and the plan alone comes out the same each time."""
+        plan = self.plan
+        self.rng = np.random.default_rng(plan.seed)
         # the hardware's start state and gains come before any plugin (a controller reads its start there)
         self.hardware = Hardware(self.model, self.data, plan.robots)
         self.plugins: list[Plugin] = []
@@ -110,31 +130,23 @@ class World(PubSub, Services):
         self._ended: str | None = None
         self._before: list[Hook] = []
         self._after: list[Hook] = []
-        session = getattr(bus, "session", None)
-        self.remote_renders: dict[int, RemoteRender] = {}  # plugin index -> its renderer link
-        self.render_plugins: dict[int, Plugin] = {}  # in a renderer: plugin index -> plugin
-        self._load_plugins(remote=role == "world" and plan.renderers == "process" and session is not None)
-        if role == "world" and plan.foxglove.scene:
+        self._load_plugins(remote=remote)
+        if self.role == "world" and plan.foxglove.scene:
             from runner.sim.scene import SceneFeed
 
             for fn, period in SceneFeed(self).hooks():
                 self._after.append(Hook(fn, period))
-        if role == "renderer":
+        if self.role == "renderer":
             for plugin in self.plugins:
                 plugin.setup()
             return
         self._clock_sent = -1  # the last clock value published
-        if plan.lockstep and session is not None:
-            keys = self._remote_subscribed  # the same set: keys subscribed later count too
-            self._lockstep = Lockstep(session, plan.name, plan.lockstep, self._received, keys)
         self._clock = self.make_publisher(plan.clock_key, "rosgraph_msgs/msg/Clock")
         self._clock_layout = Layout(
             self._clock.type, msgs.T[self._clock.type](clock=msgs.time_msg(0)), ["clock"]
         )
         self._clock_hook = Hook(self._publish_clock, round(1e9 / plan.clock_rate))
-        self._timeline = [
-            (ev.t_ns, ev.key, ev.type, msgs.from_data(ev.type, ev.data)) for ev in plan.timeline
-        ]
+        self._timeline = [(ev.t_ns, ev.key, ev.type, self._timeline_message(ev)) for ev in plan.timeline]
         self._timeline_i = 0
         if plan.contact_watch:
             for fn, period in ContactWatch(self, plan.contact_watch).hooks():
@@ -146,6 +158,12 @@ class World(PubSub, Services):
             self._events = Events(self)
         for plugin in self.plugins:
             plugin.setup()
+
+    def _timeline_message(self, ev: TimelinePlan) -> Any:
+        """A timeline entry's message, or with `call` its request."""
+        if ev.call:
+            return msgs.from_data(interfaces.service_type(ev.type).request, ev.data)
+        return msgs.from_data(ev.type, ev.data)
 
     def _load_plugins(self, remote: bool) -> None:
         """Every robot's plugins, in plan order, and their hooks. In a renderer process only the rendering
@@ -161,7 +179,7 @@ class World(PubSub, Services):
                 if role == "renderer" and not cls.renders:
                     continue
                 if remote and cls.renders:
-                    link = RemoteRender(session, self.plan.name, index)
+                    link = self.remote_renders.get(index) or RemoteRender(session, self.plan.name, index)
                     self.remote_renders[index] = link
                     self._after.append(Hook(self._render_hook(link), period))
                     self._hooks_of[index] = [self._after[-1]]
@@ -209,7 +227,11 @@ class World(PubSub, Services):
                 h.next_ns = next_due(h, now)
         while self._timeline_i < len(self._timeline) and self._timeline[self._timeline_i][0] <= now:
             _t, key, type_name, msg = self._timeline[self._timeline_i]
-            self.publish(self.make_publisher(key, type_name), msg, now)
+            if not self.plan.timeline[self._timeline_i].call:
+                self.publish(self.make_publisher(key, type_name), msg, now)
+            elif self._timeline_i not in self.calls_made:  # (once per run: not again after a reset)
+                self.calls_made.add(self._timeline_i)
+                self.request(key, msg)  # answered below, with the requests from outside
             self._timeline_i += 1
         if self._lockstep is not None:
             # the nodes' answers to the clocks published so far come before their next wait message
@@ -219,6 +241,8 @@ class World(PubSub, Services):
         events = self._events
         if events is not None and now >= events.next_ns:
             events.boundary(now)
+            if self._asked:  # an event called a service: answered in this step, as the timeline's are
+                self._drain_requests()
         for h in self._before:
             if now >= h.next_ns:
                 h.fn(now)
@@ -232,7 +256,7 @@ class World(PubSub, Services):
     # ---------------------------------------------------------------------------- renderer processes
     def _render_hook(self, link: RemoteRender) -> Callable[[int], None]:
         def send(now: int) -> None:
-            link.send(now, self._state_bytes(), self._should_stop)
+            link.send(now, self._state_bytes(), self._should_stop, self._epoch[0])
 
         return send
 
@@ -250,8 +274,12 @@ class World(PubSub, Services):
             time.sleep(0.02)
         return True
 
-    def render(self, index: int, now_ns: int, state: bytes) -> None:
-        """In a renderer process: pose the world as the state says and run the plugin's hook."""
+    def render(self, index: int, now_ns: int, state: bytes, epoch_ns: int = 0) -> None:
+        """In a renderer process: pose the world as the state says and run the plugin's hook. A new
+        `epoch_ns`: the world was reset (reset_simulation): the rendering plugins are made again, as the
+        world's own are (their noise streams from the start), and stamp their messages' log time on."""
+        if epoch_ns != self._epoch[0]:
+            self.renderer_reset(epoch_ns)
         m, d = self.model, self.data
         nq, nm = m.nq, m.nmocap
         values = np.frombuffer(state, dtype=np.float64)
@@ -278,7 +306,7 @@ class World(PubSub, Services):
         alone are read from the bytes (`Peek`), unless the message object is at hand."""
         plan = self.plan
         own = {t.key for r in plan.robots for p in r.plugins for t in p.topics if t.direction == "pub"}
-        own |= set(self._out) | {ev.key for ev in plan.timeline}
+        own |= set(self._out) | {ev.key for ev in plan.timeline if not ev.call}
         own |= {a["key"] for e in plan.events for a in e.do if a["kind"] == "publish"}
         own.add(f"{plan.name}/_contacts")  # (not a node's topic, though a node declares it: `publishes:`)
         if key in own:
@@ -333,6 +361,9 @@ class World(PubSub, Services):
         factor = {"realtime": 1.0, "max": None}.get(plan.rate, plan.rate)  # type: ignore[arg-type]
         wall0 = time.perf_counter()
         next_check = wall0
+        # the pacing's origin: sim time `pace_ns` at wall time `pace_wall` (moved on by a pause and a reset:
+        # the world never runs fast to catch up the time it stood still, or the sim time a reset took back)
+        pace_ns, pace_wall = self.now_ns, wall0
         steps = 0
         warnings = [d.warning[i] for i in _UNSTABLE]
         badctrl = d.warning[_BADCTRL]
@@ -341,12 +372,28 @@ class World(PubSub, Services):
         error = None
         while True:
             self._boundary()
+            if self._rewind is not None:
+                self._rewound()
+                pace_ns, pace_wall = 0, time.perf_counter()
+                continue  # the boundary at t = 0, as a fresh run's first
+            if self._stepped and not self.steps_left:
+                self._steps_taken()
             # the hooks' controls, checked before physics takes them (a NaN fails `<=` too), in ~1 µs
             if nu and not np.abs(ctrl, out=abs_ctrl).max() <= CTRL_MAX and (error := self._bad_controls()):
                 break
             if self.now_ns >= end_ns or self._ended is not None:
                 break
+            if self.paused and not self.steps_left:
+                if not self._idle(should_stop):
+                    break
+                pace_ns, pace_wall = self.now_ns, time.perf_counter()
+                if self._rewind is not None:  # asked while paused: reset now (it stays paused)
+                    self._rewound()
+                    pace_ns = 0
+                    continue  # the boundary at t = 0
             target = self._next_boundary(end_ns)
+            if self.steps_left:  # step N while paused: stop there, paused again
+                target = min(target, self.now_ns + self.steps_left * self.step_ns)
             n = max(1, math.ceil((target - self.now_ns) / self.step_ns))
             if self._split:
                 mujoco.mj_step2(m, d)  # finish the step begun at the boundary, with the new controls
@@ -360,9 +407,11 @@ class World(PubSub, Services):
                 error = self._instability(self.now_ns, self.now_ns + n * self.step_ns)
                 break
             self.now_ns += n * self.step_ns
+            if self.steps_left:
+                self.steps_left = max(0, self.steps_left - n)
             wall = time.perf_counter()
             if factor is not None:
-                ahead = self.now_ns / 1e9 / factor - (wall - wall0)
+                ahead = (self.now_ns - pace_ns) / 1e9 / factor - (wall - pace_wall)
                 if ahead > 0:
                     sleep_until(wall + ahead)
                     wall = time.perf_counter()
@@ -372,6 +421,12 @@ class World(PubSub, Services):
                     on_progress(self.now_ns)
                 if should_stop():
                     break
+        return self._finish(steps, wall0, error, should_stop)
+
+    def _finish(
+        self, steps: int, wall0: float, error: str | None, should_stop: Callable[[], bool]
+    ) -> WorldStats:
+        """The loop is over: the last lockstep answers, renderers and plugins closed, the run's numbers."""
         if self._lockstep is not None:
             # their answers to the last clock are part of the run (recorded), as every earlier one
             self._lockstep.wait(self._clock_sent, should_stop)
@@ -390,12 +445,36 @@ class World(PubSub, Services):
         return WorldStats(
             steps=steps,
             sim_ns=self.now_ns,
+            run_ns=self._epoch[0] + self.now_ns,
             wall_s=wall_s,
             published=published,
             error=error,
             rejected=rejected,
             ended=self._ended,
         )
+
+    def _rewound(self) -> None:
+        """A reset_simulation asked at this boundary: done, and its askers answered (at t = 0)."""
+        answers, self._rewind = self._rewind or [], None
+        self.reset_simulation()
+        for answer in answers:
+            answer()
+
+    def _idle(self, should_stop: Callable[[], bool]) -> bool:
+        """Paused: take messages and answer services, sim time standing still, until unpaused, a step or a
+        reset is asked (True), or the run is stopped (False)."""
+        check = time.perf_counter()
+        while self.paused and not self.steps_left and self._rewind is None:
+            self._drain_inbox()
+            self._drain_requests()
+            if self._requests.empty() and self._inbox.empty():
+                time.sleep(0.001)
+            now = time.perf_counter()
+            if now >= check:
+                check = now + 0.05
+                if should_stop():
+                    return False
+        return True
 
     def _bad_controls(self) -> str | None:
         """Controls beyond CTRL_MAX: a NaN or Inf stops the run (the error, naming the actuator, its robot

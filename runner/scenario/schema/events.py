@@ -197,6 +197,14 @@ class Publish(Strict):
     data: dict[str, Any] = Field(default_factory=dict, description="Message fields.")
 
 
+class Call(Strict):
+    service: Topic = Field(
+        description="A service of the world, e.g. `/reset_simulation`, `/world/<world>/control` "
+        "(`scenario validate` lists them). Called once per run: a reset does not make the call again."
+    )
+    data: dict[str, Any] = Field(default_factory=dict, description="The request's fields.")
+
+
 class Teleport(Strict):
     body: str = Field(description="A robot, actor or free world model.")
     pose: Pose = Field(description="Where it is put (its velocity is zeroed).")
@@ -278,6 +286,7 @@ class Action(Strict):
     block: JointRef | None = Field(None, description="Block a joint (a jammed wheel).")
     cut: JointRef | None = Field(None, description="Cut the motor of a joint (it turns freely).")
     end: End | None = Field(None, description="End the run here, judged pass or fail.")
+    call: Call | None = Field(None, description="Call a service of the world (pause, reset...).")
 
     @model_validator(mode="after")
     def _one(self) -> Action:
@@ -289,7 +298,20 @@ class Action(Strict):
         return next(k for k in ACTIONS if getattr(self, k) is not None)
 
 
-ACTIONS = ("publish", "start", "stop", "teleport", "push", "impulse", "set", "fault", "block", "cut", "end")
+ACTIONS = (
+    "publish",
+    "start",
+    "stop",
+    "teleport",
+    "push",
+    "impulse",
+    "set",
+    "fault",
+    "block",
+    "cut",
+    "end",
+    "call",
+)
 
 
 class Event(Strict):

@@ -5,23 +5,52 @@ from __future__ import annotations
 
 from typing import Any, Literal
 
-from pydantic import Field, NonNegativeFloat, PositiveFloat
+from pydantic import Field, NonNegativeFloat, PositiveFloat, model_validator
 
 from runner.scenario.schema.base import TOPIC_RE, Strict
 
 
 class TimelineEntry(Strict):
-    """At sim time `t`, publish a message on a topic of the run."""
+    """At sim time `t`, publish a message on a topic of the run (`topic`, `type`, `data`), or call a
+    service of the world (`call`, `data` the request): `/reset_simulation`, `/world/<world>/control`..."""
 
     t: NonNegativeFloat = Field(description="Sim time in seconds.")
-    topic: str = Field(
+    topic: str | None = Field(
+        None,
         pattern=TOPIC_RE.pattern,
         description="Topic inside the run's key space, e.g. `r1/cmd_vel` (-> `<run>/r1/cmd_vel`).",
     )
-    type: str = Field(description="ROS 2 message type, e.g. `geometry_msgs/msg/Twist`.")
+    call: str | None = Field(
+        None,
+        pattern=TOPIC_RE.pattern,
+        description="Instead of `topic`: a service of the world to call, e.g. `/reset_simulation`, "
+        "`/pause_physics`, `/world/<world>/control` (`scenario validate` lists them); `data` is the "
+        "request, the type is the service's. Answered at that step, recorded as `<service>/_service_event`. "
+        "Made once per run: a `/reset_simulation` replays the topics' entries, not the calls.",
+    )
+    type: str | None = Field(
+        None,
+        description="ROS 2 message type, e.g. `geometry_msgs/msg/Twist` (with `call`: the service's type, "
+        "which may be left out).",
+    )
     data: dict[str, Any] = Field(
         default_factory=dict, description="Message fields as YAML; omitted fields are zero."
     )
+
+    @model_validator(mode="after")
+    def _what(self) -> TimelineEntry:
+        if (self.topic is None) == (self.call is None):
+            raise ValueError(
+                "an entry has a `topic` (a message to publish) or a `call` (a service), one of them"
+            )
+        if self.topic is not None and self.type is None:
+            raise ValueError("a message on a topic needs its `type`, e.g. geometry_msgs/msg/Twist")
+        return self
+
+    @property
+    def name(self) -> str:
+        """The topic, or the service called."""
+        return self.topic if self.topic is not None else str(self.call)
 
 
 class Record(Strict):
