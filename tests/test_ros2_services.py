@@ -5,10 +5,12 @@ One run of the example bench arm with `ros2:` (realtime), a free box on the floo
   of its own) lists the services as `ros2 service list` does, calls the controller manager and the
   simulation's services (gazebo_ros's and ros_gz's names), and sends FollowJointTrajectory and
   GripperCommand goals as rclpy's ActionClient does (feedback, cancel, result, rejection);
-- raw zenoh-python, following rmw_zenoh's design and sources (rmw_zenoh_cpp/src/detail/rmw_client_data.cpp,
-  rmw_service_data.cpp, liveliness_utils.cpp, attachment_helpers.cpp; rolling as of 2025, commit
-  3411fdec of liveliness_utils.cpp): the `SS` tokens field by field, a query with a hand-made attachment
-  and the reply's attachment (the request's sequence number, a fresh source timestamp, the client's GID).
+- raw zenoh-python, following rmw_zenoh's design and sources (ros2/rmw_zenoh, rmw_zenoh_cpp/src/detail/:
+  rmw_service_data.cpp at 028bbe30 and rmw_client_data.cpp at 03470ce8 (queryable `complete`, querier
+  ALL_COMPLETE / consolidation NONE, reply attachment), liveliness_utils.cpp at 3411fdec (token layout),
+  attachment_helpers.cpp (sequence number, source timestamp, GID)): the `SS` tokens field by field, a
+  query with a hand-made attachment and the reply's attachment (the request's sequence number, a fresh
+  source timestamp, the client's GID).
 The recording holds every call as `<service>/_service_event` (who asked: the client's GID).
 """
 
