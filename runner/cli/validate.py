@@ -63,10 +63,10 @@ def validate(
     if any(part.actors or part.events for part in parts):
         out.print(_happenings_table(parts))
     if plan.timeline:
-        out.print(
-            f"timeline: {len(plan.timeline)} message(s) from t={plan.timeline[0].t_ns / 1e9:g} s "
-            f"to t={plan.timeline[-1].t_ns / 1e9:g} s"
-        )
+        calls = sum(1 for e in plan.timeline if e.call)
+        what = f"{len(plan.timeline) - calls} message(s)" + (f", {calls} service call(s)" if calls else "")
+        first, last = plan.timeline[0].t_ns / 1e9, plan.timeline[-1].t_ns / 1e9
+        out.print(f"timeline: {what} from t={first:g} s to t={last:g} s")
     out.print(f"record: {plan.record.path if plan.record.enabled else 'off'}")
     print_notices(plan.notices, verbose=True)
     if strict:
