@@ -129,7 +129,7 @@ SCRIPT: list[dict[str, Any]] = [
     {
         "call": "/world/svc/control",
         "type": "ros_gz_interfaces/srv/ControlWorld",
-        "request": {"world_control": {"multi_step": 25}},
+        "request": {"world_control": {"pause": True, "multi_step": 25}},
     },
     {"call": "/get_entity_state", "type": "gazebo_msgs/srv/GetEntityState", "request": {"name": "crate"}},
     {

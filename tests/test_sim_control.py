@@ -155,15 +155,15 @@ def test_bad_requests_get_false_and_the_world_goes_on(tmp_path: Path, capsys: py
     assert garbage[0][0] is None and "does not decode" in garbage[0][1]
     deleted = _answer(delete_unknown, dl)
     assert not deleted.success and deleted.status_message == "Entity [ghost] does not exist"
-    # steps asked of a running world with `pause: false`: refused, nothing done
-    assert not _answer(step_running, "ros_gz_interfaces/srv/ControlWorld").success
+    # steps asked with `pause: false`: gz-sim runs the world (pause is applied every time) and takes no
+    # steps (SimulationRunner.cc:1444-1451); a running world stays running
+    assert _answer(step_running, "ros_gz_interfaces/srv/ControlWorld").success
     assert not world.paused and world.steps_left == 0
     with pytest.raises(ValueError, match="pause it first"):
         world.step(3)
     assert world.entity_state("crate") == before
     err = capsys.readouterr().err
     assert "entity [ghost] does not exist" in err and "reference entity [nowhere] not found" in err
-    assert "a step is taken only while paused" in err
     stats = world.run()
     assert stats.error is None and stats.sim_ns == world.plan.duration_ns
 
@@ -202,10 +202,15 @@ def test_pause_step_unpause_in_the_running_loop(tmp_path: Path) -> None:
     assert world.now_ns == 25 * step_ns and world.steps_left == 0
     time.sleep(0.05)
     assert world.now_ns == 25 * step_ns and thread.is_alive()
-    # steps asked of a paused world without `pause: true` are steps too: it stays paused
-    more = _call(bus, "g/world/g/control", cw, {"world_control": {"multi_step": 5}})
-    _wait(lambda: bool(more))
-    assert _answer(more, cw).success and world.paused and world.now_ns == 30 * step_ns
+    # `step: true` is one step; `run_to_sim_time` (with `pause: false`) runs on to then and pauses
+    one = _call(bus, "g/world/g/control", cw, {"world_control": {"pause": True, "step": True}})
+    _wait(lambda: bool(one))
+    assert _answer(one, cw).success and world.paused and world.now_ns == 26 * step_ns
+    to = _call(
+        bus, "g/world/g/control", cw, {"world_control": {"run_to_sim_time": {"nanosec": 30 * step_ns}}}
+    )
+    _wait(lambda: bool(to))
+    assert _answer(to, cw).success and world.paused and world.now_ns == 30 * step_ns
     # a reset while paused: time back to 0, the t = 0 sensors published again, still paused
     imu = len(_stamps(bus, "g/bot/imu"))
     reset = _call(bus, "g/reset_simulation", em)

@@ -376,50 +376,44 @@ class Control:
         reply(msgs.T["ros_gz_interfaces/srv/SetEntityPose_Response"](success=ok))
 
     def _srv_control(self, req: Any, reply: Reply) -> None:
-        """ros_gz ControlWorld: `reset.all` is reset_simulation, `reset.model_only` reset_world; then
-        `pause` sets the state (WorldControl has no "as it is": false runs the world); `step` is one step,
-        `multi_step` that many: taken while paused (the world stays paused whatever `pause` says), or with
-        `pause: true`; asked of a running world with `pause: false` the request is refused, nothing done.
-        `time_only`, `seed` and `run_to_sim_time` are refused (success false). (Our mapping: gz-sim's
-        handling was not read for it.)"""
+        """ros_gz ControlWorld, as gz-sim's SimulationRunner takes a WorldControl (gz-sim8
+        src/SimulationRunner.cc:1331-1372 OnWorldControlState, 1433-1466 ProcessWorldControl): `pause` sets
+        the state every time (false runs the world); `multi_step` (or `step`: 1) steps are taken only when
+        the request leaves the world paused, then it stands still again; `reset.all` or `reset.time_only`
+        rewinds (reset_simulation: gz-sim rewinds for both); `run_to_sim_time` runs the world until then and
+        pauses it. Where we differ, on purpose: `reset.model_only` (gz-sim: "not supported", nothing done)
+        is reset_world here; the answer comes once the steps are taken (gz-sim answers at once), so a
+        script that steps and then reads sees the world after the steps. `seed` is said and ignored, as
+        gz-sim does."""
         c = req.world_control
         response = msgs.T["ros_gz_interfaces/srv/ControlWorld_Response"]
-        refused = [
-            what
-            for what, given in (
-                ("reset.time_only", c.reset.time_only),
-                ("seed", c.seed != 0),
-                ("run_to_sim_time", c.run_to_sim_time.sec != 0 or c.run_to_sim_time.nanosec != 0),
-            )
-            if given
-        ]
-        if refused:
-            self._said(f"control: {', '.join(refused)} not supported")
-            reply(response(success=False))
-            return
+        if c.seed != 0:
+            self._said('control: `seed` is not supported (gz-sim: "Changing seed is not supported.")')
+        until_ns = int(c.run_to_sim_time.sec) * 1_000_000_000 + int(c.run_to_sim_time.nanosec)
         steps = c.multi_step or (1 if c.step else 0)
-        if steps and not c.pause and not self.paused:
-            # (steps of a running world, which the request leaves running: refused as a whole)
-            self._said("control: a step is taken only while paused: send `pause: true` with `multi_step`")
-            reply(response(success=False))
-            return
-        if c.reset.model_only and not c.reset.all:
+        if c.reset.model_only and not (c.reset.all or c.reset.time_only):
             self.reset_world()
-        if c.pause or steps:  # (a step request keeps a paused world paused, whatever its `pause` says)
+        if c.pause:
             self.pause()
         else:
             self.unpause()
 
         def answer() -> None:
-            if steps:
-                self.step(steps)
-                # answered once the steps are taken (at the boundary they end at, its sensors published):
-                # a script that steps and then reads sees the world after the steps
+            taken = 0
+            if c.pause and steps:
+                taken = steps
+            elif not c.pause and until_ns > self.now_ns:
+                # run until then and pause (as a paused world stepped to that time)
+                self.pause()
+                taken = math.ceil((until_ns - self.now_ns) / self.step_ns)
+            if taken:
+                self.step(taken)
+                # answered once the steps are taken (at the boundary they end at, its sensors published)
                 self._stepped.append(lambda: reply(response(success=True)))
             else:
                 reply(response(success=True))
 
-        if c.reset.all:  # the reset first (at the end of this step), then any steps from t = 0
+        if c.reset.all or c.reset.time_only:  # the rewind first (at the end of this step), then the rest
             self._rewind = [*(self._rewind or []), answer]
             return
         answer()
