@@ -258,10 +258,23 @@ def _check_field(desc: tuple[Any, Any], value: Any, path: tuple[str | int, ...])
         _field_value(desc, value, path)
 
 
+_EMPTY_MEMBER = "structure_needs_at_least_one_member"
+
+
+def _field_names(msg: Any) -> list[str]:
+    """A message's fields (not its constants, which rosbags' classes also carry as attributes)."""
+    defs = TYPESTORE.fielddefs.get(getattr(msg, "__msgtype__", ""))
+    if defs is None:
+        return [k for k in msg.__dataclass_fields__ if k != "__msgtype__"]
+    return [name for name, _desc in defs[1]]
+
+
 def to_data(msg: Any) -> Any:
-    """A message as plain data (for printing and tests)."""
+    """A message as plain data (for printing and tests): its fields, without its constants (class
+    variables, as `ros2 topic echo` leaves them out) or the member rosidl adds to an empty message."""
     if hasattr(msg, "__dataclass_fields__"):
-        return {k: to_data(getattr(msg, k)) for k in msg.__dataclass_fields__ if k != "__msgtype__"}
+        names = _field_names(msg)
+        return {k: to_data(getattr(msg, k)) for k in names if k != _EMPTY_MEMBER}
     if isinstance(msg, np.ndarray):
         return msg.tolist()
     if isinstance(msg, list):
