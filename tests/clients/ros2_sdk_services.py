@@ -35,25 +35,8 @@ import uuid
 from pathlib import Path
 from typing import Any
 
-LOOPBACK_ONLY = (
-    'listen/endpoints=["tcp/127.0.0.1:0"];scouting/multicast/enabled=false;scouting/gossip/enabled=false'
-)
-
-
-def _field_type(node: tuple[Any, Any]) -> tuple[str, list[str]]:
-    from rosbags.typesys.base import Nodetype
-
-    kind, detail = node
-    if kind == Nodetype.BASE:
-        name, bound = detail
-        return (f"{name}<={bound}" if bound else name), []
-    if kind == Nodetype.NAME:
-        return detail, [detail]
-    inner, length = detail
-    text, refs = _field_type(inner)
-    if kind == Nodetype.ARRAY:
-        return f"{text}[{length}]", refs
-    return (f"{text}[<={length}]" if length else f"{text}[]"), refs
+# (run as a script: this folder is on sys.path; the first client's loopback settings and .msg spelling)
+from ros2_sdk_client import LOOPBACK_ONLY, _field_type
 
 
 def definition(name: str) -> tuple[str, list[str]]:
