@@ -157,12 +157,12 @@ class Bridge:
         self._lock = threading.Lock()
         for p in plans:
             self._add(p)
-        self._served: set[tuple[str, str]] = set()
+        self._served: set[str] = set()  # the sim keys of the services offered or waiting to be
         # a service is offered to ROS 2 once the world answers it (its graph token, declared after its
         # queryable): a client that finds the SS token and calls at once is answered, not left waiting
         self._pending: dict[str, ServiceBridgePlan] = {}
         for sp in services:
-            self._served.add((sp.sim_key, "srv"))
+            self._served.add(sp.sim_key)
             self._pending[sp.sim_key] = sp
         if self._pending:
             key = meta_key(run, "graph", "**")
@@ -220,8 +220,8 @@ class Bridge:
                             ros2=ros,
                         )
                         with self._lock, contextlib.suppress(Exception):
-                            if (e.key, "srv") not in self._served:
-                                self._served.add((e.key, "srv"))
+                            if e.key not in self._served:
+                                self._served.add(e.key)
                                 self._serve_ros(sp)
                     continue
                 if e.kind not in ("pub", "sub"):
