@@ -60,6 +60,12 @@ class _Request:
     respond: Respond
     local: Callable[[Any], None] | None = field(default=None)  # an in-process caller's callback
 
+    def fail(self, why: str) -> None:
+        """An error reply (an in-process caller gets None)."""
+        self.respond(None, why)
+        if self.local is not None:
+            self.local(None)
+
 
 class Services:
     """The world's services and the queue of requests waiting for a boundary. `World.__init__` calls
@@ -125,20 +131,20 @@ class Services:
     def _answer(self, req: _Request) -> None:
         service = self._services.get(req.key)
         if service is None:
-            req.respond(None, f"no service on {req.key}")
+            req.fail(f"no service on {req.key}")
             return
         st = service.type
         if len(req.payload) > MAX_INBOUND_BYTES:
-            req.respond(None, f"a request of {len(req.payload):,} bytes, {too_large(MAX_INBOUND_BYTES)}")
+            req.fail(f"a request of {len(req.payload):,} bytes, {too_large(MAX_INBOUND_BYTES)}")
             return
         try:
             request = msgs.decode(req.payload, st.request)
         except Exception as e:
-            req.respond(None, f"the request does not decode as {st.request}: {e}")
+            req.fail(f"the request does not decode as {st.request}: {e}")
             return
         where = msgs.nonfinite(request, st.request)
         if where is not None:
-            req.respond(None, f"{msgs.path_text(where)} is not a finite number")
+            req.fail(f"{msgs.path_text(where)} is not a finite number")
             return
         att = unpack_ros_attachment(req.attachment)
         seq, gid = (att[0], att[2]) if att is not None else (0, bytes(16))
@@ -154,9 +160,7 @@ class Services:
                 payload = msgs.encode(response, st.response)
             except Exception as e:
                 self._failed(service, f"its response does not encode as {st.response}: {e}")
-                req.respond(None, f"the service's response is not a {st.response}")
-                if req.local is not None:
-                    req.local(None)
+                req.fail(f"the service's response is not a {st.response}")
                 return
             self._event(service, RESPONSE_SENT, seq, gid, response=response)
             req.respond(payload, None)
@@ -169,9 +173,7 @@ class Services:
             self._failed(service, f"{type(e).__name__}: {e}")
             if not done["replied"]:
                 done["replied"] = True
-                req.respond(None, f"the service failed: {type(e).__name__}: {e}")
-                if req.local is not None:
-                    req.local(None)
+                req.fail(f"the service failed: {type(e).__name__}: {e}")
 
     def _failed(self, service: _Service, why: str) -> None:
         if not service.failed:
