@@ -169,7 +169,11 @@ class GraphTokens:
         self._declare(f"{self.base}/srv/{_q(key)}/{_q(type_name or '-')}")
 
     def withdraw_subscriber(self, key: str, type_name: str | None = None) -> None:
-        token = self._tokens.pop(f"{self.base}/sub/{_q(key)}/{_q(type_name or '-')}", None)
+        self.withdraw("sub", key, type_name)
+
+    def withdraw(self, kind: str, key: str, type_name: str | None = None) -> None:
+        """The token of an endpoint (`pub`, `sub`, `srv`) that is no more."""
+        token = self._tokens.pop(f"{self.base}/{kind}/{_q(key)}/{_q(type_name or '-')}", None)
         if token is not None:
             with contextlib.suppress(Exception):
                 token.undeclare()

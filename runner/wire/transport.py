@@ -248,7 +248,25 @@ class ZenohBus:
         self.best_effort = [zenoh.KeyExpr(e) for e in best_effort]
         self._keep: list[Any] = []
         self._pubs: list[Any] = []
+        self._of_key: dict[str, list[tuple[str, Any, str | None]]] = {}  # key -> (kind, entity, type)
         self.shm = SharedMemorySender()
+
+    def _held(self, kind: str, key: str, entity: Any, type_name: str | None) -> None:
+        self._keep.append(entity)
+        self._of_key.setdefault(key, []).append((kind, entity, type_name))
+
+    def withdraw(self, key: str) -> None:
+        """Everything declared on `key` (publisher, subscriber, queryable) undeclared, and its graph tokens
+        withdrawn: a deleted robot's topics and services go away, as its plugins do."""
+        for kind, entity, type_name in self._of_key.pop(key, []):
+            with contextlib.suppress(Exception):
+                entity.undeclare()
+            with contextlib.suppress(ValueError):
+                self._keep.remove(entity)
+            if entity in self._pubs:
+                self._pubs.remove(entity)
+            if self.graph is not None:
+                self.graph.withdraw(kind, key, type_name)
 
     def publisher(self, key: str, type_name: str) -> Callable[[bytes | bytearray, bytes], None]:
         if self.graph is not None:
@@ -262,7 +280,7 @@ class ZenohBus:
             congestion_control=zenoh.CongestionControl.DROP if drop else zenoh.CongestionControl.BLOCK,
             reliability=zenoh.Reliability.BEST_EFFORT if drop else zenoh.Reliability.RELIABLE,
         )
-        self._keep.append(pub)
+        self._held("pub", key, pub, type_name)
         self._pubs.append(pub)
 
         shm = self.shm
@@ -293,9 +311,8 @@ class ZenohBus:
             callback(str(sample.key_expr), sample.payload.to_bytes(), att.to_bytes() if att else None)
 
         # REMOTE only: what this process publishes is delivered to its own plugins directly, in order.
-        self._keep.append(
-            self.session.declare_subscriber(key, on_sample, allowed_origin=zenoh.Locality.REMOTE)
-        )
+        sub = self.session.declare_subscriber(key, on_sample, allowed_origin=zenoh.Locality.REMOTE)
+        self._held("sub", key, sub, type_name)
 
     def queryable(self, key: str, on_request: OnRequest, type_name: str) -> None:
         """A service on `key` (a Zenoh queryable): each query's payload and attachment go to `on_request`
@@ -329,7 +346,7 @@ class ZenohBus:
             payload = query.payload.to_bytes() if query.payload is not None else b""
             on_request(payload, att.to_bytes() if att else None, respond)
 
-        self._keep.append(self.session.declare_queryable(key, on_query, complete=True))
+        self._held("srv", key, self.session.declare_queryable(key, on_query, complete=True), type_name)
         if self.graph is not None:
             # announced once it answers: the bridge offers it to ROS 2 when it sees this token
             self.graph.service(key, type_name)
