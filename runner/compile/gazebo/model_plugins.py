@@ -9,11 +9,11 @@ from __future__ import annotations
 import re
 from typing import Any
 
-from runner.compile.gazebo import thirdparty
+from runner.compile.gazebo import catalogue, thirdparty
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.control.drives import by_wheels
 from runner.compile.gazebo.controllers import ros_control
-from runner.compile.gazebo.tables import IGNORED_REASONS, NOOP_PLUGINS, PLUGIN_PARAMS
+from runner.compile.gazebo.tables import IGNORED_REASONS, NOOP_PLUGINS
 from runner.compile.gazebo.tags import TagReader, floats, plugin_base, ros_topic
 
 
@@ -46,10 +46,14 @@ def read_model_plugin(g: ReaderBase, p: Any, link: str | None) -> None:
     if result is not None:
         type_name, params = result
         g.add(p, type_name, name, params)
-    known = PLUGIN_PARAMS.get(base)
-    if known is not None:
+    doc = catalogue.entry(base)
+    if doc is not None:  # its parameters, from the catalogue: the rest are typos or leftovers
+        known, ignored = doc.names(), doc.ignored()
         for el in r.leftovers():
-            if el.tag not in known and el.tag not in IGNORED_REASONS:
+            if el.tag in ignored:
+                r.mark(el.tag)
+                g.note(el, f"<{el.tag}> in {context} is ignored ({ignored[el.tag]})")
+            elif el.tag not in known and el.tag not in IGNORED_REASONS:
                 r.mark(el.tag)
                 g.note(el, f"<{el.tag}> is not a parameter of {filename!r}: Gazebo ignores it too")
     g.ignored(r, context)
