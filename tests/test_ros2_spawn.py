@@ -68,7 +68,9 @@ def _script() -> list[dict[str, Any]]:
         {
             "call": "/world/sp/create",
             "type": "ros_gz_interfaces/srv/SpawnEntity",
-            "request": {"entity_factory": {"name": "r9", "sdf": diffbot(), "pose": {"position": {"x": -1.0}}}},
+            "request": {
+                "entity_factory": {"name": "r9", "sdf": diffbot(), "pose": {"position": {"x": -1.0}}}
+            },
         },
         {"topics": True, "wait_for": ["/r9/odom"]},
         {"echo": "/r9/odom", "type": ODOM},

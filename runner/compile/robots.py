@@ -218,6 +218,7 @@ def robot_model(
                 notices=notices,
                 sources=result.sources,
                 expanded=True,
+                origins=result.origins,
                 timestep=timestep,
                 controllers=controllers,
                 spawn=spawn,

@@ -58,14 +58,16 @@ def urdf_to_model(
     notices: Notices | None = None,
     sources: list[Path] | None = None,
     expanded: bool = False,
+    origins: list[tuple[Path, int] | None] | None = None,
     timestep: float = 0.002,
     controllers: list[Path] | None = None,
     spawn: Spawn | None = None,
 ) -> RobotModel:
     notices = notices if notices is not None else Notices()
     base_dir = file.parent if file else Path.cwd()
-    where = Locator(file, sources or ([file] if file else []), expanded)
+    where = Locator(file, sources or ([file] if file else []), expanded, origins)
     root = _parse(urdf, file, expanded, where)
+    where.bind(root)
     root_link = check_structure(root, where)
     check_numbers(root, where)
     adjusted: list[ParityLine] = []
@@ -89,6 +91,7 @@ def urdf_to_model(
         notices=notices,
         controllers=controllers,
         spawn=spawn,
+        where=where,
     )
     transmissions = read_transmissions(root, where, notices, controllers)
     vlimits = velocity_limits(root)
