@@ -160,3 +160,20 @@ def test_the_ledger_knows_every_element_it_walks() -> None:
         return 1 + sum(walk(c) for c in children.values())
 
     assert walk(READ["robot"]) > 20
+
+
+def test_a_descriptions_own_mujoco_block_is_kept_and_its_memory_reaches_the_world(tmp_path: Path) -> None:
+    from tests.helpers import compile_with_notices, robot_scenario
+
+    urdf = (
+        '<robot name="m"><mujoco><size memory="64M"/><option timestep="0.01"/>'
+        '<compiler discardvisual="true"/></mujoco>'
+        '<link name="a"><inertial><mass value="1"/>'
+        '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'
+        '<visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual></link></robot>'
+    )
+    plan, notices = compile_with_notices(robot_scenario(tmp_path, urdf))
+    m = mujoco.MjModel.from_xml_string(plan.mjcf)
+    assert m.narena >= 64 << 20
+    assert m.ngeom >= 1  # the visual kept, whatever the block's compiler says (said)
+    assert "discardvisual" in notices and "<mujoco><option> is not used" in notices

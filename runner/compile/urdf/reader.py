@@ -174,6 +174,12 @@ def _load(root: Any, where: Any, file: Path | None, shell: set[str], notices: No
     mj = blocks[0] if blocks else etree.Element("mujoco")
     if blocks:
         root.remove(mj)
+    for option in mj.findall("option"):
+        notices.add(
+            "the description's <mujoco><option> is not used: the world's physics are the scenario's "
+            "(`world.physics`), one for every robot",
+            *where(option),
+        )
     compiler = mj.find("compiler")
     if compiler is None:
         compiler = etree.SubElement(mj, "compiler")
