@@ -1,0 +1,75 @@
+"""The bridge's side on ROS 2: its node and publishers as rmw_zenoh announces and numbers them
+(`runner.wire.ros2`)."""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Any
+
+import zenoh
+
+from runner.plan import Ros2Plan
+from runner.wire import msgs, ros2
+
+TF = "tf2_msgs/msg/TFMessage"
+
+
+class RosNode:
+    """One ROS 2 node as rmw_zenoh announces it: its token, and ids for its entities."""
+
+    def __init__(self, session: zenoh.Session, plan: Ros2Plan, node_id: int):
+        self.session = session
+        self.plan = plan
+        self.zid = str(session.zid())
+        self.node_id = node_id
+        self.next_id = node_id + 1
+        self.token = session.liveliness().declare_token(
+            ros2.node_token(plan.domain, self.zid, node_id, "/", plan.node)
+        )
+
+    def entity(self, kind: str, topic: str, type_name: str, qos: ros2.Qos) -> tuple[Any, bytes]:
+        """A publisher ("MP"), subscription ("MS") or service server ("SS") token; returns it and the
+        entity's GID."""
+        key = ros2.entity_token(
+            self.plan.domain,
+            self.zid,
+            self.node_id,
+            self.next_id,
+            kind,
+            "/",
+            self.plan.node,
+            topic,
+            type_name,
+            qos,
+        )
+        self.next_id += 1
+        return self.session.liveliness().declare_token(key), ros2.gid(key)
+
+
+class RosOut:
+    """One ROS 2 publisher of the bridge's node: every mapping to its topic goes out through it (one
+    entity per topic, as a node has), numbered in one sequence. On a TRANSIENT_LOCAL TFMessage topic
+    (`/tf_static`), what it sends is the whole static tree received so far, each frame's latest transform,
+    as tf2_ros' StaticTransformBroadcaster does: the one message a late subscriber gets from the cache
+    holds every frame, whichever robot or world sent it."""
+
+    def __init__(self, key: str, type_name: str, pub: Any, token: Any, gid: bytes, merge_tf: bool):
+        self.key = key
+        self.type = type_name
+        self.pub = pub
+        self.token = token  # its rmw_zenoh `MP` liveliness token
+        self.gid = gid
+        self.seq = 0
+        self.users = 0  # mappings sending through it (robots' `tf` on `/tf`): it goes with the last
+        self.lock = threading.Lock()
+        self.tree: dict[str, Any] | None = {} if merge_tf else None
+
+    def put(self, payload: bytes) -> None:
+        with self.lock:
+            if self.tree is not None:
+                for t in msgs.decode(payload, TF).transforms:
+                    self.tree[t.child_frame_id] = t
+                payload = msgs.encode(msgs.T[TF](transforms=list(self.tree.values())), TF)
+            self.seq += 1  # rmw_zenoh numbers each publisher's messages from 1
+            self.pub.put(payload, attachment=ros2.pack_attachment(self.seq, time.time_ns(), self.gid))
