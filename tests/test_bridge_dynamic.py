@@ -361,15 +361,20 @@ def test_tf_stays_while_any_spawned_robot_feeds_it(rig: Rig) -> None:
 
 
 @pytest.mark.timeout(120)
-def test_a_node_that_stops_takes_its_ros2_side_with_it(rig: Rig) -> None:
-    """A node's topics and services (mirrored as the node starts) go when it withdraws them or ends."""
+@pytest.mark.parametrize(("process", "role"), [("reporter", "node"), ("world-renderer", "renderer")])
+def test_a_node_or_renderer_that_stops_takes_its_ros2_side_with_it(rig: Rig, process: str, role: str) -> None:
+    """A node's topics and services (mirrored as the node starts), or a renderer's (a spawned robot's
+    camera images), go when it withdraws them or ends."""
     view = rig.view
     session = rig.world.session
-    node = ZenohBus(session, GraphTokens(session, RUN, "reporter", "node"))
-    node.publisher(f"{RUN}/r1/status", "std_msgs/msg/String")
-    node.queryable(f"{RUN}/r1/ping", lambda _p, _a, respond: respond(b"", None), "std_srvs/srv/Empty")
-    mine = {("MP", "/r1/status", _dds("std_msgs/msg/String")), ("SS", "/r1/ping", _dds("std_srvs/srv/Empty"))}
-    view.wait(lambda ents: mine <= set(ents), "the node's endpoints")
+    node = ZenohBus(session, GraphTokens(session, RUN, process, role))
+    node.publisher(f"{RUN}/r9/camera/image_raw", "sensor_msgs/msg/Image")
+    node.queryable(f"{RUN}/r9/ping", lambda _p, _a, respond: respond(b"", None), "std_srvs/srv/Empty")
+    mine = {
+        ("MP", "/r9/camera/image_raw", _dds("sensor_msgs/msg/Image")),
+        ("SS", "/r9/ping", _dds("std_srvs/srv/Empty")),
+    }
+    view.wait(lambda ents: set(ents) >= mine, f"the {role}'s endpoints")
     node.undeclare_all()
-    view.wait(lambda ents: not (mine & set(ents)), "the node stopped")
+    view.wait(lambda ents: not (mine & set(ents)), f"the {role} stopped")
     assert ("MP", "/r1/odom", _dds(ODOM)) in view.entities()  # the plan's mappings stay

@@ -113,7 +113,8 @@ class Bridge:
         self._lock = threading.Lock()
         for p in plans:
             self._add(p)
-        # the sim keys the plan mirrors to ROS 2: a world's endpoint on one of them is the plan's to map
+        # the sim keys the plan mirrors to ROS 2: a world's (or its renderer's) endpoint on one of them is
+        # the plan's to map
         self._planned = {p.sim_key for p in plans if p.ros2 is not None}
         self._served: set[str] = set()  # the sim keys of the services offered or waiting to be
         # a service is offered to ROS 2 once the world answers it (its graph token, declared after its
@@ -170,7 +171,7 @@ class Bridge:
                 self.complain(sp.where, f"could not offer the service: {err}")
             return
         plans = topic_plans(e, role, self.run, ros)
-        if not plans or (role == "world" and e.key in self._planned):
+        if not plans or (role != "node" and e.key in self._planned):
             return  # (a world's topic the plan mirrors since the start, as it says)
         self._holders.hold(e)
         for p in plans:

@@ -14,8 +14,9 @@ from runner.wire.graph import Endpoint, Graph
 from runner.wire.transport import hidden_topic
 
 TF = "tf2_msgs/msg/TFMessage"
-# the processes whose endpoints are followed as they come and go
-MIRRORED_ROLES = ("world", "node")
+# the processes whose endpoints are followed as they come and go (a renderer process publishes the
+# cameras' images of its world)
+MIRRORED_ROLES = ("world", "renderer", "node")
 # an action's topics and services are under `<name>/_action/`: hidden, as ROS 2 hides them from `ros2 topic
 # list`, but its clients use them (`mirror_all`'s `action_topics`, `mirror_services`' `action_parts`)
 ACTION_TOPICS = tuple("/" + suffix for suffix, _t in interfaces.ACTION_TOPICS)
