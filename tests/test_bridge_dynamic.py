@@ -25,7 +25,7 @@ import pytest
 import zenoh
 
 from runner.plan import BridgePlan, Ros2Plan
-from runner.wire import msgs, ros2
+from runner.wire import interfaces, msgs, ros2
 from runner.wire.graph import GraphTokens
 from runner.wire.transport import ZenohBus, free_port, make_config, meta_key, pack_attachment
 
@@ -35,6 +35,8 @@ ODOM = "nav_msgs/msg/Odometry"
 TWIST = "geometry_msgs/msg/Twist"
 TF = "tf2_msgs/msg/TFMessage"
 TRIGGER = "std_srvs/srv/Trigger"
+FJT = "control_msgs/action/FollowJointTrajectory"
+ACTION = "arm_controller/follow_joint_trajectory"
 WAIT_S = 20.0
 ROS = Ros2Plan(domain=DOMAIN, node=RUN)
 
@@ -148,6 +150,14 @@ class Robot:
             respond(msgs.encode(res, f"{TRIGGER}_Response"), None)
 
         bus.queryable(self.keys["do_it"], answer, TRIGGER)
+        # an action server, as runner.plugin.actions declares one: three services and two topics
+        services, topics = interfaces.action_parts(FJT)
+        for suffix, type_name in topics:
+            self.keys[suffix] = f"{RUN}/{ns}/{ACTION}/{suffix}"
+            bus.publisher(self.keys[suffix], type_name)
+        for suffix, type_name in services:
+            self.keys[suffix] = f"{RUN}/{ns}/{ACTION}/{suffix}"
+            bus.queryable(self.keys[suffix], lambda _p, _a, respond: respond(None, "not here"), type_name)
 
     def delete(self) -> None:
         for key in self.keys.values():
@@ -229,6 +239,8 @@ R9 = {
     ("MS", "/r9/cmd_vel", _dds(TWIST)),
     ("MP", "/r9/tf", _dds(TF)),
     ("SS", "/r9/do_it", _dds(TRIGGER)),
+    *(("SS", f"/r9/{ACTION}/{suffix}", _dds(t)) for suffix, t in interfaces.action_parts(FJT)[0]),
+    *(("MP", f"/r9/{ACTION}/{suffix}", _dds(t)) for suffix, t in interfaces.action_parts(FJT)[1]),
 }
 
 
@@ -329,7 +341,7 @@ def test_a_robot_spawned_mid_run_appears_to_ros2_goes_when_deleted_and_comes_bac
         ents = view.entities()
         assert ents.count(("MP", "/r1/odom", _dds(ODOM))) == 1
         assert ents.count(("MP", "/tf", _dds(TF))) == 1
-        for topic in ("/r9/odom", "/r9/cmd_vel", "/r9/tf", "/r9/do_it"):
+        for _kind, topic, _dds_type in R9:
             assert len([e for e in ents if e[1] == topic]) == 1, (topic, ents)
         _check_r9_works(rig, robot, 0.5 + attempt)
         robot.delete()
