@@ -24,10 +24,21 @@ from typing import Any
 import pytest
 import zenoh
 
-from runner.plan import BridgePlan, Ros2Plan
+from runner.compile.plugins import action_topics
+from runner.launch.bridge_follow import service_plan, topic_plans
+from runner.plan import BridgePlan, Ros2Plan, TopicPlan
 from runner.wire import interfaces, msgs, ros2
-from runner.wire.graph import GraphTokens
-from runner.wire.transport import ZenohBus, free_port, make_config, meta_key, pack_attachment
+from runner.wire.graph import Endpoint, GraphTokens
+from runner.wire.transport import (
+    ZenohBus,
+    free_port,
+    make_config,
+    meta_key,
+    pack_attachment,
+    topic_key,
+)
+from tests.conftest import SCENARIOS
+from tests.helpers import plan_of
 
 RUN = "dyn"
 DOMAIN = 21
@@ -390,3 +401,64 @@ def test_a_node_or_renderer_that_stops_takes_its_ros2_side_with_it(rig: Rig, pro
     node.undeclare_all()
     view.wait(lambda ents: not (mine & set(ents)), f"the {role} stopped")
     assert ("MP", "/r1/odom", _dds(ODOM)) in view.entities()  # the plan's mappings stay
+
+
+SPAWNABLE = """
+name: same
+duration: 5
+worlds:
+  - name: a
+  - name: b
+robots:
+  - name: r1
+    world: a
+    description: "{diffbot}"
+    pose: {xyz: [0, 0, 0.06]}
+    plugins: [{type: diff_drive}, {type: lidar, params: {link: lidar_link, samples: 8, rate: 10}}]
+  - name: arm
+    world: b
+    description: ARM
+    controllers: [CONTROLLERS]
+ros2: {domain: 4}
+"""
+
+
+def test_what_appears_mid_run_is_mirrored_as_the_plan_mirrors_it_from_the_start(write_scenario) -> None:
+    """Each world endpoint, had it appeared mid-run, maps to what `mirror_all` and `mirror_services` make of
+    it at compile time: the same ROS 2 names and directions, a robot's `tf` on `/tf` too, an action's hidden
+    parts, services named under their own world (two worlds here)."""
+    robot = SCENARIOS / "robots" / "bench_arm"
+    text = SPAWNABLE.replace("ARM", str(robot / "urdf" / "bench_arm.urdf"))
+    plan = plan_of(write_scenario(text.replace("CONTROLLERS", str(robot / "config" / "controllers.yaml"))))
+    assert plan.ros2 is not None
+    parts = [part.name for part in plan.parts()]
+    planned = set()
+    for b in plan.bridges:
+        for d in ("SIM_TO_ZENOH", "ZENOH_TO_SIM"):
+            if b.direction in (d, "BIDIRECTIONAL"):
+                planned.add((b.sim_key, b.ros_topic, d))
+    followed = set()
+    for part in plan.parts():
+        # what the world publishes: its plugins' topics, its actions', and the scene's for viewers
+        scene = [TopicPlan(key=f"{part.name}/{n}", type=TF) for n in ("tf", "tf_static")]
+        scene += [
+            TopicPlan(key=topic_key(part.name, r.namespace, "robot_description"), type="std_msgs/msg/String")
+            for r in part.robots
+            if r.urdf
+        ]
+        assert part.foxglove.scene
+        for t in [*part.topics(), *action_topics(part.services()), *scene]:
+            e = Endpoint("a" if part.name.endswith("/a") else "b", t.direction, t.key, t.type)
+            followed |= {
+                (b.sim_key, b.ros_topic, b.direction) for b in topic_plans(e, "world", plan.name, plan.ros2)
+            }
+    assert followed == planned
+    assert ("same/a/r1/tf", "/tf", "SIM_TO_ZENOH") in followed
+    services = {(s.sim_key, s.type, s.ros_name) for s in plan.service_bridges}
+    assert any("/_action/send_goal" in name for _k, _t, name in services)
+    offered = set()
+    for key, type_name, _name in services:
+        sp = service_plan(Endpoint("b", "srv", key, type_name), "world", plan.name, parts, plan.ros2)
+        assert sp is not None, key
+        offered.add((sp.sim_key, sp.type, sp.ros_name))
+    assert offered == services
