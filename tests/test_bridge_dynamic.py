@@ -23,6 +23,7 @@ from typing import Any
 
 import pytest
 import zenoh
+import zenoh.ext
 
 from runner.compile.plugins import action_topics
 from runner.launch.bridge_follow import service_plan, topic_plans
@@ -149,10 +150,11 @@ class Robot:
 
     def __init__(self, bus: ZenohBus, ns: str):
         self.bus = bus
-        self.keys = {n: f"{RUN}/{ns}/{n}" for n in ("odom", "cmd_vel", "tf", "do_it")}
+        self.keys = {n: f"{RUN}/{ns}/{n}" for n in ("odom", "cmd_vel", "tf", "tf_static", "do_it")}
         self.commands = Inbox()
         self.odom = bus.publisher(self.keys["odom"], ODOM)
         self.tf = bus.publisher(self.keys["tf"], TF)
+        self.tf_static = bus.publisher(self.keys["tf_static"], TF)
         bus.subscribe(self.keys["cmd_vel"], lambda _k, p, a: self.commands.put(p, a), TWIST)
 
         def answer(payload: bytes, _att: bytes | None, respond: Any) -> None:
@@ -249,6 +251,7 @@ R9 = {
     ("MP", "/r9/odom", _dds(ODOM)),
     ("MS", "/r9/cmd_vel", _dds(TWIST)),
     ("MP", "/r9/tf", _dds(TF)),
+    ("MP", "/r9/tf_static", _dds(TF)),
     ("SS", "/r9/do_it", _dds(TRIGGER)),
     *(("SS", f"/r9/{ACTION}/{suffix}", _dds(t)) for suffix, t in interfaces.action_parts(FJT)[0]),
     *(("MP", f"/r9/{ACTION}/{suffix}", _dds(t)) for suffix, t in interfaces.action_parts(FJT)[1]),
@@ -360,15 +363,53 @@ def test_a_robot_spawned_mid_run_appears_to_ros2_goes_when_deleted_and_comes_bac
     del r1_odom
 
 
+def _late_static_tree(ros: zenoh.Session, expected: set[str]) -> set[str]:
+    """The frames a late TRANSIENT_LOCAL subscriber to `/tf_static` gets (tf2's static listener, RViz
+    started now): what the publisher's cache holds, queried as rmw_zenoh's advanced subscriber does; asked
+    again until it is `expected` (the cache is refreshed as the bridge hears of a change)."""
+    deadline = time.monotonic() + WAIT_S
+    frames: set[str] = set()
+    while time.monotonic() < deadline:
+        got = Inbox()
+        sub = zenoh.ext.declare_advanced_subscriber(
+            ros,
+            ros2.topic_key(DOMAIN, "/tf_static", TF),
+            got,
+            history=zenoh.ext.HistoryConfig(detect_late_publishers=True, max_samples=1),
+        )
+        try:
+            assert got.wait_until(bool, WAIT_S), "nothing from the /tf_static cache"
+            frames = _children(got.got[-1][0])
+        finally:
+            sub.undeclare()
+        if frames == expected:
+            break
+    return frames
+
+
 @pytest.mark.timeout(120)
 def test_tf_stays_while_any_spawned_robot_feeds_it(rig: Rig) -> None:
-    """`/tf` is one publisher for every robot's `tf` (and the plan's r1): it stays while one is left."""
+    """`/tf` and `/tf_static` are one publisher each for every robot (and the plan's r1 on `/tf`): they
+    stay while one is left; a deleted robot's frames leave the static tree a late subscriber gets."""
     view, ros = rig.view, rig.ros
     r8, r9 = Robot(rig.world, "r8"), Robot(rig.world, "r9")
-    view.wait(lambda ents: {("MP", "/r8/tf", _dds(TF)), ("MP", "/r9/tf", _dds(TF))} <= set(ents), "spawned")
+    both = {("MP", f"/{ns}/{n}", _dds(TF)) for ns in ("r8", "r9") for n in ("tf", "tf_static")}
+    view.wait(lambda ents: set(ents) >= both, "spawned")
+    static = Inbox()
+    sub = ros.declare_subscriber(ros2.topic_key(DOMAIN, "/tf_static", TF), static)
+    for robot, frame in ((r8, "r8/base_link"), (r9, "r9/base_link")):
+        _keep_sending(
+            lambda robot=robot, frame=frame: robot.tf_static(_tf(frame), pack_attachment(0, 0)),
+            static,
+            lambda got, frame=frame: any(frame in _children(p) for p, _a in got),
+            f"{frame} on /tf_static",
+        )
+    sub.undeclare()
+    assert _late_static_tree(ros, {"r8/base_link", "r9/base_link"}) == {"r8/base_link", "r9/base_link"}
     r9.delete()
     view.wait(lambda ents: not any(t and t.startswith("/r9/") for _k, t, _d in ents), "r9 withdrawn")
-    assert ("MP", "/tf", _dds(TF)) in view.entities()
+    assert {("MP", "/tf", _dds(TF)), ("MP", "/tf_static", _dds(TF))} <= set(view.entities())
+    assert _late_static_tree(ros, {"r8/base_link"}) == {"r8/base_link"}
     tf = Inbox()
     sub = ros.declare_subscriber(ros2.topic_key(DOMAIN, "/tf", TF), tf)
     _keep_sending(
@@ -381,6 +422,7 @@ def test_tf_stays_while_any_spawned_robot_feeds_it(rig: Rig) -> None:
     r8.delete()
     view.wait(lambda ents: not any(t and t.startswith("/r8/") for _k, t, _d in ents), "r8 withdrawn")
     assert ("MP", "/tf", _dds(TF)) in view.entities()  # the plan's r1 still feeds it
+    assert ("MP", "/tf_static", _dds(TF)) not in view.entities()  # nothing does
 
 
 @pytest.mark.timeout(120)

@@ -255,11 +255,13 @@ class Bridge:
         if out is None:
             out = self._new_ros_out(p)
         out.users += 1
-        keep.append(_Undeclare(lambda: self._release(out)))
+        keep.append(_Undeclare(lambda: self._release(out, p.sim_key)))
         return out
 
-    def _release(self, out: RosOut) -> None:
+    def _release(self, out: RosOut, source: str) -> None:
         out.users -= 1
+        with contextlib.suppress(Exception):  # (the session closing as the run ends)
+            out.forget(source)
         if out.users > 0 or self._ros_outs.get(out.key) is not out:
             return
         del self._ros_outs[out.key]
@@ -323,7 +325,7 @@ class Bridge:
                 payload = json.dumps(data, default=_json_default, separators=(",", ":")).encode()
             if ros_out is not None:
                 try:
-                    ros_out.put(payload)
+                    ros_out.put(payload, p.sim_key)
                 except Exception as e:  # (a TFMessage that does not decode, on a merged topic)
                     self.complain(p.where, f"a message on {p.sim_key} does not decode as {type_name}: {e}")
                     return

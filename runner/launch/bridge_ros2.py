@@ -52,7 +52,8 @@ class RosOut:
     entity per topic, as a node has), numbered in one sequence. On a TRANSIENT_LOCAL TFMessage topic
     (`/tf_static`), what it sends is the whole static tree received so far, each frame's latest transform,
     as tf2_ros' StaticTransformBroadcaster does: the one message a late subscriber gets from the cache
-    holds every frame, whichever robot or world sent it."""
+    holds every frame, whichever robot or world sent it; a sim key that no longer feeds it (a robot
+    deleted) takes its frames out of it."""
 
     def __init__(self, key: str, type_name: str, pub: Any, token: Any, gid: bytes, merge_tf: bool):
         self.key = key
@@ -63,13 +64,34 @@ class RosOut:
         self.seq = 0
         self.users = 0  # mappings sending through it (robots' `tf` on `/tf`): it goes with the last
         self.lock = threading.Lock()
-        self.tree: dict[str, Any] | None = {} if merge_tf else None
+        # child frame -> (the sim key that sent it, its latest transform)
+        self.tree: dict[str, tuple[str, Any]] | None = {} if merge_tf else None
 
-    def put(self, payload: bytes) -> None:
+    def put(self, payload: bytes, source: str) -> None:
+        """Send a message that came from the sim key `source`."""
         with self.lock:
             if self.tree is not None:
                 for t in msgs.decode(payload, TF).transforms:
-                    self.tree[t.child_frame_id] = t
-                payload = msgs.encode(msgs.T[TF](transforms=list(self.tree.values())), TF)
-            self.seq += 1  # rmw_zenoh numbers each publisher's messages from 1
-            self.pub.put(payload, attachment=ros2.pack_attachment(self.seq, time.time_ns(), self.gid))
+                    self.tree[t.child_frame_id] = (source, t)
+                payload = self._whole_tree()
+            self._send(payload)
+
+    def forget(self, source: str) -> None:
+        """`source` feeds it no more: its frames leave the static tree, and the smaller tree is sent (the
+        one the cache keeps for late subscribers) while other sources still feed it."""
+        with self.lock:
+            if self.tree is None:
+                return
+            gone = [child for child, (src, _t) in self.tree.items() if src == source]
+            for child in gone:
+                del self.tree[child]
+            if gone and self.tree and self.users > 0:
+                self._send(self._whole_tree())
+
+    def _whole_tree(self) -> bytes:
+        assert self.tree is not None
+        return msgs.encode(msgs.T[TF](transforms=[t for _src, t in self.tree.values()]), TF)
+
+    def _send(self, payload: bytes) -> None:
+        self.seq += 1  # rmw_zenoh numbers each publisher's messages from 1
+        self.pub.put(payload, attachment=ros2.pack_attachment(self.seq, time.time_ns(), self.gid))
