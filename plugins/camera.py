@@ -62,8 +62,17 @@ class Camera(Plugin):
         self.intrinsics = Intrinsics(p.width, p.height, p.fov)
         self.make_info = InfoMaker(self.intrinsics)
         self.renderer: CameraRenderer | None = None
+        self.camera_id = cam
         self.renderer = CameraRenderer(m, cam, p.width, p.height, p.near, p.far)
         self.color_pubs()
+
+    def rebind(self) -> None:
+        """A new model (a robot spawned): a renderer of it (its meshes and textures, the new robot's too)."""
+        p = self.params
+        if self.renderer is not None:
+            self.renderer.close()
+        self.renderer = None
+        self.renderer = CameraRenderer(self.ctx.model, self.camera_id, p.width, p.height, p.near, p.far)
 
     def color_pubs(self) -> None:
         p = self.params

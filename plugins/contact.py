@@ -66,10 +66,22 @@ class Contact(Plugin):
     def setup(self) -> None:
         p = self.params
         r = self.ctx.robot
-        m = self.ctx.model
         self.body = r.body_id(p.link)
         self.frame_id = p.frame_id or r.frame(p.link)
         self.in_world = p.frame_id == "world"
+        self._tables()
+        self.pub = self.ctx.publisher(p.topic, CONTACTS_TYPE)
+        T = msgs.T
+        self.States, self.State = T[CONTACTS_TYPE], T["gazebo_msgs/msg/ContactState"]
+        self.Wrench, self.Vec = T["geometry_msgs/msg/Wrench"], T["geometry_msgs/msg/Vector3"]
+        self._f6 = np.zeros(6)
+
+    def rebind(self) -> None:
+        self._tables()  # (a spawned robot's geoms have ids past the old tables' ends)
+
+    def _tables(self) -> None:
+        """Per geom of the world: the link's own collision geoms, the robot's, every geom's name."""
+        r, m = self.ctx.robot, self.ctx.model
         self.own = np.zeros(m.ngeom, dtype=bool)  # the link's collision geoms
         for g in range(m.ngeom):
             if int(m.geom_bodyid[g]) == self.body and _collides(m, g):
@@ -77,11 +89,6 @@ class Contact(Plugin):
         self.robot = np.zeros(m.ngeom, dtype=bool)
         self.robot[r.geom_ids] = True
         self.names = [m.geom(g).name or m.body(int(m.geom_bodyid[g])).name for g in range(m.ngeom)]
-        self.pub = self.ctx.publisher(p.topic, CONTACTS_TYPE)
-        T = msgs.T
-        self.States, self.State = T[CONTACTS_TYPE], T["gazebo_msgs/msg/ContactState"]
-        self.Wrench, self.Vec = T["geometry_msgs/msg/Wrench"], T["geometry_msgs/msg/Vector3"]
-        self._f6 = np.zeros(6)
 
     def contacts(self) -> list[tuple[int, int, np.ndarray, np.ndarray, float, np.ndarray, np.ndarray]]:
         """(link geom, other geom, position, normal into the link, depth, force on the link, contact

@@ -344,6 +344,10 @@ class WheelDrive(Lifecycle, Plugin):
         self.last_ns: int | None = None
         self.qpos, self.qvel, self.actuator_ctrl = d.qpos, d.qvel, d.ctrl  # views, looked up once
 
+    def rebind(self) -> None:
+        d = self.ctx.data
+        self.qpos, self.qvel, self.actuator_ctrl = d.qpos, d.qvel, d.ctrl  # (the new data's)
+
     def _side_means(self, values: np.ndarray) -> np.ndarray:
         return self._means @ values
 

@@ -150,10 +150,16 @@ class Imu(Lifecycle, Plugin):
         self.at_w = self.layout.spans["angular_velocity"].offset
         self.at_a = self.layout.spans["linear_acceleration"].offset
         self.noise = _Noise(self.ctx.rng, p.angular_velocity_stddev, p.linear_acceleration_stddev)
-        sd = self.ctx.data.sensordata  # views into it, made once
-        self.sd_w, self.sd_a, self.sd_q = sd[self.gyro], sd[self.accel], sd[self.quat]
+        self._views()
         self.bw, self.ba = self.bias_w.tolist(), self.bias_a.tolist()
         self._setup_drift()
+
+    def _views(self) -> None:
+        sd = self.ctx.data.sensordata  # views into it, made once (again when the world grows: `rebind`)
+        self.sd_w, self.sd_a, self.sd_q = sd[self.gyro], sd[self.accel], sd[self.quat]
+
+    def rebind(self) -> None:
+        self._views()
 
     def _setup_drift(self) -> None:
         """hector's error model: drifting biases, a heading error, the tilt of the accelerometer bias and

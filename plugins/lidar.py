@@ -181,6 +181,20 @@ class Lidar(Plugin):
         self.dist = np.zeros(n * nv, dtype=np.float64)
         if p.points:
             self._setup_points()
+        self._geom_tables()
+        self.vec = np.zeros((n * nv, 3))
+        self._blind_of: list[tuple[float, float]] | None = None  # the sectors `self.blind` was made for
+        self.blind = np.zeros(n * nv, dtype=bool)
+        if p.publish_scan:
+            self._setup_scan()
+        if p.range_topic:
+            self._setup_range()
+
+    def rebind(self) -> None:
+        self._geom_tables()  # (per geom of the world: a spawned robot's geoms come after the old ends)
+
+    def _geom_tables(self) -> None:
+        ctx, m = self.ctx, self.ctx.model
         # Rays skip the robot's own geoms and visual-only geoms (URDF visuals are group 1, no contacts).
         skip = np.zeros(m.ngeom, dtype=bool)
         skip[ctx.robot.geom_ids] = True
@@ -198,13 +212,6 @@ class Lidar(Plugin):
         visible = m.geom_group != _HIDDEN_GROUP
         visible[self.own] = False
         self.may_recast = bool((skip & visible).any())
-        self.vec = np.zeros((n * nv, 3))
-        self._blind_of: list[tuple[float, float]] | None = None  # the sectors `self.blind` was made for
-        self.blind = np.zeros(n * nv, dtype=bool)
-        if p.publish_scan:
-            self._setup_scan()
-        if p.range_topic:
-            self._setup_range()
 
     def _setup_scan(self) -> None:
         p = self.params

@@ -233,6 +233,8 @@ class RunPlan(BaseModel):
     scenario_warnings: list[str] = []
     assertions: list[dict[str, Any]] = []  # the scenario's assertion models, as plain data
     assertion_keys: list[str] = []  # the key each assertion reads
+    # what of the scenario a robot spawned at run time is compiled against (runner.compile.spawn)
+    spawn: dict[str, Any] | None = None
     contact_watch: list[str] = []  # robot/model names whose contacts the world publishes on <run>/_contacts
     stop_on: Literal["never", "first_failure", "all_decided"] = "never"
     renderers: Literal["auto", "world", "process"] = "auto"  # the launcher resolves auto

@@ -15,6 +15,14 @@ import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+from runner.errors import Problem
+
+if TYPE_CHECKING:
+    from runner.errors import Problems
+    from runner.scenario.loader import Document
+    from runner.scenario.schema import Scenario
 
 ENV_VARS = (
     "SCENARIO_PACKAGE_PATH",
@@ -155,3 +163,22 @@ def resolve_uri(uri: str, packages: PackageMap, base_dir: Path) -> Path | None:
         return Path(uri[len("file://") :])
     p = Path(uri)
     return p if p.is_absolute() else base_dir / p
+
+
+def scenario_packages(sc: Scenario, doc: Document, problems: Problems) -> PackageMap:
+    """Where `package://` and `model://` names are found: the scenario's `packages:` (each folder must
+    exist), its folder, SCENARIO_PACKAGE_PATH...; `allow_paths:` let files outside them be read."""
+    base = doc.base_dir
+    packages = PackageMap.for_scenario(base, {k: (base / v) for k, v in sc.packages.items()})
+    packages.allowed = [base / p for p in sc.allow_paths]
+    for name, folder in packages.explicit.items():
+        if not folder.is_dir():
+            problems.add(
+                Problem(
+                    f"package folder {str(folder)!r} does not exist",
+                    doc.locate(("packages", name)),
+                    ("packages", name),
+                    hint="paths are relative to the scenario's folder",
+                )
+            )
+    return packages

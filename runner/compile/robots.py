@@ -5,6 +5,7 @@ summed up, and the model attached under the robot's namespace at its pose."""
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -66,9 +67,13 @@ def add_robot(
     packages: PackageMap,
     notices: Notices,
     problems: Problems,
+    *,
+    xyz: Sequence[float] | None = None,
+    quat: Sequence[float] | None = None,
 ) -> RobotPlan:
     """Robot `i` (`robots[i]`) read, its plugins built (each one's mistakes to `problems`, left out),
-    attached to `world` under `<ns>/` at its pose."""
+    attached to `world` under `<ns>/` at its pose (or at `xyz` / `quat` (w x y z): a robot spawned at run
+    time, runner.compile.spawn)."""
     before = len(notices)
     model = robot_model(robot, i, doc, packages, notices, sc.world.physics.timestep)
     # the hardware first: a controller's build claims the actuators it made (plugins/_actuators.py)
@@ -80,8 +85,9 @@ def add_robot(
     parity = summary(model, hardware) + summarize(
         model, plugins, notices.items[before:], f"{sc.name}/{robot.ns}/"
     )
-    pos = robot.pose.xyz
-    frame = world.worldbody.add_frame(pos=list(pos), quat=list(rpy_to_quat(robot.pose.rpy)))
+    pos = list(robot.pose.xyz if xyz is None else xyz)
+    rot = list(rpy_to_quat(robot.pose.rpy) if quat is None else quat)
+    frame = world.worldbody.add_frame(pos=pos, quat=rot)
     prefix = f"{robot.ns}/"
     wheels = wheel_links(plugins, model.spec)
     world.attach(model.spec, prefix=prefix, frame=frame)

@@ -13,11 +13,12 @@ from runner.checks import assertion_keys, check_names
 from runner.compile.actors import add_actors
 from runner.compile.events import compile_events
 from runner.compile.nodes import compile_nodes, declared_topics, host_of
-from runner.compile.packages import PackageMap
+from runner.compile.packages import PackageMap, scenario_packages
 from runner.compile.record import record_plan
 from runner.compile.robots import add_robots
 from runner.compile.sanity import check_start_overlaps
 from runner.compile.sdf import load_sdf_world
+from runner.compile.spawn import spawn_context
 from runner.compile.timeline import compile_timeline
 from runner.compile.wheels import check_geometry
 from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError, missing_file_hint
@@ -58,7 +59,7 @@ def compile_world(
     partial (robots that did not load are left out, their key prefixes added to `unloaded` so that later
     checks do not report their topics as missing, and there is no model): the caller raises `problems`
     before anything uses it."""
-    packages = _packages(sc, doc, problems)
+    packages = scenario_packages(sc, doc, problems)
     world, sdf_rate, actors = mujoco.MjSpec(), None, []
     # the world's name in ros_gz's service names (/world/<name>/control): the SDF file's <world name>,
     # else the scenario's name (with several worlds, the world's own)
@@ -118,26 +119,8 @@ def compile_world(
         resources=sc.resources.model_dump() if sc.resources else None,
         host=host,
         world_services=services,
+        spawn=spawn_context(sc),
     )
-
-
-def _packages(sc: Scenario, doc: Document, problems: Problems) -> PackageMap:
-    """Where `package://` and `model://` names are found: the scenario's `packages:` (each folder must
-    exist), its folder, SCENARIO_PACKAGE_PATH...; `allow_paths:` let files outside them be read."""
-    base = doc.base_dir
-    packages = PackageMap.for_scenario(base, {k: (base / v) for k, v in sc.packages.items()})
-    packages.allowed = [base / p for p in sc.allow_paths]
-    for name, folder in packages.explicit.items():
-        if not folder.is_dir():
-            problems.add(
-                Problem(
-                    f"package folder {str(folder)!r} does not exist",
-                    doc.locate(("packages", name)),
-                    ("packages", name),
-                    hint="paths are relative to the scenario's folder",
-                )
-            )
-    return packages
 
 
 def _assertion_keys(

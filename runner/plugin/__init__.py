@@ -286,8 +286,16 @@ class Plugin:
     def after_step(self, now_ns: int) -> None:
         """Read the model after physics reached `now_ns` (sensors) and publish."""
 
+    def rebind(self) -> None:
+        """The world's model grew (a robot was spawned, runner.sim.grow): `self.ctx.model` and
+        `self.ctx.data` are new objects. Every MuJoCo id and address this plugin holds is still valid (what
+        was there keeps its ids; the new robot's things come after), but anything made from the old model or
+        data must be made again here: numpy views into `data` (`data.sensordata[a:b]`), renderers and
+        OpenGL contexts, tables sized by the model's counts. The world checks after this call that the
+        plugin holds no view of the old data and no old model or data object, and says so if it does."""
+
     def close(self) -> None:
-        """Run time, once, at the end."""
+        """Run time, once, at the end (and when its robot is deleted)."""
 
 
 def overrides(obj: Plugin, hook: str) -> bool:

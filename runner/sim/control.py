@@ -104,6 +104,7 @@ class Control:
         # gains, damping), after the start's mj_forward; they change it again as they start again
         restore_model(m, self._model0)
         mujoco.mj_resetData(m, d)
+        w._apply_deleted()  # (deleted robots stay out: Gazebo's reset does not bring a deleted model back)
         mujoco.mj_forward(m, d)
         self._epoch[0] += self.now_ns
         self.now_ns = 0
@@ -417,28 +418,6 @@ class Control:
             self._rewind = [*(self._rewind or []), answer]
             return
         answer()
-
-    def _srv_spawn(self, _req: Any, reply: Reply) -> None:
-        why = "spawning is not supported: the world's model is compiled once (docs/simulation_control.md)"
-        self._said(f"spawn_entity: {why}")
-        reply(msgs.T["gazebo_msgs/srv/SpawnEntity_Response"](success=False, status_message=why))
-
-    def _srv_delete(self, req: Any, reply: Reply) -> None:
-        try:
-            self.body_of(req.name)
-            why = "deleting is not supported: the world's model is compiled once (docs/simulation_control.md)"
-        except EntityError as e:
-            why = f"Entity [{req.name}] does not exist" if "does not exist" in str(e) else str(e)
-        self._said(f"delete_entity: {why}")
-        reply(msgs.T["gazebo_msgs/srv/DeleteEntity_Response"](success=False, status_message=why))
-
-    def _srv_create(self, _req: Any, reply: Reply) -> None:
-        self._said("create: spawning is not supported: the world's model is compiled once")
-        reply(msgs.T["ros_gz_interfaces/srv/SpawnEntity_Response"](success=False))
-
-    def _srv_remove(self, _req: Any, reply: Reply) -> None:
-        self._said("remove: deleting is not supported: the world's model is compiled once")
-        reply(msgs.T["ros_gz_interfaces/srv/DeleteEntity_Response"](success=False))
 
     def _said(self, text: str) -> None:
         """A refused request, on stderr (as gazebo_ros logs RCLCPP_ERROR), at its sim time."""

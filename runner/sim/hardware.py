@@ -37,6 +37,9 @@ class Hardware:
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, robots: list[RobotPlan]):
         self.m, self.d = model, data
         self._limited: list[tuple[int, int, float, float]] = []  # (actuator, qpos adr, loop gain, vmax)
+        self._acts: np.ndarray = np.zeros(0, dtype=int)
+        self._adr: np.ndarray = np.zeros(0, dtype=int)
+        self._window: np.ndarray = np.zeros(0)
         self._target: np.ndarray = np.zeros(0)
         self._written: np.ndarray = np.zeros(0)
         self._ff_dofs: np.ndarray = np.zeros(0, dtype=int)  # free-base held joints (`_feedforward`)
@@ -54,6 +57,30 @@ class Hardware:
         mujoco.mj_forward(model, data)
         self._gains(joints)
         self._feedforward(joints)
+
+    # -------------------------------------------------------------- a robot spawned or deleted mid-run
+    def rebind(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+        """The world's new model and data (a robot spawned): every id held is still valid."""
+        self.m, self.d = model, data
+
+    def add(self, robots: list[RobotPlan]) -> None:
+        """A spawned robot's hardware: its start state, gains and feed-forward, as at a run's start, then
+        kept at each boundary with the others'."""
+        other = Hardware(self.m, self.d, robots)
+        self._limited += other._limited
+        for name in ("_acts", "_adr", "_window", "_target", "_written", "_ff_dofs", "_ff_limit"):
+            setattr(self, name, np.concatenate([getattr(self, name), getattr(other, name)]))
+        self.active = self.active or other.active
+
+    def drop(self, actuators: set[int], dofs: set[int]) -> None:
+        """A deleted robot's actuators and joints, no longer kept (its feed-forward torques taken off)."""
+        keep = np.array([a not in actuators for a in self._acts.tolist()], dtype=bool)
+        self._limited = [x for x, k in zip(self._limited, keep.tolist(), strict=True) if k]
+        for name in ("_acts", "_adr", "_window", "_target", "_written"):
+            setattr(self, name, getattr(self, name)[keep])
+        gone = np.array([int(v) in dofs for v in self._ff_dofs.tolist()], dtype=bool)
+        self.d.qfrc_applied[self._ff_dofs[gone]] = 0.0
+        self._ff_dofs, self._ff_limit = self._ff_dofs[~gone], self._ff_limit[~gone]
 
     def _start(self, joints: list[tuple[RobotPlan, HardwareJoint, int]]) -> None:
         """gz_system.cpp: JointPositionReset / JointVelocityReset with the `initial_value`s."""

@@ -15,8 +15,9 @@ from collections.abc import Callable
 from typing import Any
 
 # the state a renderer gets: sim time ns, frame number, the sim time run before the last reset_simulation
-# (the renderer's epoch: runner.sim.pubsub.Outgoing.epoch), then the state
-STATE_HEAD = struct.Struct("<qQq")
+# (the renderer's epoch: runner.sim.pubsub.Outgoing.epoch), the world's model generation (a robot spawned or
+# deleted: runner.sim.grow), then the state
+STATE_HEAD = struct.Struct("<qQqq")
 _WAIT = struct.Struct("<q")
 
 
@@ -73,9 +74,16 @@ class RemoteRender:
                     raise RuntimeError(f"the renderer process did not answer for {self.TIMEOUT_S:.0f} s")
                 self._cond.wait(0.05)
 
-    def send(self, now_ns: int, state: bytes, should_stop: Callable[[], bool], epoch_ns: int = 0) -> None:
+    def send(
+        self,
+        now_ns: int,
+        state: bytes,
+        should_stop: Callable[[], bool],
+        epoch_ns: int = 0,
+        generation: int = 0,
+    ) -> None:
         self._wait(self.sent - self.DEPTH + 1, should_stop)
-        self._pub.put(STATE_HEAD.pack(now_ns, self.sent, epoch_ns) + state)
+        self._pub.put(STATE_HEAD.pack(now_ns, self.sent, epoch_ns, generation) + state)
         self.sent += 1
 
     def finish(self, should_stop: Callable[[], bool]) -> None:

@@ -154,7 +154,11 @@ class PubSub:
                 limit = MAX_INBOUND_BYTES if max_bytes is None else int(max_bytes)
                 self._max_bytes[key] = max(limit, self._max_bytes.get(key, 0))
             # the same list as the publisher's `local`, if this process also publishes the key
-            self._local.setdefault(key, []).append((msgs.normalize_type(type_name), callback, None))
+            entry = (msgs.normalize_type(type_name), callback, None)
+            self._local.setdefault(key, []).append(entry)
+            subs_of = getattr(self, "_subs_of", None)
+            if subs_of is not None and checked:  # (a robot's: taken back if it is deleted, runner.sim.grow)
+                subs_of.setdefault(namespace, []).append((key, entry))
             if key not in self._remote_subscribed:
                 self._remote_subscribed.add(key)
                 self.bus.subscribe(key, self._on_remote, msgs.normalize_type(type_name))

@@ -71,6 +71,16 @@ def main(argv: list[str] | None = None) -> int:
             # last: the world starts stepping once it sees this token
             subs.append(session.liveliness().declare_token(meta_key(plan.name, "render", "alive")))
             prefix = meta_key(plan.name, "render", "")
+
+            def fetch(generation: int) -> bytes:
+                """The world's model at `generation` (runner.sim.grow serves it)."""
+                key = meta_key(plan.name, "render", "model", str(generation))
+                for _ in range(3):
+                    for reply in session.get(key, timeout=10.0):
+                        if reply.ok is not None:
+                            return bytes(reply.ok.payload.to_bytes())
+                raise RuntimeError(f"the world did not give its model at generation {generation}")
+
             frames = dict.fromkeys(world.render_plugins, 0)
             while not should_stop():
                 try:
@@ -81,8 +91,12 @@ def main(argv: list[str] | None = None) -> int:
                 if what == "stop":
                     break
                 index = int(what)
-                now_ns, _frame, epoch_ns = STATE_HEAD.unpack_from(payload)
-                world.render(index, now_ns, payload[STATE_HEAD.size :], epoch_ns)
+                now_ns, _frame, epoch_ns, generation = STATE_HEAD.unpack_from(payload)
+                world.render(index, now_ns, payload[STATE_HEAD.size :], epoch_ns, generation, fetch)
+                if index not in acks:  # a spawned robot's camera
+                    acks[index] = session.declare_publisher(ack_key(index), congestion_control=block)
+                    subs.append(acks[index])
+                    frames[index] = 0
                 frames[index] += 1
                 acks[index].put(json.dumps({"n": frames[index], "published": world.published()}).encode())
         except Exception as e:  # reported on stderr, which the runner shows

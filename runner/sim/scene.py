@@ -22,6 +22,7 @@ the transport has no latching, and a viewer that seeks into a recording needs th
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, Protocol
 
 import mujoco
@@ -75,8 +76,9 @@ def _frame(m: mujoco.MjModel, body: int) -> str:
     return WORLD if body == 0 else (mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, body) or f"body{body}")
 
 
-def scene_update(m: mujoco.MjModel, stamp_ns: int) -> bytes:
-    """Every body's visual geometry as one SceneUpdate, encoded (protobuf)."""
+def scene_update(m: mujoco.MjModel, stamp_ns: int, gone: Sequence[str] = ()) -> bytes:
+    """Every body's visual geometry as one SceneUpdate, encoded (protobuf); `gone`: the entities of deleted
+    robots, deleted (a viewer keeps an entity until it is)."""
     fm = _fox()
     per_body: dict[int, dict[str, list[Any]]] = {}
     for g in range(m.ngeom):
@@ -101,7 +103,13 @@ def scene_update(m: mujoco.MjModel, stamp_ns: int) -> bytes:
         )
         for body, prims in sorted(per_body.items())
     ]
-    return bytes(fm.SceneUpdate(entities=entities).encode())
+    deletions = [
+        fm.SceneEntityDeletion(
+            timestamp=fm.Timestamp(sec=sec, nsec=nsec), type=fm.SceneEntityDeletionType.MatchingId, id=frame
+        )
+        for frame in gone
+    ]
+    return bytes(fm.SceneUpdate(entities=entities, deletions=deletions).encode())
 
 
 def _pose(fm: Any, pos: Any, quat: Any) -> Any:
@@ -166,22 +174,25 @@ def _add_geom(fm: Any, m: mujoco.MjModel, g: int, rgba: Any, prims: dict[str, li
 class SceneFeed:
     """The world's hooks for the 3D view (see the module docstring)."""
 
-    def __init__(self, world: WorldView):
+    def __init__(self, world: WorldView, gone: Sequence[str] = (), stamp_ns: int = 0):
+        """`gone`: the body frames of robots deleted (runner.sim.grow), deleted from the view."""
         plan, m, d = world.plan, world.model, world.data
         self.world = world
+        deleted = getattr(world, "deleted", {})
         rate = plan.foxglove.rate
         self.period_ns = round(1e9 / rate)
         self.tf_period_ns = round(1e9 / plan.foxglove.tf_rate)
         make = world.make_publisher
         self.scene_out = make(f"{plan.name}/scene", "foxglove.SceneUpdate")
-        self.scene_bytes = scene_update(m, 0)
+        self.scene_bytes = scene_update(m, stamp_ns, gone)
+        self._model_due = True  # the model goes out once: at the start, and again when it changed
         self.descriptions = [
             (
                 make(f"{plan.name}/{r.namespace}/robot_description", "std_msgs/msg/String"),
                 prefixed_urdf(r.urdf, r.namespace),
             )
             for r in plan.robots
-            if r.urdf
+            if r.urdf and r.name not in deleted
         ]
         robot_bodies = {b for h in world.robots for b in h.body_ids}
         # world -> odom of each driven robot: where its base started (odometry starts at zero there)
@@ -244,7 +255,8 @@ class SceneFeed:
         return [(self.slow, self.period_ns), (self.fast, self.tf_period_ns)]
 
     def slow(self, now_ns: int) -> None:
-        if now_ns == 0:
+        if self._model_due:
+            self._model_due = False
             self.model_out.publish(msgs.T["std_msgs/msg/String"](data=self.mjcf), now_ns)
         self.scene_out.publish_cdr(self.scene_bytes, now_ns)
         for out, urdf in self.descriptions:

@@ -39,11 +39,13 @@ from runner.plugin import Plugin, RobotHandle, RuntimeContext, overrides
 from runner.plugin.registry import load
 from runner.sim.contacts import ContactWatch
 from runner.sim.control import Control
+from runner.sim.grow import Grow
 from runner.sim.hardware import Hardware
 from runner.sim.links import Lockstep, RemoteRender
 from runner.sim.pubsub import PubSub
 from runner.sim.schedule import Hook, next_due, sleep_until
 from runner.sim.services import Services
+from runner.sim.spawn_services import SpawnServices
 
 if TYPE_CHECKING:
     from runner.sim.events import Events
@@ -84,7 +86,7 @@ CTRL_MAX = 1e10
 _BADCTRL = int(mujoco.mjtWarning.mjWARN_BADCTRL)
 
 
-class World(PubSub, Services, Control):
+class World(PubSub, Services, Control, Grow, SpawnServices):
     """The simulated world of a plan. `role="world"` steps physics and runs every plugin, except, with
     `plan.renderers == "process"` on a Zenoh bus, the rendering ones: their frames are made by a renderer
     process (`role="renderer"`, see runner/sim/render.py) from the state this world sends it."""
@@ -103,6 +105,7 @@ class World(PubSub, Services, Control):
         self._init_pubsub()
         self._init_services()
         self._init_control()
+        self._init_grow()
         self._lockstep: Lockstep | None = None
         self.robots = [RobotHandle(self.model, r) for r in plan.robots]
         session = getattr(bus, "session", None)
@@ -123,7 +126,8 @@ class World(PubSub, Services, Control):
         plan = self.plan
         self.rng = np.random.default_rng(plan.seed)
         # the hardware's start state and gains come before any plugin (a controller reads its start there)
-        self.hardware = Hardware(self.model, self.data, plan.robots)
+        live = [r for r in plan.robots if r.name not in self.deleted]
+        self.hardware = Hardware(self.model, self.data, live)
         self.plugins: list[Plugin] = []
         self._plugin_index: dict[int, Plugin] = {}  # by place in the plan (events change their parameters)
         self._hooks_of: dict[int, list[Hook]] = {}
@@ -134,7 +138,7 @@ class World(PubSub, Services, Control):
         if self.role == "world" and plan.foxglove.scene:
             from runner.sim.scene import SceneFeed
 
-            for fn, period in SceneFeed(self).hooks():
+            for fn, period in SceneFeed(self, self.deleted_frames()).hooks():
                 self._after.append(Hook(fn, period))
         if self.role == "renderer":
             for plugin in self.plugins:
@@ -169,37 +173,46 @@ class World(PubSub, Services, Control):
         """Every robot's plugins, in plan order, and their hooks. In a renderer process only the rendering
         ones (no hooks: `render` runs them); with `remote`, a rendering plugin runs in the renderer process
         and its hook here sends the state there."""
+        handles = {h.name: h for h in self.robots}
+        index = 0
+        for rp in self.plan.robots:
+            handle = handles.get(rp.name)
+            if handle is not None:  # (a deleted robot's plugins keep their places: events name them by it)
+                self._load_robot_plugins(handle, index, remote)
+            index += len(rp.plugins)
+
+    def _load_robot_plugins(self, handle: RobotHandle, first: int, remote: bool) -> None:
+        """One robot's plugins, the first at place `first` in the plan, and their hooks."""
         role, session = self.role, getattr(self.bus, "session", None)
-        index = -1
-        for handle in self.robots:
-            for pp in handle.plan.plugins:
-                index += 1
-                cls = load(pp.type)
-                period = 0 if not pp.rate else round(1e9 / pp.rate)
-                if role == "renderer" and not cls.renders:
-                    continue
-                if remote and cls.renders:
-                    link = self.remote_renders.get(index) or RemoteRender(session, self.plan.name, index)
-                    self.remote_renders[index] = link
-                    self._after.append(Hook(self._render_hook(link), period))
-                    self._hooks_of[index] = [self._after[-1]]
-                    continue
-                params = cls.Params.model_validate(pp.params)
-                # random numbers by the plugin's place in the plan, so a renderer process draws the same
-                plugin = cls(params, self._context(handle, index), pp.name)
-                self.plugins.append(plugin)
-                self._plugin_index[index] = plugin
-                if role == "renderer":
-                    self.render_plugins[index] = plugin
-                    continue
-                hooks = self._hooks_of.setdefault(index, [])
-                if overrides(plugin, "before_step"):
-                    control = period if pp.control_rate is None else round(1e9 / pp.control_rate)
-                    hooks.append(Hook(plugin.before_step, control))
-                    self._before.append(hooks[-1])
-                if overrides(plugin, "after_step"):
-                    hooks.append(Hook(plugin.after_step, period, forward=plugin.needs_forward))
-                    self._after.append(hooks[-1])
+        index = first - 1
+        for pp in handle.plan.plugins:
+            index += 1
+            cls = load(pp.type)
+            period = 0 if not pp.rate else round(1e9 / pp.rate)
+            if role == "renderer" and not cls.renders:
+                continue
+            if remote and cls.renders:
+                link = self.remote_renders.get(index) or RemoteRender(session, self.plan.name, index)
+                self.remote_renders[index] = link
+                self._after.append(Hook(self._render_hook(link), period))
+                self._hooks_of[index] = [self._after[-1]]
+                continue
+            params = cls.Params.model_validate(pp.params)
+            # random numbers by the plugin's place in the plan, so a renderer process draws the same
+            plugin = cls(params, self._context(handle, index), pp.name)
+            self.plugins.append(plugin)
+            self._plugin_index[index] = plugin
+            if role == "renderer":
+                self.render_plugins[index] = plugin
+                continue
+            hooks = self._hooks_of.setdefault(index, [])
+            if overrides(plugin, "before_step"):
+                control = period if pp.control_rate is None else round(1e9 / pp.control_rate)
+                hooks.append(Hook(plugin.before_step, control))
+                self._before.append(hooks[-1])
+            if overrides(plugin, "after_step"):
+                hooks.append(Hook(plugin.after_step, period, forward=plugin.needs_forward))
+                self._after.append(hooks[-1])
 
     def _context(self, handle: RobotHandle, stream: int) -> RuntimeContext:
         """What a plugin of this robot works with; its random numbers are the plan seed's stream `stream`."""
@@ -236,6 +249,7 @@ class World(PubSub, Services, Control):
         if self._lockstep is not None:
             # the nodes' answers to the clocks published so far come before their next wait message
             self._lockstep.wait(self._clock_sent, self._should_stop, self._drain_requests)
+        self._hold_deleted()
         self._drain_inbox()
         self._drain_requests()  # after the messages: a service sees what a controller sees
         events = self._events
@@ -256,7 +270,7 @@ class World(PubSub, Services, Control):
     # ---------------------------------------------------------------------------- renderer processes
     def _render_hook(self, link: RemoteRender) -> Callable[[int], None]:
         def send(now: int) -> None:
-            link.send(now, self._state_bytes(), self._should_stop, self._epoch[0])
+            link.send(now, self._state_bytes(), self._should_stop, self._epoch[0], self.generation)
 
         return send
 
@@ -274,10 +288,22 @@ class World(PubSub, Services, Control):
             time.sleep(0.02)
         return True
 
-    def render(self, index: int, now_ns: int, state: bytes, epoch_ns: int = 0) -> None:
+    def render(
+        self,
+        index: int,
+        now_ns: int,
+        state: bytes,
+        epoch_ns: int = 0,
+        generation: int = 0,
+        fetch: Callable[[int], bytes] | None = None,
+    ) -> None:
         """In a renderer process: pose the world as the state says and run the plugin's hook. A new
         `epoch_ns`: the world was reset (reset_simulation): the rendering plugins are made again, as the
-        world's own are (their noise streams from the start), and stamp their messages' log time on."""
+        world's own are (their noise streams from the start), and stamp their messages' log time on. A new
+        `generation`: a robot was spawned or deleted: the world's model as it is now (`fetch(generation)`,
+        runner.sim.grow) is taken first."""
+        if generation != self.generation and fetch is not None:
+            self.follow(fetch(generation))
         if epoch_ns != self._epoch[0]:
             self.renderer_reset(epoch_ns)
         m, d = self.model, self.data
@@ -349,29 +375,25 @@ class World(PubSub, Services, Control):
         should_stop: Callable[[], bool] = lambda: False,
         on_progress: Callable[[int], None] | None = None,
     ) -> WorldStats:
-        plan = self.plan
-        m, d = self.model, self.data
         self._should_stop = should_stop
-        # everything built so far lives for the whole run: out of the collector's way (shorter GC pauses)
-        gc.freeze()
-        if self._lockstep is not None:
-            # every lockstep node set up (subscribed) and waiting, before the first sensor message
-            self._lockstep.wait(-1, should_stop)
-        end_ns = plan.duration_ns
-        factor = {"realtime": 1.0, "max": None}.get(plan.rate, plan.rate)  # type: ignore[arg-type]
-        wall0 = time.perf_counter()
-        next_check = wall0
+        self._start_loop(should_stop)
+        end_ns = self.plan.duration_ns
+        factor = {"realtime": 1.0, "max": None}.get(self.plan.rate, self.plan.rate)  # type: ignore[arg-type]
+        next_check = wall0 = time.perf_counter()
         # the pacing's origin: sim time `pace_ns` at wall time `pace_wall` (moved on by a pause and a reset:
         # the world never runs fast to catch up the time it stood still, or the sim time a reset took back)
         pace_ns, pace_wall = self.now_ns, wall0
         steps = 0
-        warnings = [d.warning[i] for i in _UNSTABLE]
-        badctrl = d.warning[_BADCTRL]
-        ctrl, abs_ctrl, nu = d.ctrl, np.empty(m.nu), m.nu
+        m, d, warnings, badctrl, ctrl, abs_ctrl, nu = self._loop_locals()
         self._clamped: set[int] = set()
         error = None
+        generation = self.generation
         while True:
             self._boundary()
+            if self.generation != generation:  # a robot spawned: the new model and data from here on
+                generation = self.generation
+                m, d, warnings, badctrl, ctrl, abs_ctrl, nu = self._loop_locals()
+                pace_ns, pace_wall = self.now_ns, time.perf_counter()  # (compiling it took wall time)
             if self._rewind is not None:
                 self._rewound()
                 pace_ns, pace_wall = 0, time.perf_counter()
@@ -387,6 +409,9 @@ class World(PubSub, Services, Control):
                 if not self._idle(should_stop):
                     break
                 pace_ns, pace_wall = self.now_ns, time.perf_counter()
+                if self.generation != generation:  # spawned while paused
+                    generation = self.generation
+                    m, d, warnings, badctrl, ctrl, abs_ctrl, nu = self._loop_locals()
                 if self._rewind is not None:  # asked while paused: reset now (it stays paused)
                     self._rewound()
                     pace_ns = 0
@@ -423,6 +448,21 @@ class World(PubSub, Services, Control):
                     break
         return self._finish(steps, wall0, error, should_stop)
 
+    def _start_loop(self, should_stop: Callable[[], bool]) -> None:
+        # everything built so far lives for the whole run: out of the collector's way (shorter GC pauses)
+        gc.freeze()
+        if self._lockstep is not None:
+            # every lockstep node set up (subscribed) and waiting, before the first sensor message
+            self._lockstep.wait(-1, should_stop)
+
+    def _loop_locals(
+        self,
+    ) -> tuple[mujoco.MjModel, mujoco.MjData, list[Any], Any, np.ndarray, np.ndarray, int]:
+        """What the loop reads at every step, looked up once (again when a spawn swapped the model)."""
+        m, d = self.model, self.data
+        warnings = [d.warning[i] for i in _UNSTABLE]
+        return m, d, warnings, d.warning[_BADCTRL], d.ctrl, np.empty(m.nu), m.nu
+
     def _finish(
         self, steps: int, wall0: float, error: str | None, should_stop: Callable[[], bool]
     ) -> WorldStats:
@@ -431,14 +471,15 @@ class World(PubSub, Services, Control):
             # their answers to the last clock are part of the run (recorded), as every earlier one
             self._lockstep.wait(self._clock_sent, should_stop)
             self._lockstep.close()
-        published = {k: o.seq for k, o in self._out.items()}
+        published = {**self.gone_counts, **{k: o.seq for k, o in self._out.items()}}
         for link in self.remote_renders.values():
             link.finish(should_stop)
+        for link in [*self._retired_renders, *self.remote_renders.values()]:
             published.update(link.published)
         wall_s = time.perf_counter() - wall0
         for plugin in self.plugins:
             plugin.close()
-        for link in self.remote_renders.values():
+        for link in [*self.remote_renders.values(), *self._retired_renders]:
             link.close()
         gc.unfreeze()  # collectable again (a process that builds several worlds must not keep them all)
         rejected = {k: dict(v) for k, v in getattr(self.bus, "rejected", {}).items()}

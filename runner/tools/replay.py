@@ -69,8 +69,8 @@ def load(mcap: Path, world: str | None = None) -> Recording:
             for _schema, channel, message in make_reader(f).iter_messages(log_time_order=True):
                 topic = channel.topic
                 if topic.endswith("/_model"):
-                    text = msgs.decode(message.data, "std_msgs/msg/String").data
-                    mjcf.setdefault(topic[: -len("/_model")], text)
+                    # the last one: a robot spawned mid-run is in it (its world grew, keeping what it had)
+                    mjcf[topic[: -len("/_model")]] = msgs.decode(message.data, "std_msgs/msg/String").data
                 elif topic.endswith("/_plan") and plan is None:
                     plan = _plan_of(msgs.decode(message.data, "std_msgs/msg/String").data)
                 elif topic.endswith("/_state"):
@@ -90,7 +90,24 @@ def load(mcap: Path, world: str | None = None) -> Recording:
     run = runs[0]
     pairs = states[run]
     robots = None if plan is None else {r.name for p in plan.parts() for r in p.robots}
-    return Recording(run, mjcf[run], [t for t, _ in pairs], [s for _, s in pairs], robots, plan)
+    grown = _grown_states([s for _, s in pairs], mjcf[run])
+    return Recording(run, mjcf[run], [t for t, _ in pairs], grown, robots, plan)
+
+
+def _grown_states(states: list[np.ndarray], mjcf: str) -> list[np.ndarray]:
+    """States recorded before robots were spawned (shorter: fewer joints) made the size of the last model's:
+    the joints they lack at the model's start values (a spawned robot shows where it was spawned)."""
+    if len({len(s) for s in states}) <= 1:
+        return states
+    m = mujoco.MjModel.from_xml_string(mjcf)
+    size, mocap = m.nq + 7 * m.nmocap, 7 * m.nmocap
+    out = []
+    for s in states:
+        nq = len(s) - mocap
+        if len(s) != size and 0 <= nq < m.nq:
+            s = np.concatenate([s[:nq], m.qpos0[nq:], s[nq:]])
+        out.append(s)
+    return out
 
 
 def _plan_of(plan_json: str) -> Any:

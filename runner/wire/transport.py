@@ -381,6 +381,7 @@ class MemoryBus:
         self.rejected: dict[str, dict[str, int]] = {}
         self.sent: list[tuple[str, str, bytes, bytes]] = []
         self.services: dict[str, OnRequest] = {}
+        self.withdrawn: list[str] = []
         self._subs: dict[str, list[Callable[[str, bytes, bytes | None], None]]] = {}
 
     def publisher(self, key: str, type_name: str) -> Callable[[bytes | bytearray, bytes], None]:
@@ -407,6 +408,12 @@ class MemoryBus:
         answers: list[tuple[bytes | None, str | None]] = []
         self.services[key](payload, attachment, lambda p, e: answers.append((p, e)))
         return answers
+
+    def withdraw(self, key: str) -> None:
+        """What was declared on `key` is gone (ZenohBus.withdraw): `withdrawn` keeps the keys, in order."""
+        self._subs.pop(key, None)
+        self.services.pop(key, None)
+        self.withdrawn.append(key)
 
     def inject(self, key: str, payload: bytes, attachment: bytes | None = None) -> None:
         for cb in self._subs.get(key, []):

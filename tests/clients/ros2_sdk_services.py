@@ -344,6 +344,58 @@ def run_action(c: Client, step: dict[str, Any], log: list[Any]) -> dict[str, Any
     return out
 
 
+def wait_topics(c: Client, step: dict[str, Any]) -> dict[str, Any]:
+    """`ros2 topic list` until every name of `wait_for` is there and none of `absent` is (60 s at most)."""
+    from zenoh_ros2_sdk.discovery import get_topic_names_and_types
+
+    want, gone = set(step.get("wait_for", [])), set(step.get("absent", []))
+    deadline = time.monotonic() + 60
+    names: set[str] = set()
+    found: list[Any] = []
+    while time.monotonic() < deadline:
+        found = get_topic_names_and_types(timeout=1.0, **c.where)
+        names = {n for n, _t in found}
+        if want <= names and not (gone & names):
+            break
+        time.sleep(0.2)
+    return {"topics": [[n, t] for n, t in found]}
+
+
+def publish(c: Client, step: dict[str, Any]) -> dict[str, Any]:
+    """`ros2 topic pub -r RATE -t COUNT`: the message `data` of `type` on `publish`."""
+    from rosbags.typesys.base import Nodetype
+    from zenoh_ros2_sdk import ROS2Publisher
+
+    type_name = step["type"]
+    pub = ROS2Publisher(step["publish"], type_name, **c.where)
+    store = pub.session_mgr.store
+    whole = _build(store, (Nodetype.NAME, type_name), step["data"])
+    fields = dict(store.fielddefs[type_name][1])
+    for _ in range(int(step.get("count", 1))):
+        pub.publish(**{k: getattr(whole, k) for k in fields})
+        time.sleep(float(step.get("period", 0.1)))
+    pub.close()
+    return {"published": step["publish"], "count": step.get("count", 1)}
+
+
+def echo(c: Client, step: dict[str, Any]) -> dict[str, Any]:
+    """`ros2 topic echo --once`: the first message on `echo` (60 s at most)."""
+    from zenoh_ros2_sdk import ROS2Subscriber
+
+    got: list[Any] = []
+    done = threading.Event()
+
+    def on_msg(msg: Any) -> None:
+        if not done.is_set():
+            got.append(_plain(msg))
+            done.set()
+
+    sub = ROS2Subscriber(step["echo"], step["type"], on_msg, **c.where)
+    done.wait(60.0)
+    sub.close()
+    return {"echo": step["echo"], "message": got[0] if got else None}
+
+
 def main() -> int:
     port, domain = int(sys.argv[1]), int(sys.argv[2])
     script = json.loads(Path(sys.argv[3]).read_text())
@@ -359,6 +411,7 @@ def main() -> int:
     for action in interfaces.ACTIONS:
         services += [f"{action}_SendGoal", f"{action}_GetResult"]
     messages = [f"{a}_FeedbackMessage" for a in interfaces.ACTIONS] + ["action_msgs/msg/GoalStatusArray"]
+    messages += ["geometry_msgs/msg/Twist", "nav_msgs/msg/Odometry"]
     messages += [
         f"{a}{s}_{part}"
         for a in interfaces.ACTIONS
@@ -394,6 +447,12 @@ def main() -> int:
             )
         elif "action" in step:
             log.append(run_action(c, step, log))
+        elif step.get("topics"):
+            log.append(wait_topics(c, step))
+        elif "publish" in step:
+            log.append(publish(c, step))
+        elif "echo" in step:
+            log.append(echo(c, step))
         out_path.write_text(json.dumps(log, default=str))
     out_path.write_text(json.dumps(log, default=str))
     os._exit(0)  # (the SDK's session threads would keep the process)
