@@ -129,6 +129,7 @@ class Bridge:
         self._dynamic: dict[Ident, list[Any]] = {}  # mapping -> its entities
         self._idents_of: dict[tuple[str, str], list[Ident]] = {}  # (pub|sub, sim key) -> its mappings
         self._dynamic_services: dict[str, list[Any]] = {}  # sim key -> its entities
+        self._closing = False
         if self._pending or mirror is not None:
             # one subscription follows the run's graph for both
             key = meta_key(run, "graph", "**")
@@ -141,6 +142,8 @@ class Bridge:
         e, role = found
         put = sample.kind == zenoh.SampleKind.PUT
         with self._lock:
+            if self._closing:
+                return
             if put and e.kind == "srv":
                 sp = self._pending.pop(e.key, None)
                 if sp is not None:
@@ -260,8 +263,9 @@ class Bridge:
 
     def _release(self, out: RosOut, source: str) -> None:
         out.users -= 1
-        with contextlib.suppress(Exception):  # (the session closing as the run ends)
-            out.forget(source)
+        if not self._closing:
+            with contextlib.suppress(Exception):  # (the session closing as the run ends)
+                out.forget(source)
         if out.users > 0 or self._ros_outs.get(out.key) is not out:
             return
         del self._ros_outs[out.key]
@@ -517,6 +521,12 @@ class Bridge:
         keep.append(_Undeclare(lambda: self.graph.withdraw("srv", key, sp.type)))
 
     def close(self) -> None:
+        with self._lock:
+            self._closing = True  # (nothing followed any more, no smaller /tf_static tree sent)
+            for held in [*self._dynamic.values(), *self._dynamic_services.values()]:
+                self._undo(held)
+            self._dynamic.clear()
+            self._dynamic_services.clear()
         for ent in reversed(self._keep):
             with contextlib.suppress(Exception):
                 ent.undeclare()
