@@ -1,7 +1,9 @@
 """`ros2: {topics: all}` follows the run's graph as it changes: a robot spawned into a running world (its
 plugins' publishers, subscribers and services announced as new world graph tokens) appears to ROS 2, and
-goes again when it is deleted (`ZenohBus.withdraw`: its entities undeclared, its tokens withdrawn); the
-same for a node that stops.
+goes again when it is deleted (`ZenohBus.withdraw`: its entities undeclared, its tokens withdrawn), and
+comes back when spawned again; the same for a node or a renderer process that stops. What is followed
+mid-run is mirrored as the plan mirrors what it knows from the start (checked against the compiler's own
+`mirror_all` / `mirror_services`).
 
 No scenario here: the bridge process (`python -m runner.launch.bridge`) joins a Zenoh router on loopback,
 and a second session plays the world with the world's own transport (`ZenohBus` with `GraphTokens` of
@@ -78,7 +80,7 @@ class RosView:
 
     def entities(self) -> list[tuple[str, str | None, str | None]]:
         with self.cond:
-            return sorted((i.kind, i.topic, i.dds_type) for i in self.tokens.values() if i.kind != "NN")
+            return self.entities_locked()
 
     def token_of(self, kind: str, topic: str) -> str:
         with self.cond:
