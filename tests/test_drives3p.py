@@ -71,7 +71,14 @@ HECTOR = """
   </gazebo>"""
 
 
-def _write(tmp_path: Path, extra: str, duration: float, timeline: str = "", name: str = "fb") -> Path:
+def _write(
+    tmp_path: Path,
+    extra: str,
+    duration: float,
+    timeline: str = "",
+    name: str = "fb",
+    link: str = "base_footprint",
+) -> Path:
     urdf = ROBOT.replace("MASS", str(MASS)).replace("WHEELS", WHEELS).replace("EXTRA", extra)
     return robot_scenario(
         tmp_path,
@@ -79,7 +86,7 @@ def _write(tmp_path: Path, extra: str, duration: float, timeline: str = "", name
         name=name,
         duration=duration,
         xyz=(0.0, 0.0, 0.0),
-        plugins="[{type: ground_truth, params: {rate: 500, topic: truth}}]",
+        plugins=f"[{{type: ground_truth, params: {{rate: 500, topic: truth, link: {link}}}}}]",
         timeline=timeline,
     )
 
@@ -154,3 +161,150 @@ def test_hector_force_based_move_follows_its_p_gain_dynamics(tmp_path: Path):
     assert np.allclose([m.twist.twist.linear.x for _, m in odom], vel[at, 0], atol=1e-6)
     tf = [m for _, m in messages(bus, "bot/tf") if m.transforms[0].child_frame_id == "bot/base_footprint"]
     assert len(tf) == len(odom) and tf[0].transforms[0].header.frame_id == "bot/odom"
+
+
+def test_robotnik_watchdog_stops_and_holds_the_base(tmp_path: Path):
+    """Robotnik's fork: hector's drive, and once no command came for <commandWatchdog> s it stops
+    pushing and puts the base back where it was, at rest, at every step."""
+    extra = """
+  <gazebo>
+    <plugin name="ros_force_based_move" filename="librobotnik_force_based_move.so">
+      <commandTopic>robotnik_base_control/cmd_vel</commandTopic>
+      <odometryTopic>robotnik_base_control/odom</odometryTopic>
+      <robotBaseFrame>base_footprint</robotBaseFrame>
+      <commandWatchdog>0.5</commandWatchdog>
+      <odometryRate>50.0</odometryRate>
+    </plugin>
+  </gazebo>"""
+    timeline = _cmd(0.2, "robotnik_base_control/cmd_vel", x=0.3)
+    path = _write(tmp_path, extra, duration=1.5, timeline=timeline)
+    plan, notices = compile_with_notices(path)
+    assert "not supported" not in notices
+    (drive,) = [p for p in plan.robots[0].plugins if p.type == "force_based_move"]
+    assert drive.params["cmd_timeout"] == 0.5 and drive.params["hold_on_timeout"] is True
+    _, bus = simulate(path)
+    t, pose, vel = _truth(bus)
+    moving = (t > 0.3) & (t < 0.7)
+    assert np.allclose(vel[moving, 0], 0.3, atol=0.01)  # kp 10000: at the command within a few steps
+    held = t > 0.75  # (the first steps after it show the one step of gravity and contact it lets act)
+    assert np.ptp(pose[held, 0]) < 1e-4 and np.abs(vel[held]).max() < 1e-3
+    assert pose[held, 0].mean() > 0.1  # where the watchdog fired, ~0.5 s × 0.3 m/s from the start
+    assert len(messages(bus, "bot/robotnik_base_control/odom")) > 0
+
+
+def test_ros2_port_force_limit_and_world_odometry(tmp_path: Path):
+    """The ROS 2 port: a PI controller clamped to <force_lim> (5 N on 22 kg: 0.227 m/s² at most), the
+    odometry the base's world pose on the (remapped) `odom` topic at <publish_rate>."""
+    extra = """
+  <gazebo>
+    <plugin name="force_based_move" filename="libgazebo_ros_force_based_move.so">
+      <ros><remapping>odom:=wheel_odom</remapping></ros>
+      <odometry_frame>odom</odometry_frame>
+      <robot_base_frame>base_footprint</robot_base_frame>
+      <publish_rate>10</publish_rate>
+      <vel_p_gain>1000</vel_p_gain>
+      <force_lim>5</force_lim>
+      <torque_lim>5</torque_lim>
+    </plugin>
+  </gazebo>"""
+    path = _write(tmp_path, extra, duration=2.0, timeline=_cmd(0.5, "cmd_vel", x=1.0))
+    _plan, notices = compile_with_notices(path)
+    assert "not supported" not in notices
+    _, bus = simulate(path)
+    t, pose, vel = _truth(bus)
+    ramp = (t > 0.6) & (t < 1.9)
+    slope = np.polyfit(t[ramp], vel[ramp, 0], 1)[0]
+    assert abs(slope - 5.0 / (MASS + 2.0)) < 0.01, slope
+    odom = messages(bus, "bot/wheel_odom")
+    assert abs(len(odom) - 20) <= 1
+    stamp, last = odom[-1]
+    i = int(np.argmin(abs(t - stamp / 1e9)))
+    assert abs(last.pose.pose.position.x - pose[i, 0]) < 1e-6  # the world pose, not integrated
+    assert last.header.frame_id == "bot/odom" and last.child_frame_id == "bot/base_footprint"
+
+
+WORLD_ODOMETRY = """
+  <gazebo>
+    <plugin name="p3d_base_controller" filename="libgazebo_ros_p3d.so">
+      <alwaysOn>true</alwaysOn>
+      <updateRate>100.0</updateRate>
+      <bodyName>base_link</bodyName>
+      <topicName>ground_truth/state</topicName>
+      <gaussianNoise>0.02</gaussianNoise>
+      <frameName>world</frameName>
+      <xyzOffset>1 2 0</xyzOffset>
+      <rpyOffset>0 0 0.5</rpyOffset>
+    </plugin>
+  </gazebo>
+  <gazebo>
+    <plugin name="world_odometry" filename="libgazebo_world_odometry.so">
+      <frameName>world</frameName>
+      <bodyName>base_link</bodyName>
+      <topicName>floating_base_pose_simulated</topicName>
+      <updateRate>50</updateRate>
+    </plugin>
+  </gazebo>
+  <gazebo>
+    <plugin name="ground_truth_controller" filename="librobotnik_gazebo_ground_truth_odom.so">
+      <updateRate>50.0</updateRate>
+      <bodyName>base_link</bodyName>
+      <frameName>base_link_gt</frameName>
+      <worldFrameName>odom</worldFrameName>
+      <topicName>odom_gt</topicName>
+      <broadcastTF>true</broadcastTF>
+    </plugin>
+  </gazebo>"""
+
+
+def test_world_odometry_plugins_publish_the_true_pose(tmp_path: Path):
+    """p3d (ROS 1), PAL's world odometry, Robotnik's ground truth on a base that drives forward while
+    turning: each on its topic, at its rate, in its frames; p3d's pose offset and twist noise, the twist
+    in the world frame (p3d), linear world / angular body (PAL), all body (Robotnik)."""
+    drive = HECTOR.replace("KYAW", "100").replace("KP", "10000")
+    timeline = _cmd(0.2, "base/cmd_vel", x=0.4, yaw=0.8)
+    path = _write(tmp_path, drive + WORLD_ODOMETRY, duration=2.0, timeline=timeline, link="base_link")
+    _plan, notices = compile_with_notices(path)
+    assert "not supported" not in notices and "xyzOffset" not in notices
+    _, bus = simulate(path)
+    truth = messages(bus, "bot/truth")
+    by_time = {s: m for s, m in truth}
+
+    def true_at(stamp: int) -> Any:
+        return by_time[stamp]
+
+    p3d = messages(bus, "bot/ground_truth/state")
+    assert abs(len(p3d) - 200) <= 1
+    assert p3d[0][1].header.frame_id == "world" and p3d[0][1].child_frame_id == "bot/base_link"
+    stamp, m = p3d[-1]
+    ref = true_at(stamp)
+    assert abs(m.pose.pose.position.x - (ref.pose.pose.position.x + 1.0)) < 1e-9
+    assert abs(m.pose.pose.position.y - (ref.pose.pose.position.y + 2.0)) < 1e-9
+    q, qr = m.pose.pose.orientation, ref.pose.pose.orientation
+    yaw = quat_to_yaw([q.w, q.x, q.y, q.z])
+    assert abs(math.remainder(yaw - quat_to_yaw([qr.w, qr.x, qr.y, qr.z]) - 0.5, 2 * math.pi)) < 1e-6
+    # twist: the world-frame velocity plus N(0, 0.02) on each component
+    errors = np.array(
+        [
+            [m.twist.twist.linear.x - true_at(s).twist.twist.linear.x, m.twist.twist.angular.z - 0.8]
+            for s, m in p3d
+            if s > 1.0e9
+        ]
+    )
+    assert abs(errors[:, 0].std() - 0.02) < 0.004 and abs(errors[:, 0].mean()) < 0.006
+    assert m.twist.covariance[0] == 0.02**2
+
+    pal = messages(bus, "bot/floating_base_pose_simulated")
+    assert abs(len(pal) - 100) <= 1
+    stamp, m = pal[-1]
+    ref = true_at(stamp)
+    assert m.header.frame_id == "world" and m.child_frame_id == "bot/base_link"
+    assert abs(m.pose.pose.position.x - ref.pose.pose.position.x) < 1e-9
+    assert abs(m.twist.twist.linear.y - ref.twist.twist.linear.y) < 1e-9  # world frame
+    assert abs(ref.twist.twist.linear.y) > 0.1  # (the heading has turned: world and body differ)
+
+    gt = messages(bus, "bot/odom_gt")
+    stamp, m = gt[-1]
+    assert m.header.frame_id == "bot/odom" and m.child_frame_id == "bot/base_link_gt"
+    assert abs(m.twist.twist.linear.x - 0.4) < 0.01 and abs(m.twist.twist.linear.y) < 0.01  # body frame
+    tf = [x for _, x in messages(bus, "bot/tf") if x.transforms[0].child_frame_id == "bot/base_link_gt"]
+    assert len(tf) == len(gt) and tf[0].transforms[0].header.frame_id == "bot/odom"
