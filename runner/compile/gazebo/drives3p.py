@@ -149,7 +149,6 @@ def _force_based_move_ros2(g: ReaderBase, r: TagReader, remap: dict[str, str]) -
         "max_torque": r.float("torque_lim") or 1.0,
         "odometry": "world",
     }
-    r.float("update_rate")  # read: the port computes a period from it and never uses it to control
     for key, tag in (("publish_odom", "publish_odom"), ("publish_tf", "publish_odom_tf")):
         value = r.bool(tag)
         if value is not None:
