@@ -308,3 +308,45 @@ def test_world_odometry_plugins_publish_the_true_pose(tmp_path: Path):
     assert abs(m.twist.twist.linear.x - 0.4) < 0.01 and abs(m.twist.twist.linear.y) < 0.01  # body frame
     tf = [x for _, x in messages(bus, "bot/tf") if x.transforms[0].child_frame_id == "bot/base_link_gt"]
     assert len(tf) == len(gt) and tf[0].transforms[0].header.frame_id == "bot/odom"
+
+
+def test_what_the_plugins_do_not_read_is_said_at_its_line(tmp_path: Path):
+    """A p3d without <topicName> stops loading (said, nothing published); ROS 1 p3d reads `xyzOffset`, so
+    the plural is said as no parameter of it; the ROS 2 port's <update_rate> and covariances are said as
+    ignored; a base frame the robot lacks is said at its tag."""
+    extra = """
+  <gazebo>
+    <plugin name="p3d_a" filename="libgazebo_ros_p3d.so">
+      <bodyName>base_link</bodyName>
+    </plugin>
+  </gazebo>
+  <gazebo>
+    <plugin name="p3d_b" filename="libgazebo_ros_p3d.so">
+      <bodyName>base_link</bodyName>
+      <topicName>gt</topicName>
+      <xyzOffsets>1 1 1</xyzOffsets>
+    </plugin>
+  </gazebo>
+  <gazebo>
+    <plugin name="fbm" filename="libgazebo_ros_force_based_move.so">
+      <update_rate>50</update_rate>
+      <covariance_x>0.1</covariance_x>
+      <robot_base_frame>chassis</robot_base_frame>
+    </plugin>
+  </gazebo>"""
+    path = _write(tmp_path, extra, duration=0.1)
+    plan, notices = compile_with_notices(path)
+    text = (tmp_path / "fb.urdf").read_text().splitlines()
+
+    def line_of(snippet: str) -> int:
+        return next(i + 1 for i, t in enumerate(text) if snippet in t)
+
+    assert f"fb.urdf:{line_of('p3d_a')}: 'libgazebo_ros_p3d.so' has no <topicName>" in notices
+    assert f"fb.urdf:{line_of('<xyzOffsets>')}: <xyzOffsets> is not a parameter" in notices
+    assert f"fb.urdf:{line_of('<update_rate>')}: <update_rate> in" in notices
+    assert f"fb.urdf:{line_of('<covariance_x>')}: <covariance_x> in" in notices
+    assert (
+        f"fb.urdf:{line_of('<robot_base_frame>')}: 'libgazebo_ros_force_based_move.so' pushes link" in notices
+    )
+    # the p3d without a topic adds nothing; the other one is a ground_truth (the scenario's own merges into it)
+    assert [p.name for p in plan.robots[0].plugins if p.type == "ground_truth"] == ["p3d_b"]
