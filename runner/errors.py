@@ -237,6 +237,11 @@ def kind_of(message: str) -> str:
     return _VARYING.sub("…", message)
 
 
+def varying_parts(message: str) -> list[str]:
+    """What `kind_of` takes out of `message`, in order: the quoted names, <tags> and numbers."""
+    return _VARYING.findall(message)
+
+
 @dataclass(frozen=True)
 class Notice:
     """A warning: something in an input that we read but do not act on (never fatal, never silent).

@@ -144,3 +144,18 @@ def test_run_says_what_changes_the_run_at_its_start(noisy: Path) -> None:
     assert "listens on 'r1/diff_cont/cmd_vel_unstamped'" in start
     assert "<visualize>" not in start  # (validate lists those)
     assert f"{COMMANDS + SENSORS + 1} warning(s): `scenario validate` lists them" in start
+
+
+def test_the_others_of_a_kind_are_said_by_line_and_what_names_them_apart() -> None:
+    """A typo'd tag in each of four plugins: the others' lines with their tags; one line said several
+    times (a macro expanded for each wheel) once, with how many; another file's path where it changes."""
+    from runner.cli.notices import more_text
+    from runner.plan import NoticePlan
+
+    def notice(tag: str, line: int, file: str = "a.xacro") -> NoticePlan:
+        return NoticePlan(message=f"<{tag}> is not a parameter of 'libx.so'", file=file, line=line)
+
+    first = notice("topicName", 24)
+    more = [notice("topic_name_twist", 29), notice("x", 30), notice("x", 30), notice("y", 3, "b.xacro")]
+    assert more_text(first, more) == "(and 4 more: 29 <topic_name_twist>, 30 <x> (x2), b.xacro:3 <y>)"
+    assert more_text(first, [first] * 12, shown=8) == "(and 12 more: 24 (x12))"

@@ -8,11 +8,19 @@ kind, and `--strict` counts each."""
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 from runner.cli.console import err
-from runner.errors import DRIVE_GEOMETRY, NO_PUBLISHER, PLUGIN_UNSUPPORTED, UNSUBSCRIBED, kind_of
+from runner.errors import (
+    DRIVE_GEOMETRY,
+    NO_PUBLISHER,
+    PLUGIN_UNSUPPORTED,
+    UNSUBSCRIBED,
+    kind_of,
+    varying_parts,
+)
 from runner.plan import NoticePlan
 
 # The kinds of warning that change what the run does, in the order they are said: a command that reaches
@@ -64,22 +72,36 @@ def group_notices(
     return leading, rest
 
 
-def more_text(
-    first_file: str | None, more: list[tuple[str | None, int | None]], shown: int = MORE_SHOWN
-) -> str:
-    """ "(and 12 more: 40, 52 (x3), wheel.xacro:3, ...)": the others' locations, in order, a file's path
-    said where it changes (the first's file is said on its own line), one location said several times
-    once with how many, up to `shown` locations."""
-    places: dict[tuple[str | None, int | None], int] = {}
-    for at in more:
+def _differs(first: NoticePlan, other: NoticePlan) -> str:
+    """What names `other` apart from `first`, where it is short enough to say beside its line: the first of
+    its varying parts (runner.errors.varying_parts) that differs from the first's, when that is a bare
+    <tag> or a short quoted name (`<broadcastTF>`, `'wheel_2'`); "" otherwise (a number, a long name)."""
+    mine, theirs = varying_parts(first.message), varying_parts(other.message)
+    for a, b in zip(mine, theirs, strict=False):
+        if a != b:
+            return b if _TAG.fullmatch(b) or (b[:1] in "'\"`" and len(b) <= _NAME_SAID) else ""
+    return ""
+
+
+_TAG = re.compile(r"</?[A-Za-z_][\w:.-]*/?>")
+_NAME_SAID = 34  # a quoted name longer than this is not said beside its line
+
+
+def more_text(first: NoticePlan, more: list[NoticePlan], shown: int = MORE_SHOWN) -> str:
+    """ "(and 12 more: 40 <x>, 52 (x3), wheel.xacro:3, ...)": the others' locations in order, each with
+    what names it apart where that is short (`_differs`), a file's path said where it changes (the
+    first's file is said on its own line), one said several times once with how many, up to `shown`."""
+    places: dict[tuple[str | None, int | None, str], int] = {}
+    for m in more:
+        at = (m.file, m.line, _differs(first, m))
         places[at] = places.get(at, 0) + 1
-    parts, file = [], first_file
-    for (f, line), times in list(places.items())[:shown]:
+    parts, file = [], first.file
+    for (f, line, what), times in list(places.items())[:shown]:
         where = "" if line is None else str(line)
         if f != file:
             where = f"{f or '<scenario>'}" + (f":{where}" if where else "")
             file = f
-        parts.append((where or "?") + (f" (x{times})" if times > 1 else ""))
+        parts.append((where or "?") + (f" {what}" if what else "") + (f" (x{times})" if times > 1 else ""))
     tail = ", ..." if len(places) > shown else ""
     return f"(and {len(more)} more: {', '.join(parts)}{tail})"
 
@@ -89,7 +111,7 @@ def _say(group: NoticeGroup) -> None:
     head, _, hint = n.text.partition("\n")
     err.print("warning: " + head, markup=False, style="yellow")
     if group.more:
-        err.print("  " + more_text(n.file, [(m.file, m.line) for m in group.more]), markup=False)
+        err.print("  " + more_text(n, group.more), markup=False)
     if hint:
         err.print(hint, markup=False)
 
