@@ -30,8 +30,8 @@ from runner.plan import NoticePlan
 # (a tag of the GUI, an ODE contact setting): worth knowing, not first.
 LEADING = (UNSUBSCRIBED, DRIVE_GEOMETRY, PLUGIN_UNSUPPORTED, NO_PUBLISHER)
 LEADING_HEADING = (
-    "what changes the run (commands that reach nothing, drives scaled by their declared wheels, plugins and "
-    "sensors left out, sensors that publish nothing):"
+    "what changes the run, most first (commands that reach nothing, drives scaled by their declared wheels, "
+    "plugins and sensors left out, sensors that publish nothing):"
 )
 GROUP_FROM = 3  # a kind said this many times or more is one line (two are said as they are)
 MORE_SHOWN = 8  # locations listed after "and N more"
@@ -126,7 +126,7 @@ def print_notices(items: list[NoticePlan], verbose: bool, every: bool = False) -
     lines = len(leading) + len(rest)
     if not verbose:
         if leading:
-            err.print(LEADING_HEADING, markup=False)
+            err.print(LEADING_HEADING, markup=False, style="bold")
             for g in leading:
                 _say(g)
         err.print(f"{len(items)} warning(s): `scenario validate` lists them", markup=False)
@@ -140,10 +140,10 @@ def print_notices(items: list[NoticePlan], verbose: bool, every: bool = False) -
     else:
         err.print(f"{len(items)} warning(s):", markup=False)
     if leading:
-        err.print(LEADING_HEADING, markup=False)
+        err.print(LEADING_HEADING, markup=False, style="bold")
         for g in leading:
             _say(g)
         if rest:
-            err.print("the rest:", markup=False)
+            err.print("the rest:", markup=False, style="bold")
     for g in rest:
         _say(g)
