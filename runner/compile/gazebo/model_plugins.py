@@ -16,6 +16,7 @@ from runner.compile.gazebo.control.drives import by_wheels
 from runner.compile.gazebo.controllers import ros_control
 from runner.compile.gazebo.tables import IGNORED_REASONS, NOOP_PLUGINS
 from runner.compile.gazebo.tags import TagReader, floats, plugin_base, ros_topic
+from runner.errors import PLUGIN_UNSUPPORTED
 
 
 def read_model_plugin(g: ReaderBase, p: Any, link: str | None) -> None:
@@ -39,6 +40,7 @@ def read_model_plugin(g: ReaderBase, p: Any, link: str | None) -> None:
             f"plugin {filename!r} is not supported and is ignored",
             hint="model plugins we map: " + ", ".join(sorted(_MODEL_PLUGINS)) + ". Add a plugin of ours "
             "under the robot's `plugins:` in the scenario instead.",
+            kind=PLUGIN_UNSUPPORTED,
         )
         return
     ros = g.ros_block(r)
