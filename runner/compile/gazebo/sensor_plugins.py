@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from runner.compile.gazebo import thirdparty
+from runner.compile.gazebo import range_plugins, thirdparty
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.tables import (
     CAMERA_KNOWN,
@@ -23,7 +23,8 @@ from runner.compile.gazebo.tables import (
 )
 from runner.compile.gazebo.tags import TagReader, floats, is_zero, join_topic, plugin_base, ros_topic
 
-_SENSOR_PLUGINS = ROS_SENSOR_PLUGINS | thirdparty.SENSOR_PLUGINS  # velodyne_simulator, hector's sonar
+# velodyne_simulator, hector's sonar; gazebo_ros_range (ROS 1)
+_SENSOR_PLUGINS = ROS_SENSOR_PLUGINS | thirdparty.SENSOR_PLUGINS | range_plugins.RANGE_PLUGINS
 
 
 def read_sensor_plugins(
@@ -51,6 +52,11 @@ def read_sensor_plugins(
         elif base in thirdparty.SENSOR_PLUGINS:
             extra, rates = thirdparty.sensor_plugin(g, r, base, remap, sensor, kind, context)
             found.update(extra)
+        elif base in range_plugins.RANGE_PLUGINS:
+            found.update(range_plugins.ros1_range(g, r, context))
+            rates = ("updateRate",)  # throttles the sensor's updates (gazebo_ros_range.cpp:117-131, 230)
+        elif base == "gazebo_ros_ray_sensor":
+            found.update(range_plugins.ros2_ray_sensor(g, r, remap, context))
         else:
             rates = _ros_sensor_plugin(g, r, base, remap, out_names, context, found)
         _plugin_rates(g, r, rates, filename, found)

@@ -74,6 +74,11 @@ def read_sensor(g: ReaderBase, el: Any, link: str | None) -> None:
 def _lidar_sensor(g: ReaderBase, s: _Sensor) -> bool:
     params = {**s.common, **_lidar(g, s.r, s.el, s.context)}
     ros = read_sensor_plugins(g, s.plugins, s.context, ("out", "scan"), s.name, s.kind)
+    if ros.get("nothing"):  # its plugin publishes nothing, as said (gazebo_ros_range, ray_sensor)
+        g.ignored(s.r, s.context)
+        return False
+    if "rate" not in (ros.get("params") or {}):
+        _plugin_rate(params, s.rate, ros)  # gazebo_ros_range's <updateRate> throttles the sensor
     params["topic"] = ros.get("topic") or s.base_topic or "scan"
     params["frame_id"] = ros.get("frame") or s.frame
     if ros.get("noise"):  # gazebo_ros_block_laser adds its <gaussianNoise> to the sensor's noise
