@@ -194,9 +194,37 @@ def _camera_plugin(
         out.update(_ros1_camera_topics(r))
         own, other = ROS1_CAMERA_PARAMS, ROS2_CAMERA_PARAMS
     r.mark(*(t for t in own if p.find(t) is not None))
+    if depth:
+        out["params"] = _depth_clip(r, base, ros2)
     if ros2 and r.bool("triggered"):
         g.note(p.find("triggered"), "<triggered> is ignored: the camera publishes at its rate")
     _camera_params_unread(g, r, filename, ros2, own, other, depth)
+    return out
+
+
+def _depth_clip(r: TagReader, base: str, ros2: bool) -> dict[str, Any]:
+    """What the depth plugin does with depths outside its limits, in its depth image and point cloud:
+
+    - ROS 2 `gazebo_ros_camera` on a depth sensor: `<min_depth>` (default 0.4) and `<max_depth>` (default
+      +inf); at or below the min -inf, at or beyond the max +inf, in the image and as x = y = z of the
+      cloud's point (gazebo_ros_camera.cpp:476-478, 679-685, 750-768);
+    - ROS 1 `gazebo_ros_depth_camera`: `<pointCloudCutoff>` (default 0.4): at or below it NaN in the image
+      and the cloud (gazebo_ros_depth_camera.cpp:126-129, 675-680, 754-766); it has no upper cut-off;
+    - ROS 1 `gazebo_ros_openni_kinect`: `<pointCloudCutoff>` (0.4) and `<pointCloudCutoffMax>` (5.0), NaN
+      outside (gazebo_ros_openni_kinect.cpp:101-108, 361-374, 454-465)."""
+    if ros2:
+        lo = r.float("min_depth")
+        hi = r.float("max_depth")
+        return {
+            "min_depth": 0.4 if lo is None else lo,
+            "max_depth": hi if hi is not None and hi != float("inf") else None,
+            "out_of_range": "inf",
+        }
+    lo = r.float("pointCloudCutoff")
+    out: dict[str, Any] = {"min_depth": 0.4 if lo is None else lo, "out_of_range": "nan"}
+    if base == "gazebo_ros_openni_kinect":
+        hi = r.float("pointCloudCutoffMax")
+        out["max_depth"] = 5.0 if hi is None else hi
     return out
 
 
@@ -275,8 +303,17 @@ def _camera_params_unread(
             )
     for tag in ("pointCloudCutoff", "pointCloudCutoffMax", "min_depth", "max_depth"):
         el = p.find(tag)
-        if el is not None and tag in own and depth:
-            g.note(el, f"<{tag}> is not applied: depth and points span the clip planes (<near>..<far>)")
+        if el is not None and tag in own and not depth:
+            g.note(
+                el, f"<{tag}> is read only on a depth sensor: a camera has no depth (Gazebo ignores it too)"
+            )
+    cut_max = p.find("pointCloudCutoffMax")
+    if cut_max is not None and depth and not ros2 and plugin_base(filename) != "gazebo_ros_openni_kinect":
+        g.note(
+            cut_max,
+            f"<pointCloudCutoffMax> is not read by {filename!r} (only by libgazebo_ros_openni_kinect.so): "
+            "Gazebo ignores it too",
+        )
     for tag in ("Cx", "Cy", "CxPrime", "focalLength", "cx", "cy", "focal_length"):
         el = p.find(tag)
         if el is not None and tag in own and not is_zero(el.text):

@@ -144,6 +144,7 @@ def _depth_sensor(g: ReaderBase, s: _Sensor) -> bool:
             points_topic=ros["points"],
         )
     params["frame_id"] = ros.get("frame") or s.frame
+    params.update(ros.get("params") or {})  # the plugin's depth limits (sensor_plugins._depth_clip)
     _plugin_rate(params, s.rate, ros)
     g.add(s.el, "depth_camera", s.name, params)
     return True
