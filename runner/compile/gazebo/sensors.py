@@ -12,7 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from runner.compile.gazebo import thirdparty
+from runner.compile.gazebo import field_sensors, thirdparty
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.noise import NoiseSpec, classic_noise_spec, noise_spec, noise_stddev
 from runner.compile.gazebo.sensor_plugins import read_sensor_plugins
@@ -65,7 +65,7 @@ def read_sensor(g: ReaderBase, el: Any, link: str | None) -> None:
             el,
             f"sensor type {kind!r} is not supported yet; {context} is ignored",
             hint="supported: ray, gpu_ray, lidar, gpu_lidar, camera, depth, depth_camera, rgbd_camera, "
-            "imu, contact",
+            "imu, contact, gps, magnetometer, air_pressure, altimeter, force_torque",
         )
         return
     g.ignored(r, context)
@@ -189,6 +189,11 @@ _KINDS: dict[str, Callable[[ReaderBase, _Sensor], bool]] = {
     **dict.fromkeys(("depth", "depth_camera", "rgbd_camera", "rgbd"), _depth_sensor),
     "imu": _imu_sensor,
     "contact": _contact_sensor,
+    # runner/compile/gazebo/field_sensors.py
+    "magnetometer": field_sensors.magnetometer,
+    "air_pressure": field_sensors.air_pressure,
+    "altimeter": field_sensors.altimeter,
+    "force_torque": field_sensors.force_torque,
 }
 
 

@@ -1,0 +1,203 @@
+"""Gazebo's magnetometer, air pressure, altimeter and force/torque sensors as robot descriptions declare them
+(`<sensor type=...>` in `<gazebo reference>` blocks): topics and types, and the values against geometry and
+physics, the world stepped in-process (real MuJoCo): a magnetometer's field turns with the robot's yaw,
+the pressure falls with height as gz-sensors' atmosphere does, an altimeter follows a free fall, an F/T
+sensor under a known mass reads its weight and moment."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from plugins.field_sensors import SDF_MAGNETIC_FIELD
+from tests.helpers import compile_with_notices, declared, messages, simulate
+
+G = 9.81  # the scenario world's gravity
+
+ROBOT = """<?xml version="1.0"?>
+<robot name="t">
+  <link name="base_link">
+    <collision><geometry><box size="0.3 0.2 0.1"/></geometry></collision>
+    <inertial><mass value="2.0"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+  </link>
+  <link name="mast">
+    <inertial><mass value="0.01"/><inertia ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" iyz="0" izz="1e-6"/></inertial>
+  </link>
+  <joint name="mast_joint" type="fixed"><parent link="base_link"/><child link="mast"/>
+    <origin xyz="0 0 1.0"/></joint>
+  <gazebo reference="base_link">
+    <sensor name="mag" type="magnetometer">
+      <update_rate>50</update_rate>
+      <magnetometer>
+        <x><noise type="gaussian"><mean>0</mean><stddev>1e-7</stddev></noise></x>
+        <y><noise type="gaussian"><mean>0</mean><stddev>1e-7</stddev></noise></y>
+        <z><noise type="gaussian"><mean>0</mean><stddev>1e-7</stddev></noise></z>
+      </magnetometer>
+    </sensor>
+    <sensor name="baro_low" type="air_pressure">
+      <update_rate>50</update_rate>
+      <air_pressure><reference_altitude>500</reference_altitude></air_pressure>
+    </sensor>
+    <sensor name="alt" type="altimeter">
+      <update_rate>100</update_rate>
+      <topic>altimeter</topic>
+      <altimeter>
+        <vertical_position><noise type="gaussian"><mean>0</mean><stddev>0</stddev></noise></vertical_position>
+      </altimeter>
+    </sensor>
+  </gazebo>
+  <gazebo reference="mast">
+    <sensor name="baro_high" type="air_pressure">
+      <update_rate>50</update_rate>
+      <topic>baro/high</topic>
+      <air_pressure>
+        <reference_altitude>500</reference_altitude>
+        <pressure><noise type="gaussian"><mean>0</mean><stddev>0.5</stddev></noise></pressure>
+      </air_pressure>
+    </sensor>
+  </gazebo>
+</robot>
+"""
+
+
+def _scenario(
+    tmp_path: Path, urdf: str, xyz: tuple[float, float, float], yaw: float, duration: float
+) -> Path:
+    (tmp_path / "t.urdf").write_text(urdf)
+    path = tmp_path / "s.yaml"
+    path.write_text(
+        f"name: g\nduration: {duration}\nrate: max\nseed: 1\nrobots:\n  - name: bot\n    description: t.urdf\n"
+        f"    pose: {{xyz: {list(xyz)}, rpy: [0, 0, {yaw}]}}\n    plugins: []\n"
+    )
+    return path
+
+
+def _topics(plan) -> dict[str, str]:  # type: ignore[no-untyped-def]
+    return {
+        t.key.removeprefix("g/bot/"): t.type
+        for p in declared(plan.robots[0])
+        for t in p.topics
+        if t.key.startswith("g/bot/")
+    }
+
+
+def _pressure(h: float) -> float:
+    """The 1976 standard atmosphere's troposphere at geopotential height of `h` m (the model gz-sensors
+    takes from RotorS): p0 (T0 / (T0 - L h'))^(-g M / (R L))."""
+    hg = 6356766.0 * h / (6356766.0 + h)
+    return 101325.0 * (1 - 0.0065 * hg / 288.15) ** (9.80665 * 28.9644 / (8314.32 * 0.0065))
+
+
+def test_magnetometer_pressure_and_altimeter_of_a_falling_yawed_robot(tmp_path: Path):
+    """Dropped from 2 m, yawed 0.7 rad: the field in the sensor frame is the world's turned by -yaw; the
+    altimeter reads the fall, -g t²/2 and -g t; the pressure rises as it falls, 1 m above reads less."""
+    yaw = 0.7
+    path = _scenario(tmp_path, ROBOT, (0.0, 0.0, 2.0), yaw, 0.4)
+    plan, notices = compile_with_notices(path)
+    assert "not supported" not in notices and "is ignored" not in notices, notices
+    assert _topics(plan) == {
+        "magnetometer": "sensor_msgs/msg/MagneticField",
+        "air_pressure": "sensor_msgs/msg/FluidPressure",
+        "baro/high": "sensor_msgs/msg/FluidPressure",
+        "altimeter": "ros_gz_interfaces/msg/Altimeter",
+    }
+    _, bus = simulate(path)
+    mag = messages(bus, "bot/magnetometer")
+    assert abs(len(mag) - 20) <= 1
+    fx, fy, fz = SDF_MAGNETIC_FIELD
+    expected = [fx * math.cos(yaw) + fy * math.sin(yaw), -fx * math.sin(yaw) + fy * math.cos(yaw), fz]
+    got = np.array([[m.magnetic_field.x, m.magnetic_field.y, m.magnetic_field.z] for _, m in mag])
+    assert np.allclose(got.mean(axis=0), expected, atol=5e-8)
+    assert abs(got[:, 0].std() / 1e-7 - 1) < 0.4
+    assert mag[-1][1].header.frame_id == "bot/base_link"
+
+    alt = messages(bus, "bot/altimeter")
+    t, msg = alt[-1]
+    ts = t / 1e9
+    assert abs(msg.vertical_reference - 2.0) < 1e-6
+    assert abs(msg.vertical_position + 0.5 * G * ts**2) < 0.02
+    assert abs(msg.vertical_velocity + G * ts) < 0.05
+
+    low = messages(bus, "bot/air_pressure")
+    high = messages(bus, "bot/baro/high")
+    for t1, lo in low:
+        z = 2.0 - 0.5 * G * (t1 / 1e9) ** 2
+        assert abs(lo.fluid_pressure - _pressure(500 + z)) < 0.3
+        assert lo.variance == 0.0
+    # one metre up: ~11.7 Pa less at 500 m (rho g, rho ~1.17 kg/m³), with 0.5 Pa of noise
+    diff = np.array(
+        [lo.fluid_pressure - hi.fluid_pressure for (_, lo), (_, hi) in zip(low, high, strict=True)]
+    )
+    assert abs(diff.mean() - (_pressure(500) - _pressure(501))) < 0.3
+    assert 11.0 < _pressure(500) - _pressure(501) < 12.0
+    assert high[-1][1].variance == math.sqrt(0.5)  # as gz-sensors writes it
+
+
+FT_ROBOT = """<?xml version="1.0"?>
+<robot name="t">
+  <link name="base_link">
+    <collision><geometry><box size="0.4 0.4 0.1"/></geometry></collision>
+    <inertial><mass value="5.0"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>
+  </link>
+  <link name="payload">
+    <inertial><origin xyz="0.1 0 0"/><mass value="1.5"/>
+      <inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-3"/></inertial>
+  </link>
+  <joint name="ft_joint" type="fixed"><parent link="base_link"/><child link="payload"/>
+    <origin xyz="0 0 0.1" rpy="0.4 0 0"/></joint>
+  <gazebo reference="ft_joint">
+    <preserveFixedJoint>true</preserveFixedJoint>
+    <sensor name="ft" type="force_torque">
+      <update_rate>100</update_rate>
+      FT_BLOCK
+    </sensor>
+  </gazebo>
+</robot>
+"""
+
+
+def test_force_torque_reads_the_weight_and_moment_of_its_payload(tmp_path: Path):
+    """1.5 kg held 0.1 m out along the child's x, the joint rolled 0.4 rad: Gazebo's defaults (child frame,
+    child_to_parent) read the weight the payload puts on the base, in the payload's frame; `parent` and
+    `parent_to_child` turn and flip it."""
+    results = {}
+    for name, block in (
+        ("default", ""),
+        (
+            "parent",
+            "<force_torque><frame>parent</frame><measure_direction>parent_to_child</measure_direction>"
+            "</force_torque>",
+        ),
+    ):
+        sub = tmp_path / name
+        sub.mkdir()
+        path = _scenario(sub, FT_ROBOT.replace("FT_BLOCK", block), (0.0, 0.0, 0.05), 0.0, 0.5)
+        plan, notices = compile_with_notices(path)
+        assert "not supported" not in notices and "left out" not in notices, notices
+        assert _topics(plan) == {"ft/forcetorque": "geometry_msgs/msg/WrenchStamped"}
+        _, bus = simulate(path)
+        wrenches = messages(bus, "bot/ft/forcetorque")
+        assert abs(len(wrenches) - 50) <= 1
+        w = wrenches[-1][1].wrench
+        results[name] = np.array([w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z])
+    m, roll = 1.5, 0.4
+    weight_world = np.array([0.0, 0.0, -m * G])  # what the payload puts on the base
+    r_child = np.array([[1, 0, 0], [0, math.cos(roll), -math.sin(roll)], [0, math.sin(roll), math.cos(roll)]])
+    arm_world = r_child @ np.array([0.1, 0.0, 0.0])
+    torque_world = np.cross(arm_world, weight_world)  # about the joint's origin
+    default = np.concatenate([r_child.T @ weight_world, r_child.T @ torque_world])
+    assert np.allclose(results["default"], default, atol=0.02), results["default"]
+    # the base lies flat: its frame is the world's; the wrench the base applies on the payload
+    assert np.allclose(results["parent"], -np.concatenate([weight_world, torque_world]), atol=0.02)
+
+
+def test_force_torque_outside_a_joint_is_left_out(tmp_path: Path):
+    urdf = FT_ROBOT.replace('<gazebo reference="ft_joint">', '<gazebo reference="payload">').replace(
+        "FT_BLOCK", ""
+    )
+    path = _scenario(tmp_path, urdf, (0.0, 0.0, 0.05), 0.0, 0.1)
+    plan, notices = compile_with_notices(path)
+    assert "mounts a force_torque sensor on a joint only" in notices
+    assert "ft/forcetorque" not in _topics(plan)
