@@ -3,6 +3,10 @@
 - `magnetometer` -> sensor_msgs/MagneticField: the world's magnetic field (`field`, tesla, in the world
   frame; SDF's default world `<magnetic_field>`) rotated into the sensor frame (gz-sensors
   MagnetometerSensor.cc:162-165), plus per-axis white noise and a constant mean (:174-196);
+  As hector_gazebo_plugins' magnetometer (`libhector_gazebo_ros_magnetic.so`, gazebo_ros_magnetic.cpp:
+  121-130, 167-173), the message may be a geometry_msgs/Vector3Stamped (`message`), and the error a drifting
+  bias per axis (`drift`, `drift_frequency`: hector's SensorModel, plugins/_drift.py) on top of the
+  constant `noise_mean` and the white noise;
 - `air_pressure` -> sensor_msgs/FluidPressure: the pressure (Pa) of the standard atmosphere at the height
   `reference_altitude` + the sensor's world z, as gz-sensors AirPressureSensor.cc:165-182 (after RotorS:
   geopotential height, a linear temperature lapse from 288.15 K at sea level), plus white noise; the
@@ -17,12 +21,14 @@ The sensors read MuJoCo's state at a site on `link` (at `pose`), after each step
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 import mujoco
 import numpy as np
 from pydantic import Field
 
 from plugins._common import MountPose, add_site, pick_link
+from plugins._drift import DriftingBias
 from runner.plugin import BuildContext, Plugin, RatedParams, Topic
 from runner.wire import msgs
 
@@ -86,6 +92,17 @@ class MagnetometerParams(_SiteParams):
     )
     noise_stddev: Vector3 = Field((0.0, 0.0, 0.0), description="White noise per sensor axis, tesla.")
     noise_mean: Vector3 = Field((0.0, 0.0, 0.0), description="Constant error per sensor axis, tesla.")
+    drift: Vector3 = Field(
+        (0.0, 0.0, 0.0),
+        description="Scale of a drifting error per axis (from N(0, drift)), as hector's.",
+    )
+    drift_frequency: Vector3 = Field(
+        (1 / 3600, 1 / 3600, 1 / 3600), description="Frequency of that drift per axis, Hz."
+    )
+    message: Literal["sensor_msgs/msg/MagneticField", "geometry_msgs/msg/Vector3Stamped"] = Field(
+        "sensor_msgs/msg/MagneticField",
+        description="The message type (hector's magnetometer publishes a Vector3Stamped by default).",
+    )
 
 
 class Magnetometer(_SiteSensor):
@@ -94,28 +111,36 @@ class Magnetometer(_SiteSensor):
     link_hints = ("mag", "magnetometer", "compass")
     message = "sensor_msgs/msg/MagneticField"
 
+    @classmethod
+    def build(cls, params: MagnetometerParams, ctx: BuildContext, name: str) -> list[Topic]:  # type: ignore[override]
+        add_site(ctx, pick_link(ctx, params.link, cls.link_hints), name, params.pose)
+        return [Topic(params.topic, params.message, "pub", params.rate)]
+
     def setup(self) -> None:
+        self.message = self.params.message
         super().setup()
-        self.field = np.array(self.params.field, dtype=float)
-        self.sd = np.array(self.params.noise_stddev, dtype=float)
-        self.mean = np.array(self.params.noise_mean, dtype=float)
+        p = self.params
+        self.field = np.array(p.field, dtype=float)
+        self.sd = np.array(p.noise_stddev, dtype=float)
+        self.mean = np.array(p.noise_mean, dtype=float)
+        rng = self.ctx.rng
+        start = rng.normal(0.0, 1.0, 3) * np.array(p.drift) if any(p.drift) else np.zeros(3)
+        self.bias = DriftingBias(rng, start, p.drift, p.drift_frequency, 1.0 / p.rate)
 
     def after_step(self, now_ns: int) -> None:
         rot = self.ctx.data.site_xmat[self.site].reshape(3, 3)
         local = rot.T @ self.field + self.mean  # MagnetometerSensor.cc:163-165: world -> sensor frame
+        local = local + self.bias.update()  # hector's drifting error (constant when its frequency is 0)
         if self.sd.any():
             local = local + self.ctx.rng.normal(0.0, 1.0, 3) * self.sd
         T = msgs.T
-        self.pub.publish(
-            T[self.message](
-                header=msgs.header(now_ns, self.frame_id),
-                magnetic_field=T["geometry_msgs/msg/Vector3"](
-                    x=float(local[0]), y=float(local[1]), z=float(local[2])
-                ),
-                magnetic_field_covariance=np.zeros(9),  # ros_gz_bridge leaves it unset
-            ),
-            now_ns,
-        )
+        vec = T["geometry_msgs/msg/Vector3"](x=float(local[0]), y=float(local[1]), z=float(local[2]))
+        header = msgs.header(now_ns, self.frame_id)
+        if self.message == "geometry_msgs/msg/Vector3Stamped":
+            msg = T[self.message](header=header, vector=vec)
+        else:  # ros_gz_bridge and hector leave the covariance unset (all zero: unknown)
+            msg = T[self.message](header=header, magnetic_field=vec, magnetic_field_covariance=np.zeros(9))
+        self.pub.publish(msg, now_ns)
 
 
 class AirPressureParams(_SiteParams):

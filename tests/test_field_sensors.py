@@ -201,3 +201,42 @@ def test_force_torque_outside_a_joint_is_left_out(tmp_path: Path):
     plan, notices = compile_with_notices(path)
     assert "mounts a force_torque sensor on a joint only" in notices
     assert "ft/forcetorque" not in _topics(plan)
+
+
+HECTOR_MAG = """
+  <gazebo>
+    <plugin name="magnetometer" filename="libhector_gazebo_ros_magnetic.so">
+      <updateRate>20</updateRate>
+      <bodyName>base_link</bodyName>
+      <topicName>magnetic</topicName>
+      <frameId>base_link</frameId>
+      <magnitude>0.5</magnitude>
+      <referenceHeading>0</referenceHeading>
+      <declination>10</declination>
+      <inclination>60</inclination>
+      <offset>0.01 0 0</offset>
+      <gaussianNoise>0.002 0.002 0.002</gaussianNoise>
+    </plugin>
+  </gazebo>
+"""
+
+
+def test_hector_magnetometer_turns_its_field_with_the_robot(tmp_path: Path):
+    """hector's field (magnitude 0.5, inclination 60°, declination 10°) in the yawed body frame, its offset
+    and noise, on a geometry_msgs/Vector3Stamped (hector's default message)."""
+    yaw = -1.2
+    urdf = ROBOT.replace("</robot>", HECTOR_MAG + "</robot>")
+    path = _scenario(tmp_path, urdf, (0.0, 0.0, 0.05), yaw, 2.0)
+    plan, notices = compile_with_notices(path)
+    assert "not supported" not in notices and "magnetic" not in notices, notices
+    assert _topics(plan)["magnetic"] == "geometry_msgs/msg/Vector3Stamped"
+    _, bus = simulate(path)
+    mag = messages(bus, "bot/magnetic")
+    assert abs(len(mag) - 40) <= 1 and mag[-1][1].header.frame_id == "bot/base_link"
+    inc, dec = math.radians(60), math.radians(10)
+    world = 0.5 * np.array([math.cos(inc) * math.cos(-dec), math.cos(inc) * math.sin(-dec), -math.sin(inc)])
+    c, s = math.cos(yaw), math.sin(yaw)
+    body = np.array([c * world[0] + s * world[1], -s * world[0] + c * world[1], world[2]]) + [0.01, 0, 0]
+    got = np.array([[m.vector.x, m.vector.y, m.vector.z] for _, m in mag])
+    assert np.allclose(got.mean(axis=0), body, atol=0.0015)
+    assert abs(got.std(axis=0).mean() / 0.002 - 1) < 0.3
