@@ -236,7 +236,9 @@ def test_hector_magnetometer_turns_its_field_with_the_robot(tmp_path: Path):
     inc, dec = math.radians(60), math.radians(10)
     world = 0.5 * np.array([math.cos(inc) * math.cos(-dec), math.cos(inc) * math.sin(-dec), -math.sin(inc)])
     c, s = math.cos(yaw), math.sin(yaw)
-    body = np.array([c * world[0] + s * world[1], -s * world[0] + c * world[1], world[2]]) + [0.01, 0, 0]
+    body = np.array([c * world[0] + s * world[1], -s * world[0] + c * world[1], world[2]]) + np.array(
+        [0.01, 0, 0]
+    )
     got = np.array([[m.vector.x, m.vector.y, m.vector.z] for _, m in mag])
     assert np.allclose(got.mean(axis=0), body, atol=0.0015)
     assert abs(got.std(axis=0).mean() / 0.002 - 1) < 0.3
