@@ -135,7 +135,7 @@ def test_magnetometer_pressure_and_altimeter_of_a_falling_yawed_robot(tmp_path: 
     assert high[-1][1].variance == math.sqrt(0.5)  # as gz-sensors writes it
 
 
-FT_ROBOT = """<?xml version="1.0"?>
+FT_LINKS = """<?xml version="1.0"?>
 <robot name="t">
   <link name="base_link">
     <collision><geometry><box size="0.4 0.4 0.1"/></geometry></collision>
@@ -147,15 +147,19 @@ FT_ROBOT = """<?xml version="1.0"?>
   </link>
   <joint name="ft_joint" type="fixed"><parent link="base_link"/><child link="payload"/>
     <origin xyz="0 0 0.1" rpy="0.4 0 0"/></joint>
-  <gazebo reference="ft_joint">
+  GAZEBO
+</robot>
+"""
+FT_ROBOT = FT_LINKS.replace(
+    "GAZEBO",
+    """<gazebo reference="ft_joint">
     <preserveFixedJoint>true</preserveFixedJoint>
     <sensor name="ft" type="force_torque">
       <update_rate>100</update_rate>
       FT_BLOCK
     </sensor>
-  </gazebo>
-</robot>
-"""
+  </gazebo>""",
+)
 
 
 def test_force_torque_reads_the_weight_and_moment_of_its_payload(tmp_path: Path):
@@ -242,3 +246,44 @@ def test_hector_magnetometer_turns_its_field_with_the_robot(tmp_path: Path):
     got = np.array([[m.vector.x, m.vector.y, m.vector.z] for _, m in mag])
     assert np.allclose(got.mean(axis=0), body, atol=0.0015)
     assert abs(got.std(axis=0).mean() / 0.002 - 1) < 0.3
+
+
+def test_gazebo_ros_ft_sensor_plugins_ros1_and_ros2(tmp_path: Path):
+    """ROS 1 `<jointName>`/`<topicName>` and ROS 2 `<joint_name>` (topic `wrench`, remapped): the wrench the
+    joint applies on the payload (holding it up), in the payload's frame, at their update rates."""
+    m, roll = 1.5, 0.4
+    r_child = np.array([[1, 0, 0], [0, math.cos(roll), -math.sin(roll)], [0, math.sin(roll), math.cos(roll)]])
+    up = np.array([0.0, 0.0, m * G])  # the joint holds the payload up
+    torque = np.cross(r_child @ np.array([0.1, 0.0, 0.0]), up)
+    expected = np.concatenate([r_child.T @ up, r_child.T @ torque])
+    for name, plugin, topic, rate in (
+        (
+            "ros1",
+            "<robotNamespace>/</robotNamespace><jointName>ft_joint</jointName><topicName>ft</topicName>"
+            "<updateRate>50</updateRate><gaussianNoise>0.0</gaussianNoise>",
+            "ft",
+            50,
+        ),
+        (
+            "ros2",
+            "<ros><remapping>wrench:=ft_sensor/wrench</remapping></ros><joint_name>ft_joint</joint_name>"
+            "<update_rate>20</update_rate>",
+            "ft_sensor/wrench",
+            20,
+        ),
+    ):
+        sub = tmp_path / name
+        sub.mkdir()
+        gz = f'<gazebo><plugin name="ft" filename="libgazebo_ros_ft_sensor.so">{plugin}</plugin></gazebo>'
+        path = _scenario(sub, FT_LINKS.replace("GAZEBO", gz), (0.0, 0.0, 0.05), 0.0, 0.5)
+        plan, notices = compile_with_notices(path)
+        assert not notices, notices
+        assert _topics(plan) == {topic: "geometry_msgs/msg/WrenchStamped"}
+        _, bus = simulate(path)
+        wrenches = messages(bus, f"bot/{topic}")
+        assert abs(len(wrenches) - rate * 0.5) <= 1
+        msg = wrenches[-1][1]
+        assert msg.header.frame_id == "bot/payload"
+        w = msg.wrench
+        got = [w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z]
+        assert np.allclose(got, expected, atol=0.02), (name, got)

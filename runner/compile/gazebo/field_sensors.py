@@ -17,6 +17,7 @@ from typing import Any
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.noise import NoiseSpec, noise_spec
 from runner.compile.gazebo.sensor_plugins import read_sensor_plugins
+from runner.compile.gazebo.tags import ros_topic
 
 # `s`: runner.compile.gazebo.sensors' `_Sensor` (one <sensor> as every kind reads it), which imports this
 _Sensor = Any
@@ -182,3 +183,73 @@ def force_torque(g: ReaderBase, s: _Sensor) -> bool:
     params["frame_id"] = s.frame
     g.add(s.el, "force_torque", s.name, params, implicit=implicit)
     return True
+
+
+def ft_sensor(g: ReaderBase, r: Any, remap: dict[str, str]) -> tuple[str, dict[str, Any]] | None:
+    """gazebo_plugins' `libgazebo_ros_ft_sensor.so` (a model plugin) -> `force_torque`: the wrench a
+    joint applies on its child link (`GetForceTorque(0).body2Force/body2Torque`), in the child link's
+    frame, plus N(0, noise) on each of the six components.
+
+    ROS 1 (noetic-devel gazebo_ros_ft_sensor.cpp:64-111, 185-216): `<jointName>` and `<topicName>` are
+    required (without either it publishes nothing), `<gaussianNoise>`, `<updateRate>` (0: every step),
+    frame the child link. ROS 2 (ros2 gazebo_ros_ft_sensor.cpp:100-157): `<joint_name>` or `<body_name>`,
+    topic `wrench` (remapped), `<gaussian_noise>`, `<update_rate>`, `<frame_name>` only with a body.
+    A `<body_name>` reports the forces other plugins applied to the link (`Link::WorldForce`), which here
+    are none: said and left out."""
+    p = r.el
+    filename = p.get("filename")
+    ros1 = p.find("jointName") is not None or p.find("topicName") is not None
+    if p.find("body_name") is not None and p.find("joint_name") is None:
+        g.note(
+            p,
+            f"{filename!r} with <body_name> reports the forces plugins apply to the link (Link::WorldForce), "
+            "which here are none: it is left out",
+            hint="measure at a joint: <joint_name>",
+        )
+        r.mark(*[c.tag for c in p if isinstance(c.tag, str)])
+        return None
+    joint = r.text("jointName" if ros1 else "joint_name")
+    topic = ros_topic(r.text("topicName")) if ros1 else (remap.get("wrench") or "wrench")
+    missing = "<jointName>" if ros1 and not joint else "<topicName>" if ros1 and not topic else None
+    if not ros1 and not joint:
+        missing = "<joint_name> or <body_name>"
+    if missing is None and joint not in g.joint_names | g.fixed_joints:
+        g.note(p, f"{filename!r}: joint {joint!r} does not exist; Gazebo loads the plugin without it either")
+        r.mark(*[c.tag for c in p if isinstance(c.tag, str)])
+        return None
+    if missing is not None:
+        g.note(p, f"{filename!r} has no {missing}: it publishes nothing (in Gazebo too)")
+        r.mark(*[c.tag for c in p if isinstance(c.tag, str)])
+        return None
+    child = _child_of(g, joint)
+    noise = r.float("gaussianNoise" if ros1 else "gaussian_noise")
+    rate = r.float("updateRate" if ros1 else "update_rate")
+    frame = p.find("frame_name")
+    if frame is not None:
+        r.mark("frame_name")
+        g.note(
+            frame, "<frame_name> is read only with <body_name>: the frame is the joint's child link (Gazebo)"
+        )
+    params: dict[str, Any] = {
+        "link": child,
+        "topic": topic,
+        "frame_id": g.frame(child),
+        "measure_frame": "child",
+        "measure_direction": "parent_to_child",
+    }
+    if noise:
+        params["force_noise_stddev"] = [abs(noise)] * 3
+        params["torque_noise_stddev"] = [abs(noise)] * 3
+    if rate and rate > 0:
+        params["rate"] = rate
+    else:
+        g.note(
+            p,
+            f"{filename!r} has no update rate (or 0): Gazebo publishes it at every physics step; here at the "
+            "force_torque plugin's 100 Hz",
+            hint="add <updateRate> / <update_rate> (or set `rate` in the scenario's plugin params)",
+        )
+    return "force_torque", params
+
+
+MODEL_PLUGINS = {"gazebo_ros_ft_sensor": ft_sensor}

@@ -9,7 +9,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
-from runner.compile.gazebo import catalogue, thirdparty
+from runner.compile.gazebo import catalogue, field_sensors, thirdparty
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.control.drives import by_wheels
 from runner.compile.gazebo.controllers import ros_control
@@ -292,5 +292,6 @@ _MODEL_PLUGINS = {
     "ign_ros2_control-system": ros_control,
 }
 _MODEL_PLUGINS.update(thirdparty.MODEL_PLUGINS)  # hector_gazebo_plugins (.thirdparty)
+_MODEL_PLUGINS.update(field_sensors.MODEL_PLUGINS)  # gazebo_ros_ft_sensor (.field_sensors)
 # forks of gz_ros2_control / ign_ros2_control / gazebo_ros2_control / gazebo_ros_control keep the name's tail
 _CONTROL_FORK = re.compile(r"(^|[_-])(gz|ign|gazebo)_ros2?_control(-system|_plugin)?$")
