@@ -287,3 +287,53 @@ def test_gazebo_ros_ft_sensor_plugins_ros1_and_ros2(tmp_path: Path):
         w = msg.wrench
         got = [w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z]
         assert np.allclose(got, expected, atol=0.02), (name, got)
+
+
+SILENT = """<?xml version="1.0"?>
+<robot name="t">
+  <link name="base_link">
+    <collision><geometry><box size="0.3 0.2 0.1"/></geometry></collision>
+    <inertial><mass value="2.0"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+  </link>
+  <link name="p"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/>
+  </inertial></link>
+  <joint name="j" type="fixed"><parent link="base_link"/><child link="p"/></joint>
+  <gazebo reference="base_link">
+    <sensor name="mag" type="magnetometer"><stray1/>
+      <magnetometer><x><noise type="gaussian"><stddev>1e-6</stddev></noise><stray2/></x><stray3/></magnetometer>
+    </sensor>
+    <sensor name="ap" type="air_pressure">
+      <air_pressure><pressure><stray4/></pressure><stray5/></air_pressure>
+    </sensor>
+    <sensor name="al" type="altimeter"><altimeter><vertical_position><stray6/></vertical_position></altimeter>
+    </sensor>
+    <sensor name="r" type="ray"><ray><range><min>0.1</min><max>3</max></range></ray>
+      <plugin name="x" filename="libgazebo_ros_range.so"><stray7/><topicName>r</topicName></plugin>
+    </sensor>
+    <sensor name="r2" type="ray"><ray><range><min>0.1</min><max>3</max></range></ray>
+      <plugin name="x2" filename="libgazebo_ros_ray_sensor.so"><stray8/><output_type>sensor_msgs/Range</output_type>
+      </plugin>
+    </sensor>
+  </gazebo>
+  <gazebo reference="j">
+    <sensor name="ft" type="force_torque"><force_torque><force><x><stray9/></x></force><stray10/></force_torque>
+    </sensor>
+  </gazebo>
+  <gazebo><plugin name="ft2" filename="libgazebo_ros_ft_sensor.so"><joint_name>j</joint_name><stray11/></plugin>
+  </gazebo>
+  <gazebo><plugin name="m" filename="libhector_gazebo_ros_magnetic.so"><updateRate>10</updateRate><stray12/></plugin>
+  </gazebo>
+</robot>"""
+
+
+def test_what_these_sensors_and_plugins_do_not_read_is_said(tmp_path: Path):
+    """A stray element at every level of each sensor and plugin block is said at its own line."""
+    path = _scenario(tmp_path, SILENT, (0.0, 0.0, 0.05), 0.0, 0.1)
+    _, notices = compile_with_notices(path)
+    lines = SILENT.splitlines()
+    for n in range(1, 13):
+        line = next(i for i, text in enumerate(lines, 1) if f"<stray{n}/>" in text)
+        assert any(f"t.urdf:{line}:" in said and f"<stray{n}>" in said for said in notices.splitlines()), (
+            n,
+            notices,
+        )

@@ -24,7 +24,10 @@ _Sensor = Any
 
 
 def _noise(g: ReaderBase, parent: Any, what: str) -> NoiseSpec | None:
-    """An axis' `<noise>`; a bias (drawn once per run in gz-sensors) is said and left out."""
+    """An axis' `<noise>` (anything else in the axis is said); a bias (drawn once per run in gz-sensors) is
+    said and left out."""
+    if parent is not None:
+        _unknown(g, parent, {"noise"}, what)
     spec = noise_spec(g, parent)
     if spec is not None and (spec.bias_mean or spec.bias_stddev):
         g.note(spec.el, f"a noise bias (<bias_mean>, <bias_stddev>) is not modelled for {what}")
@@ -32,6 +35,7 @@ def _noise(g: ReaderBase, parent: Any, what: str) -> NoiseSpec | None:
 
 
 def _unknown(g: ReaderBase, block: Any, known: set[str], context: str) -> None:
+    """What of `block` is none of the `known` SDF elements: said, as Gazebo's SDF parser warns of it."""
     for child in block:
         if isinstance(child.tag, str) and child.tag not in known:
             g.note(child, f"<{child.tag}> in {context} <{block.tag}> is ignored (not an SDF element)")
