@@ -18,6 +18,7 @@ from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.noise import NoiseSpec, noise_spec
 from runner.compile.gazebo.sensor_plugins import read_sensor_plugins
 from runner.compile.gazebo.tags import ros_topic
+from runner.errors import NO_PUBLISHER, PLUGIN_UNSUPPORTED
 
 # `s`: runner.compile.gazebo.sensors' `_Sensor` (one <sensor> as every kind reads it), which imports this
 _Sensor = Any
@@ -147,6 +148,7 @@ def force_torque(g: ReaderBase, s: _Sensor) -> bool:
             f"{s.context} is not in a joint's <gazebo reference=...> block: Gazebo mounts a force_torque "
             "sensor on a joint only; it is left out",
             hint='write it in <gazebo reference="the joint">',
+            kind=PLUGIN_UNSUPPORTED,
         )
         s.r.mark(*[c.tag for c in s.el if isinstance(c.tag, str)])
         return False
@@ -209,6 +211,7 @@ def ft_sensor(g: ReaderBase, r: Any, remap: dict[str, str]) -> tuple[str, dict[s
             f"{filename!r} with <body_name> reports the forces plugins apply to the link (Link::WorldForce), "
             "which here are none: it is left out",
             hint="measure at a joint: <joint_name>",
+            kind=PLUGIN_UNSUPPORTED,
         )
         r.mark(*[c.tag for c in p if isinstance(c.tag, str)])
         return None
@@ -218,11 +221,12 @@ def ft_sensor(g: ReaderBase, r: Any, remap: dict[str, str]) -> tuple[str, dict[s
     if not ros1 and not joint:
         missing = "<joint_name> or <body_name>"
     if missing is None and joint not in g.joint_names | g.fixed_joints:
-        g.note(p, f"{filename!r}: joint {joint!r} does not exist; Gazebo loads the plugin without it either")
+        said = f"{filename!r}: joint {joint!r} does not exist: it publishes nothing (in Gazebo too)"
+        g.note(p, said, kind=NO_PUBLISHER)
         r.mark(*[c.tag for c in p if isinstance(c.tag, str)])
         return None
     if missing is not None:
-        g.note(p, f"{filename!r} has no {missing}: it publishes nothing (in Gazebo too)")
+        g.note(p, f"{filename!r} has no {missing}: it publishes nothing (in Gazebo too)", kind=NO_PUBLISHER)
         r.mark(*[c.tag for c in p if isinstance(c.tag, str)])
         return None
     child = _child_of(g, joint)

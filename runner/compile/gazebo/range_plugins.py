@@ -23,6 +23,7 @@ from typing import Any
 
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.tags import TagReader, join_topic, ros_topic
+from runner.errors import NO_PUBLISHER
 
 RANGE_PLUGINS = {"gazebo_ros_range"}
 
@@ -70,7 +71,8 @@ def ros1_range(g: ReaderBase, r: TagReader, context: str) -> dict[str, Any]:
         params["range_noise_stddev"] = abs(noise)
     found: dict[str, Any] = {"params": params}
     if topic is None:  # an empty <topicName>: the plugin advertises nothing (gazebo_ros_range.cpp:171)
-        g.note(p, f"{context}: an empty <topicName>: gazebo_ros_range publishes nothing (in Gazebo too)")
+        said = f"{context}: an empty <topicName>: gazebo_ros_range publishes nothing (in Gazebo too)"
+        g.note(p, said, kind=NO_PUBLISHER)
         found["nothing"] = True
     # tf::resolve leaves the default `/world` (absolute) alone
     found["frame"] = g.frame(frame) if frame and frame.strip("/") != "world" else "world"
@@ -106,6 +108,7 @@ def ros2_ray_sensor(g: ReaderBase, r: TagReader, remap: dict[str, str], context:
             "(here: nothing either)",
             hint="one of sensor_msgs/LaserScan, sensor_msgs/PointCloud2, sensor_msgs/PointCloud, "
             "sensor_msgs/Range",
+            kind=NO_PUBLISHER,
         )
         found["nothing"] = True
         return found
@@ -162,6 +165,7 @@ def _range_params(g: ReaderBase, r: TagReader, topic: str, context: str) -> dict
             f"<radiation_type> {radiation!r} in {context} is invalid: gazebo_ros_ray_sensor publishes "
             "nothing (here: nothing either)",
             hint="ultrasound or infrared",
+            kind=NO_PUBLISHER,
         )
         return None
     h, v = _spans(p.getparent())
