@@ -38,6 +38,9 @@ def test_a_contact_sensor_above_the_step_runs_once_a_step(tmp_path: Path):
     line = ROBOT.splitlines().index('    <sensor name="bumper" type="contact">') + 1
     assert f"t.urdf:{line}" in notices
     assert "its rate 1000 Hz is above the physics step's 500 Hz" in notices
+    # validate's "as in Gazebo" block lists it as a rate, not as something ignored
+    rate_lines = [said for said in plan.robots[0].gazebo if said.kind == "rate"]
+    assert len(rate_lines) == 1 and rate_lines[0].line == line
     _, bus = simulate(path)
     assert abs(len(messages(bus, "bot/bumper")) - 500) <= 1
 

@@ -11,7 +11,7 @@ from pydantic import ValidationError
 
 from runner.compile.gazebo import DescribedPlugin
 from runner.compile.urdf import RobotModel
-from runner.errors import Location, Notices, Problem, Problems, ScenarioError
+from runner.errors import RATE_CAPPED, Location, Notices, Problem, Problems, ScenarioError
 from runner.plan import PluginPlan, ServicePlan, TopicPlan
 from runner.plugin import BuildContext, PluginConfigError, Service, Topic
 from runner.plugin.registry import PluginLookupError, drive_frames, load
@@ -191,6 +191,8 @@ def _cap_rate(
             file,
             line,
             hint="lower the rate to what runs, or shorten the world's physics timestep",
+            kind=RATE_CAPPED,
+            about=entry.name,
         )
     return params.model_copy(update={"rate": top})
 
