@@ -184,3 +184,12 @@ def test_ros2_ray_sensor_other_outputs(tmp_path: Path):
     _, bus = simulate(path)
     cloud = messages(bus, "bot/a_ray/out")[-1][1]
     assert cloud.height == 1 and cloud.width == 9  # every ray meets the wall: 3 x 3 points
+
+
+def test_ros1_gazebo_ros_range_needs_a_cpu_ray_sensor(tmp_path: Path):
+    """On a gpu_ray sensor Gazebo refuses the plugin: nothing is published, as said."""
+    extra = _sensor("s", 0.0, _ros1("s")).replace('type="ray"', 'type="gpu_ray"')
+    path = _write(tmp_path, extra, duration=0.1)
+    plan, notices = compile_with_notices(path)
+    assert "needs a sensor of type 'ray'" in notices
+    assert _topics(plan) == {}

@@ -43,10 +43,21 @@ def _spans(sensor_el: Any) -> tuple[float, float]:
     return out[0], out[1]
 
 
-def ros1_range(g: ReaderBase, r: TagReader, context: str) -> dict[str, Any]:
+def ros1_range(g: ReaderBase, r: TagReader, kind: str, context: str) -> dict[str, Any]:
     """ROS 1 `libgazebo_ros_range.so` -> what `read_sensor_plugins` finds: topic, frame, the plugin's rate
-    (`rate`, applied as a throttle of the sensor's) and the lidar's params."""
+    (`rate`, applied as a throttle of the sensor's) and the lidar's params. It needs a CPU `ray` sensor:
+    on any other Gazebo refuses to load it (gazebo_ros_range.cpp:66-71)."""
     p = r.el
+    if kind != "ray":
+        g.note(
+            p,
+            f"{context}: libgazebo_ros_range.so needs a sensor of type 'ray' (Gazebo throws on a {kind!r} "
+            "sensor): it publishes nothing, and the sensor is left out",
+            hint='use <sensor type="ray">',
+            kind=NO_PUBLISHER,
+        )
+        r.mark(*[c.tag for c in p if isinstance(c.tag, str)])
+        return {"nothing": True}
     topic_text = r.text("topicName")
     topic = ros_topic(topic_text) if topic_text is not None else "range"
     frame = r.text("frameName")

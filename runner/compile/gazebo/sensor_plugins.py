@@ -55,7 +55,7 @@ def read_sensor_plugins(
             extra, rates = thirdparty.sensor_plugin(g, r, base, remap, sensor, kind, context)
             found.update(extra)
         elif base in range_plugins.RANGE_PLUGINS:
-            found.update(range_plugins.ros1_range(g, r, context))
+            found.update(range_plugins.ros1_range(g, r, kind, context))
             rates = ("updateRate",)  # throttles the sensor's updates (gazebo_ros_range.cpp:117-131, 230)
         elif base == "gazebo_ros_ray_sensor":
             found.update(range_plugins.ros2_ray_sensor(g, r, remap, context))
