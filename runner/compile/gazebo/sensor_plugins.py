@@ -214,6 +214,10 @@ def _depth_clip(r: TagReader, base: str, ros2: bool) -> dict[str, Any]:
       and the cloud (gazebo_ros_depth_camera.cpp:126-129, 675-680, 754-766); it has no upper cut-off;
     - ROS 1 `gazebo_ros_openni_kinect`: `<pointCloudCutoff>` (0.4) and `<pointCloudCutoffMax>` (5.0), NaN
       outside (gazebo_ros_openni_kinect.cpp:101-108, 361-374, 454-465)."""
+    if base not in ("gazebo_ros_camera", "gazebo_ros_depth_camera", "gazebo_ros_openni_kinect") or (
+        base == "gazebo_ros_camera" and not ros2
+    ):
+        return {}  # ROS 1 camera, multicamera: no depth of their own
     if ros2:
         lo = r.float("min_depth")
         hi = r.float("max_depth")
