@@ -13,16 +13,22 @@ publishes:
   the rendered pixel centres, (u + 0.5 - width / 2) / fx;
 - when `publish_color`: the colour image and its CameraInfo on `image_topic`/`info_topic`, as `camera`.
 
+Depth limits of the ROS plugins (`min_depth`, `max_depth`, `out_of_range`), in the depth image and the
+cloud alike: `inf` (ROS 2 gazebo_ros_camera: -inf at or below `min_depth`, +inf at or beyond `max_depth`
+or where nothing is hit, and x = y = z = that infinity in the cloud) or `nan` (ROS 1 gazebo_ros_depth_camera
+and openni_kinect: NaN outside `(min_depth, max_depth)`, in the image and the cloud). With the default,
+`clip`, only the clip planes limit depth, as described above.
+
 `noise_stddev` applies to the colour image only (the point colours are noise-free); depth is exact up to
 the depth buffer's precision (well under a millimetre at a few metres with the default clip planes).
 """
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, PositiveFloat
 
 from plugins._pixels import ImageOut
 from plugins._render import CAMERA_INFO, IMAGE, POINT_CLOUD, CameraParams
@@ -43,6 +49,18 @@ class DepthCameraParams(CameraParams):
     )
     publish_color: bool = Field(
         True, description="Also publish the colour image and its CameraInfo (image_topic, info_topic)."
+    )
+    min_depth: float = Field(
+        0.0, ge=0, description="Depths at or below this are out of range (metres; 0: only the clip plane)."
+    )
+    max_depth: PositiveFloat | None = Field(
+        None, description="Depths at or beyond this are out of range (metres; null: only the far plane)."
+    )
+    out_of_range: Literal["clip", "inf", "nan"] = Field(
+        "clip",
+        description="What min_depth/max_depth do: nothing, only the clip planes limit depth (clip); "
+        "-inf/+inf below/beyond them in the image and the cloud (inf, ROS 2 gazebo_ros_camera); NaN (nan, "
+        "ROS 1 gazebo_ros_depth_camera and openni_kinect).",
     )
 
     def topic_params(self) -> dict[str, str | None]:
@@ -119,6 +137,7 @@ class DepthCamera(Camera):
             self.publish_color(rgb, now_ns)
         else:
             self.renderer.depth(depth)
+        self._limit(depth)
         self.depth_pub.publish_cdr(self.depth_out.payload(now_ns), now_ns)
         if self.depth_info_out is not None:
             assert self.depth_info_pub is not None
@@ -126,6 +145,22 @@ class DepthCamera(Camera):
         if self.points_pub is not None:
             self.fill_points(self.points, depth, rgb)
             self.points_pub.publish_cdr(self.points_out.fill(now_ns), now_ns)
+
+    def _limit(self, depth: np.ndarray) -> None:
+        """The plugin's depth limits, in place (see the module doc)."""
+        p = self.params
+        if p.out_of_range == "clip" or (p.min_depth <= 0 and p.max_depth is None):
+            return
+        lo = depth <= p.min_depth
+        hi = depth >= p.max_depth if p.max_depth is not None else None
+        if p.out_of_range == "nan":
+            depth[lo] = np.nan
+            if hi is not None:
+                depth[hi] = np.nan
+        else:
+            depth[lo] = -np.inf
+            if hi is not None:
+                depth[hi] = np.inf
 
     def fill_points(self, buf: np.ndarray, depth: np.ndarray, rgb: np.ndarray | None) -> np.ndarray:
         """An organized cloud's points (H x W x fields float32) in the optical frame from a depth image (and
@@ -146,6 +181,11 @@ class DepthCamera(Camera):
             b[..., 2] = z
             np.multiply(self.ray_x, z, out=b[..., 0])
             np.multiply(self.ray_y[r0:r1], z, out=b[..., 1])
+            if self.params.out_of_range == "inf" and not finite.all():
+                # ROS 2 gazebo_ros_camera: x = y = z = -inf / +inf for a depth out of range
+                # (gazebo_ros_camera.cpp:757-768); no return at all reads +inf there too
+                infinite = np.isinf(d)
+                b[infinite] = np.where(d[infinite] > 0, np.float32(np.inf), np.float32(-np.inf))[:, None]
             if packed is not None and rgb is not None:
                 # float32 `rgb` holding 0x00RRGGBB, little-endian: bytes B, G, R, 0
                 p = packed[r0:r1]

@@ -12,10 +12,20 @@ have no retro-reflectivity here, and a scan is one instant). `organize_cloud` ke
 there is no return; `xyz` does by default) or only the returns (`velodyne` does by default).
 `publish_scan: false` leaves the LaserScan out (velodyne_simulator publishes only the cloud).
 
-`range_topic` publishes a sensor_msgs/Range as hector_gazebo_plugins' sonar does: the nearest return of
-all beams (`range_max` when none), with its own error (`range_offset`, a drifting bias `range_drift`, white
-noise `range_noise_stddev`, see plugins/_drift.py) added to returns short of `range_max`, clamped to
-`[range_min, range_max]`.
+`range_topic` publishes a sensor_msgs/Range, the nearest return of all beams, as one of three Gazebo
+plugins computes it (`range_style`):
+
+- `hector` (hector_gazebo_plugins' sonar): `range_max` when nothing is hit; else the nearest return with
+  its own error (`range_offset`, a drifting bias `range_drift`, white noise `range_noise_stddev`, see
+  plugins/_drift.py), clamped to `[range_min, range_max]`;
+- `gazebo_ros_range` (gazebo_plugins' ROS 1 `libgazebo_ros_range.so`, gazebo_ros_range.cpp:302-316): the
+  nearest *noise-free* ray (it reads the ray shape, not the sensor's noisy scan), `range_max` when nothing is
+  hit; else plus N(0, `range_noise_stddev`), capped at `range_max` only (noise may take it below
+  `range_min`);
+- `gazebo_ros_ray_sensor` (gazebo_plugins' ROS 2 `<output_type>sensor_msgs/Range`, conversions/
+  sensor_msgs.hpp:291-316): the nearest of the sensor's published ranges, each masked as Gazebo's ray
+  sensor does (REP 117: +inf beyond `range_max`, -inf at or below `range_min`, else with the sensor's noise,
+  clamped to the limits), so +inf when nothing is within range.
 
 `noise_stddev`, `resolution` and `blind_sectors` may change while it runs (an event's `set:`): a sector
 blinded by an event (mud on the window, a failed emitter) returns +inf on every beam whose azimuth lies in
@@ -90,6 +100,10 @@ class LidarParams(RatedParams):
     )
     range_drift_frequency: float = Field(1 / 3600, ge=0, description="Frequency of that drift, Hz.")
     range_noise_stddev: float = Field(0.0, ge=0, description="White noise on the Range, metres.")
+    range_style: Literal["hector", "gazebo_ros_range", "gazebo_ros_ray_sensor"] = Field(
+        "hector",
+        description="How the Range is made of the rays, as which Gazebo plugin does it (see the module doc).",
+    )
     organize_cloud: bool | None = Field(
         None,
         description="Keep every beam in the cloud, NaN where there is no return (true), or only the "
@@ -277,12 +291,33 @@ class Lidar(Plugin):
         start = [rng.normal(0.0, p.range_drift)] if p.range_drift else [0.0]
         self.range_bias = DriftingBias(rng, start, p.range_drift, p.range_drift_frequency, 1.0 / p.rate)
 
+    def _range_rays(self, raw: np.ndarray, noisy: np.ndarray) -> np.ndarray:
+        """The rays the Range is the minimum of, for the gazebo_ros styles (`raw`: noise-free distances)."""
+        p = self.params
+        if p.blind_sectors:
+            raw[self._blind_mask(p.blind_sectors)] = np.inf
+        if p.range_style == "gazebo_ros_range":
+            return raw  # LaserShape()->GetRange(i): the ray shape's own, noise-free lengths
+        # the ray sensor's scan (gazebo RaySensor::UpdateImpl): masked by the raw range, noisy within it
+        out = np.clip(noisy, p.range_min, p.range_max)
+        out[raw >= p.range_max] = np.inf
+        out[raw <= p.range_min] = -np.inf
+        return out
+
     def _publish_range(self, ranges: np.ndarray, now_ns: int) -> None:
-        """The nearest return; hector's error model applies to a return short of range_max (its drift
-        moves only then), and the result is clamped to the Range's limits."""
+        """The nearest return, as `range_style` says (see the module doc)."""
         p = self.params
         r = float(ranges.min()) if len(ranges) else math.inf
-        if r < p.range_max:
+        if p.range_style == "gazebo_ros_ray_sensor":
+            pass  # the nearest masked ray as it is: +inf when nothing is within range_max
+        elif p.range_style == "gazebo_ros_range":
+            if r < p.range_max:  # gazebo_ros_range.cpp:315-316
+                if p.range_noise_stddev:
+                    r += float(self.ctx.rng.normal(0.0, p.range_noise_stddev))
+                r = min(r, p.range_max)
+            else:
+                r = p.range_max
+        elif r < p.range_max:
             r += p.range_offset + float(self.range_bias.update()[0])
             if p.range_noise_stddev:
                 r += float(self.ctx.rng.normal(0.0, p.range_noise_stddev))
@@ -346,6 +381,7 @@ class Lidar(Plugin):
     def after_step(self, now_ns: int) -> None:
         p = self.params
         every = self.scan()  # inf where nothing is hit: noise and rounding leave those inf
+        raw = every.copy() if p.range_topic and p.range_style != "hector" else None
         if p.noise_stddev > 0:
             noise = self.ctx.rng.standard_normal(len(every))
             noise *= p.noise_stddev
@@ -360,7 +396,7 @@ class Lidar(Plugin):
         if p.points:
             self._publish_points(every, now_ns)
         if p.range_topic:
-            self._publish_range(every, now_ns)
+            self._publish_range(every if raw is None else self._range_rays(raw, every), now_ns)
         if not p.publish_scan:
             return
         out = self.out_ranges  # float32 view into the message bytes

@@ -222,6 +222,7 @@ DRIVE_GEOMETRY = "drive-geometry"  # a drive's declared wheel values are not the
 PLUGIN_UNSUPPORTED = "plugin-unsupported"  # a Gazebo plugin or sensor left out (its topics, motion)
 NO_PUBLISHER = "sensor-no-publisher"  # a sensor that publishes nothing (as in Gazebo)
 TAG_IGNORED = "tag-ignored"  # a tag read but not acted on (about: the tag)
+RATE_CAPPED = "rate-capped"  # a rate above the physics step's, run once a step (about: the plugin)
 
 _VARYING = re.compile(
     r"'[^']*'|\"[^\"]*\"|`[^`]*`"  # quoted names and values

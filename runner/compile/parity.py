@@ -11,14 +11,25 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from runner.compile.wheels import wheel_joints
-from runner.errors import Notice
+from runner.errors import RATE_CAPPED, Notice
 from runner.plan import ParityLine, PluginPlan
 
 if TYPE_CHECKING:
     from runner.compile.urdf import RobotModel
 
 _DRIVES = {"diff_drive", "skid_steer", "planar_move"}
-_SENSORS = {"lidar", "camera", "depth_camera", "imu", "contact", "gps"}
+_SENSORS = {
+    "lidar",
+    "camera",
+    "depth_camera",
+    "imu",
+    "contact",
+    "gps",
+    "magnetometer",
+    "air_pressure",
+    "altimeter",
+    "force_torque",
+}
 
 
 def _line(kind: str, text: str, where: tuple[str | None, int | None] = (None, None)) -> ParityLine:
@@ -98,5 +109,6 @@ def summarize(
         if n.message in shown:
             continue
         file = str(n.location.file) if n.location.file else None
-        out.append(_line("ignored", n.message, (file, n.location.line)))
+        label = "rate" if n.kind == RATE_CAPPED else "ignored"
+        out.append(_line(label, n.message, (file, n.location.line)))
     return out

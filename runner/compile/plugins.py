@@ -11,7 +11,7 @@ from pydantic import ValidationError
 
 from runner.compile.gazebo import DescribedPlugin
 from runner.compile.urdf import RobotModel
-from runner.errors import Location, Problem, Problems, ScenarioError
+from runner.errors import RATE_CAPPED, Location, Notices, Problem, Problems, ScenarioError
 from runner.plan import PluginPlan, ServicePlan, TopicPlan
 from runner.plugin import BuildContext, PluginConfigError, Service, Topic
 from runner.plugin.registry import PluginLookupError, drive_frames, load
@@ -81,9 +81,16 @@ def _state_publisher(sc: Scenario, entries: list[_Entry]) -> list[_Entry]:
 
 
 def build_plugins(
-    sc: Scenario, robot: Robot, i: int, model: RobotModel, doc: Document, problems: Problems
+    sc: Scenario,
+    robot: Robot,
+    i: int,
+    model: RobotModel,
+    doc: Document,
+    problems: Problems,
+    notices: Notices | None = None,
 ) -> list[PluginPlan]:
-    """The robot's plugins, built; each one's mistakes go to `problems` and it is left out."""
+    """The robot's plugins, built; each one's mistakes go to `problems` and it is left out. A rate above
+    the physics step's is capped to it, and said to `notices` (`_cap_rate`)."""
     plans: list[PluginPlan] = []
     ctx = BuildContext(
         spec=model.spec,
@@ -125,6 +132,7 @@ def build_plugins(
                     param = ".".join(str(x) for x in err["loc"]) or None
                     hint = f"give `{param}` a value the {entry.type} plugin takes" if param else None
                     raise fail(f"{err['msg']} (found {err.get('input')!r})", param, hint) from None
+            params = _cap_rate(sc, cls, params, entry, doc, here, notices)
             try:
                 topics = cls.build(params, ctx, entry.name)
             except PluginConfigError as e:
@@ -147,6 +155,46 @@ def build_plugins(
                 )
             )
     return plans
+
+
+def _cap_rate(
+    sc: Scenario,
+    cls: Any,
+    params: Any,
+    entry: _Entry,
+    doc: Document,
+    here: PathKey,
+    notices: Notices | None,
+) -> Any:
+    """A plugin runs at most once per physics step, in Gazebo as here: a sensor's next update is due by sim
+    time, which moves a whole step at a time (Gazebo Classic's Sensor::NeedsUpdate, gz-sensors'
+    Sensor::NextDataUpdateTime), and a model plugin's update is a world-update callback, once a step: a
+    contact sensor at 1000 Hz with a 2 ms step publishes at 500 Hz. The
+    plan's rate says what runs: `rate` above 1/timestep becomes 1/timestep, said at the tag (the
+    description's line, or the scenario's `rate:` when the scenario set it)."""
+    rate = cls.rate_of(params)
+    step = sc.world.physics.timestep
+    top = 1.0 / step
+    if not rate or rate <= top * (1 + 1e-9) or not hasattr(params, "rate"):
+        return params
+    if notices is not None:
+        src = entry.source
+        if src is not None and "rate" not in entry.scenario_keys:
+            file, line = src.file, src.line
+        else:
+            loc = doc.locate((*here, "params", "rate"))
+            file, line = loc.file, loc.line
+        notices.add(
+            f"{entry.type} {entry.name!r}: its rate {rate:g} Hz is above the physics step's {top:g} Hz "
+            f"(timestep {step:g} s); Gazebo updates a sensor or plugin at most once a step, so it runs at "
+            f"{top:g} Hz (here too)",
+            file,
+            line,
+            hint="lower the rate to what runs, or shorten the world's physics timestep",
+            kind=RATE_CAPPED,
+            about=entry.name,
+        )
+    return params.model_copy(update={"rate": top})
 
 
 def _endpoints(declared: list[Any], run: str, ns: str, owner: str) -> dict[str, Any]:

@@ -79,7 +79,7 @@ def add_robot(
     model = robot_model(robot, i, doc, packages, notices, sc.world.physics.timestep)
     # the hardware first: a controller's build claims the actuators it made (plugins/_actuators.py)
     hardware, rate = add_hardware(model, notices, sc.world.physics.timestep)
-    plugins = build_plugins(sc, robot, i, model, doc, problems)
+    plugins = build_plugins(sc, robot, i, model, doc, problems, notices)
     release_hardware(model.spec, hardware)
     if model.world is not None:
         _welded_by_description(model, robot, i, doc, notices)

@@ -51,6 +51,13 @@ trajectory_msgs/MultiDOFJointTrajectoryPoint multi_dof_error
 trajectory_msgs/MultiDOFJointTrajectoryPoint multi_dof_output
 float64 speed_scaling_factor
 """,
+    # ros_gz_interfaces (ros_gz, Jazzy): what ros_gz_bridge makes of gz.msgs.Altimeter
+    "ros_gz_interfaces/msg/Altimeter": """\
+std_msgs/Header header
+float64 vertical_position
+float64 vertical_velocity
+float64 vertical_reference
+""",
     "control_msgs/msg/GripperCommand": """\
 float64 position
 float64 max_effort

@@ -247,6 +247,241 @@ CATALOGUE: tuple[PluginDoc, ...] = (
             _p("updateRate", "approx", "0 (its default): every physics step"),
         ),
     ),
+    # ---- sensors: Range, field sensors, force/torque, depth limits (issue 38, part A) ----
+    PluginDoc(
+        ("gazebo_ros_range",),
+        "sensor",
+        "gazebo_plugins (ROS 1 Noetic): src/gazebo_ros_range.cpp:52-158 parameters, :302-316 the range",
+        "lidar with only a sensor_msgs/Range (range_style gazebo_ros_range: the nearest noise-free ray, "
+        "max_range when none, its noise capped at max_range)",
+        (
+            _p("alwaysOn", "ignored", "sensors are always on"),
+            _p("robotNamespace", "approx", "the robot's namespace is the scenario's (said when it differs)"),
+            _p("topicName", "same", "default `/range`: `range` under the robot's namespace"),
+            _p("frameName", "same", "default `/world`: `world`"),
+            _p("radiation", "same", "`ultrasound` (the default) is ULTRASOUND, anything else INFRARED"),
+            _p("fov", "same", "the Range's field_of_view, default 0.05 (not the ray fan's)"),
+            _p("gaussianNoise", "same", "added to the nearest ray short of max_range, then capped at it"),
+            _p("updateRate", "same", "throttles the sensor's `<update_rate>` (every ceil(sensor/plugin)-th)"),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_ray_sensor",),
+        "sensor",
+        "gazebo_plugins (ROS 2 Humble/Jazzy): src/gazebo_ros_ray_sensor.cpp:101-237; gazebo_ros "
+        "conversions/sensor_msgs.hpp:291-316 (Range)",
+        "lidar publishing the one `<output_type>` on `~/out`: LaserScan, PointCloud2 (the default), or a "
+        "Range "
+        "(range_style gazebo_ros_ray_sensor: the nearest REP 117-masked ray, +inf when none)",
+        (
+            _p(
+                "ros",
+                "approx",
+                "`<remapping>` kept (`~/out:=x`); `<namespace>` replaced by the robot's (said)",
+            ),
+            _p(
+                "output_type",
+                "approx",
+                "sensor_msgs/PointCloud is published as a PointCloud2 (said); an "
+                "invalid type publishes nothing, in Gazebo too (said)",
+            ),
+            _p(
+                "radiation_type",
+                "same",
+                "infrared (the default) or ultrasound; anything else publishes nothing, in Gazebo too (said)",
+            ),
+            _p("frame_name", "same", "default: the sensor's link"),
+            _p(
+                "min_intensity",
+                "ignored",
+                "every return has intensity 0 here (no `<laser_retro>`); said "
+                "above 0, where Gazebo would drop the rays of surfaces without retro-reflectivity",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("sensor:magnetometer",),
+        "sensor",
+        "gz-sensors (Harmonic): src/MagnetometerSensor.cc:104-198; gz-sim src/systems/magnetometer/"
+        "Magnetometer.cc:359-379 topic and field; ros_gz_bridge: sensor_msgs/MagneticField",
+        "magnetometer (the world's field turned into the sensor frame)",
+        (
+            _p(
+                "topic",
+                "same",
+                "default the scoped `.../sensor/<name>/magnetometer` (Harmonic); classic "
+                "Gazebo has no ROS plugin for it: published on `magnetometer`, said as implicit",
+            ),
+            _p("update_rate", "same", "capped at the physics step's rate (said)"),
+            _p("pose", "same"),
+            _p("gz_frame_id", "approx", "under the robot's namespace"),
+            _p("always_on visualize enable_metrics", "ignored", "sensors are always on; GUI; diagnostics"),
+            _p(
+                "magnetometer.x.noise magnetometer.y.noise magnetometer.z.noise",
+                "approx",
+                "mean and stddev per axis; a bias (bias_mean, bias_stddev) is said and left out",
+            ),
+            _p(
+                "magnetic_field",
+                "approx",
+                "the world's: SDF's default field (5.5645e-6, 22.8758e-6, "
+                "-42.3884e-6 T); gz-sim's table at the world's <spherical_coordinates> is not read",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("sensor:air_pressure",),
+        "sensor",
+        "gz-sensors (Harmonic): src/AirPressureSensor.cc:41-52 the atmosphere, :113-203; gz-sim src/systems/"
+        "air_pressure/AirPressure.cc:186-210; ros_gz_bridge: sensor_msgs/FluidPressure",
+        "air_pressure (the RotorS standard atmosphere at reference_altitude + the sensor's world z)",
+        (
+            _p("topic", "same", "default `.../sensor/<name>/air_pressure` (Harmonic); classic: implicit"),
+            _p("update_rate", "same", "capped at the physics step's rate (said)"),
+            _p("pose", "same"),
+            _p("gz_frame_id", "approx", "under the robot's namespace"),
+            _p("always_on visualize enable_metrics", "ignored", "sensors are always on; GUI; diagnostics"),
+            _p("air_pressure.reference_altitude", "same"),
+            _p(
+                "air_pressure.pressure.noise",
+                "approx",
+                "mean and stddev; the message's variance is "
+                "sqrt(stddev), as gz-sensors writes it; a bias is said and left out",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("sensor:altimeter",),
+        "sensor",
+        "gz-sensors (Harmonic): src/AltimeterSensor.cc:117-131 noise; gz-sim src/systems/altimeter/"
+        "Altimeter.cc:186-212 topic and reference, :265-266; ros_gz_bridge: ros_gz_interfaces/msg/Altimeter",
+        "altimeter (world z less the start z, world vertical velocity, the start z as the reference)",
+        (
+            _p("topic", "same", "default `.../sensor/<name>/altimeter` (Harmonic); classic: implicit"),
+            _p("update_rate", "same", "capped at the physics step's rate (said)"),
+            _p("pose", "same"),
+            _p("gz_frame_id", "approx", "under the robot's namespace"),
+            _p("always_on visualize enable_metrics", "ignored", "sensors are always on; GUI; diagnostics"),
+            _p(
+                "altimeter.vertical_position.noise altimeter.vertical_velocity.noise",
+                "approx",
+                "mean and stddev; a bias is said and left out",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("sensor:force_torque",),
+        "sensor",
+        "gz-sensors (Harmonic): src/ForceTorqueSensor.cc:126-155, 199-257; gz-sim src/systems/force_torque/"
+        "ForceTorque.cc:262-320 (the joint's transmitted wrench); ros_gz_bridge: geometry_msgs/WrenchStamped",
+        "force_torque at the joint's child link (MuJoCo's force and torque sensors, turned and signed); in a "
+        "link's block (Gazebo mounts it on joints only): said and left out",
+        (
+            _p(
+                "topic",
+                "same",
+                "default `.../joint/<joint>/sensor/<name>/forcetorque` (Harmonic); classic: "
+                "`<name>/forcetorque`, implicit",
+            ),
+            _p("update_rate", "same", "capped at the physics step's rate (said)"),
+            _p("pose", "same", "the sensor frame and the point torques are about"),
+            _p("gz_frame_id", "approx", "under the robot's namespace"),
+            _p("always_on visualize enable_metrics", "ignored", "sensors are always on; GUI; diagnostics"),
+            _p("force_torque.frame", "same", "child (default), parent, sensor"),
+            _p("force_torque.measure_direction", "same", "child_to_parent (default), parent_to_child"),
+            _p(
+                "force_torque.force.noise force_torque.torque.noise",
+                "approx",
+                "mean and stddev per axis; a bias is said and left out",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_ft_sensor",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic): src/gazebo_ros_ft_sensor.cpp:64-111, 185-216; (ROS 2 Humble/Jazzy): "
+        "src/gazebo_ros_ft_sensor.cpp:100-215",
+        "force_torque at the joint's child link: the joint's wrench on it (parent_to_child), in its frame",
+        (
+            *_COMMON,
+            _p("jointName joint_name", "same", "required (ROS 1 also `<topicName>`): without, nothing"),
+            _p("topicName", "same", "ROS 2: `wrench` under the namespace, remapped by `<ros>`"),
+            _p("gaussianNoise gaussian_noise", "same", "N(0, noise) on each of the six components"),
+            _p("updateRate update_rate", "approx", "0 (the default): every physics step; here 100 Hz (said)"),
+            _p("body_name", "ignored", "Link::WorldForce is what other plugins apply, none here: left out"),
+            _p("frame_name", "ignored", "read only with body_name (Gazebo warns too)"),
+        ),
+    ),
+    PluginDoc(
+        ("hector_gazebo_ros_magnetic",),
+        "model",
+        "hector_gazebo_plugins (ROS 1 melodic-devel, its ROS 2 ports): src/gazebo_ros_magnetic.cpp:60-173; "
+        "sensor_model.h (the error model), update_timer.h (the rate)",
+        "magnetometer (field from magnitude/heading/declination/inclination, Vector3Stamped by default)",
+        (
+            *_COMMON,
+            _p("bodyName topicName frameId"),
+            _p("updateRate updatePeriod", "approx", "none or 0: every physics step; here 50 Hz (said)"),
+            _p("updateOffset", "ignored", "readings are taken at multiples of the period (said)"),
+            _p("magnitude referenceHeading declination inclination useMagneticFieldMsgs"),
+            _p("offset drift driftFrequency gaussianNoise"),
+            _p("scaleError", "ignored", "fields are not scaled (said when not 1)"),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_depth_camera", "gazebo_ros_openni_kinect"),
+        "sensor",
+        "gazebo_plugins (ROS 1 Noetic): src/gazebo_ros_depth_camera.cpp:126-129, 675-766; "
+        "src/gazebo_ros_openni_kinect.cpp:101-108, 361-465; src/gazebo_ros_camera_utils.cpp (names, rate)",
+        "depth_camera (out_of_range nan: NaN in the image and the cloud outside the cut-offs)",
+        (
+            *_COMMON,
+            _p("cameraName imageTopicName cameraInfoTopicName depthImageTopicName"),
+            _p("depthImageCameraInfoTopicName pointCloudTopicName frameName"),
+            _p("updateRate", "same", "throttles the sensor's `<update_rate>`"),
+            _p("pointCloudCutoff", "same", "default 0.4 m: at or below, NaN"),
+            _p(
+                "pointCloudCutoffMax",
+                "same",
+                "openni_kinect only, default 5 m: at or beyond, NaN (said "
+                "and unused in depth_camera, as there)",
+            ),
+            _p("triggerTopicName", "ignored", "the camera publishes at its rate"),
+            _p("Cx Cy CxPrime focalLength", "ignored", "CameraInfo is the ideal pinhole of <horizontal_fov>"),
+            _p("hackBaseline borderCrop autoDistortion", "ignored", "stereo/rectification only"),
+            _p(
+                "distortionK1 distortionK2 distortionK3 distortionT1 distortionT2",
+                "ignored",
+                "images are not distorted (said when not 0)",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_camera",),
+        "sensor",
+        "gazebo_plugins (ROS 2 Humble/Jazzy): src/gazebo_ros_camera.cpp:476-478 depth limits, :642-768; "
+        "(ROS 1 Noetic, the same file name): src/gazebo_ros_camera_utils.cpp",
+        "camera, or depth_camera on a depth sensor (out_of_range inf: -inf/+inf in the image and the cloud)",
+        (
+            *_COMMON,
+            _p("camera_name frame_name", "same", "default: the sensor's name; the link"),
+            _p("min_depth", "same", "default 0.4 m: at or below, -inf (x = y = z in the cloud)"),
+            _p("max_depth", "same", "default +inf: at or beyond, +inf"),
+            _p("triggered", "ignored", "the camera publishes at its rate (said)"),
+            _p("cx cy focal_length", "ignored", "CameraInfo is the ideal pinhole of <horizontal_fov>"),
+            _p("hack_baseline border_crop", "ignored", "stereo/rectification only"),
+            _p(
+                "distortion_k1 distortion_k2 distortion_k3 distortion_t1 distortion_t2",
+                "ignored",
+                "images are not distorted (said when not 0)",
+            ),
+            _p(
+                "cameraName imageTopicName cameraInfoTopicName frameName updateRate",
+                "same",
+                "the ROS 1 plugin of the same file name (told apart by its tags)",
+            ),
+        ),
+    ),
 )
 
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from runner.compile.gazebo import thirdparty
+from runner.compile.gazebo import range_plugins, thirdparty
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.tables import (
     CAMERA_KNOWN,
@@ -24,7 +24,8 @@ from runner.compile.gazebo.tables import (
 from runner.compile.gazebo.tags import TagReader, floats, is_zero, join_topic, plugin_base, ros_topic
 from runner.errors import PLUGIN_UNSUPPORTED
 
-_SENSOR_PLUGINS = ROS_SENSOR_PLUGINS | thirdparty.SENSOR_PLUGINS  # velodyne_simulator, hector's sonar
+# velodyne_simulator, hector's sonar; gazebo_ros_range (ROS 1)
+_SENSOR_PLUGINS = ROS_SENSOR_PLUGINS | thirdparty.SENSOR_PLUGINS | range_plugins.RANGE_PLUGINS
 
 
 def read_sensor_plugins(
@@ -53,6 +54,11 @@ def read_sensor_plugins(
         elif base in thirdparty.SENSOR_PLUGINS:
             extra, rates = thirdparty.sensor_plugin(g, r, base, remap, sensor, kind, context)
             found.update(extra)
+        elif base in range_plugins.RANGE_PLUGINS:
+            found.update(range_plugins.ros1_range(g, r, kind, context))
+            rates = ("updateRate",)  # throttles the sensor's updates (gazebo_ros_range.cpp:117-131, 230)
+        elif base == "gazebo_ros_ray_sensor":
+            found.update(range_plugins.ros2_ray_sensor(g, r, remap, context))
         else:
             rates = _ros_sensor_plugin(g, r, base, remap, out_names, context, found)
         _plugin_rates(g, r, rates, filename, found)
@@ -190,9 +196,41 @@ def _camera_plugin(
         out.update(_ros1_camera_topics(r))
         own, other = ROS1_CAMERA_PARAMS, ROS2_CAMERA_PARAMS
     r.mark(*(t for t in own if p.find(t) is not None))
+    if depth:
+        out["params"] = _depth_clip(r, base, ros2)
     if ros2 and r.bool("triggered"):
         g.note(p.find("triggered"), "<triggered> is ignored: the camera publishes at its rate")
     _camera_params_unread(g, r, filename, ros2, own, other, depth)
+    return out
+
+
+def _depth_clip(r: TagReader, base: str, ros2: bool) -> dict[str, Any]:
+    """What the depth plugin does with depths outside its limits, in its depth image and point cloud:
+
+    - ROS 2 `gazebo_ros_camera` on a depth sensor: `<min_depth>` (default 0.4) and `<max_depth>` (default
+      +inf); at or below the min -inf, at or beyond the max +inf, in the image and as x = y = z of the
+      cloud's point (gazebo_ros_camera.cpp:476-478, 679-685, 750-768);
+    - ROS 1 `gazebo_ros_depth_camera`: `<pointCloudCutoff>` (default 0.4): at or below it NaN in the image
+      and the cloud (gazebo_ros_depth_camera.cpp:126-129, 675-680, 754-766); it has no upper cut-off;
+    - ROS 1 `gazebo_ros_openni_kinect`: `<pointCloudCutoff>` (0.4) and `<pointCloudCutoffMax>` (5.0), NaN
+      outside (gazebo_ros_openni_kinect.cpp:101-108, 361-374, 454-465)."""
+    if base not in ("gazebo_ros_camera", "gazebo_ros_depth_camera", "gazebo_ros_openni_kinect") or (
+        base == "gazebo_ros_camera" and not ros2
+    ):
+        return {}  # ROS 1 camera, multicamera: no depth of their own
+    if ros2:
+        lo = r.float("min_depth")
+        hi = r.float("max_depth")
+        return {
+            "min_depth": 0.4 if lo is None else lo,
+            "max_depth": hi if hi is not None and hi != float("inf") else None,
+            "out_of_range": "inf",
+        }
+    lo = r.float("pointCloudCutoff")
+    out: dict[str, Any] = {"min_depth": 0.4 if lo is None else lo, "out_of_range": "nan"}
+    if base == "gazebo_ros_openni_kinect":
+        hi = r.float("pointCloudCutoffMax")
+        out["max_depth"] = 5.0 if hi is None else hi
     return out
 
 
@@ -271,8 +309,17 @@ def _camera_params_unread(
             )
     for tag in ("pointCloudCutoff", "pointCloudCutoffMax", "min_depth", "max_depth"):
         el = p.find(tag)
-        if el is not None and tag in own and depth:
-            g.note(el, f"<{tag}> is not applied: depth and points span the clip planes (<near>..<far>)")
+        if el is not None and tag in own and not depth:
+            g.note(
+                el, f"<{tag}> is read only on a depth sensor: a camera has no depth (Gazebo ignores it too)"
+            )
+    cut_max = p.find("pointCloudCutoffMax")
+    if cut_max is not None and depth and not ros2 and plugin_base(filename) != "gazebo_ros_openni_kinect":
+        g.note(
+            cut_max,
+            f"<pointCloudCutoffMax> is not read by {filename!r} (only by libgazebo_ros_openni_kinect.so): "
+            "Gazebo ignores it too",
+        )
     for tag in ("Cx", "Cy", "CxPrime", "focalLength", "cx", "cy", "focal_length"):
         el = p.find(tag)
         if el is not None and tag in own and not is_zero(el.text):

@@ -12,7 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from runner.compile.gazebo import thirdparty
+from runner.compile.gazebo import field_sensors, thirdparty
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.noise import NoiseSpec, classic_noise_spec, noise_spec, noise_stddev
 from runner.compile.gazebo.sensor_plugins import read_sensor_plugins
@@ -66,7 +66,7 @@ def read_sensor(g: ReaderBase, el: Any, link: str | None) -> None:
             el,
             f"sensor type {kind!r} is not supported yet; {context} is ignored",
             hint="supported: ray, gpu_ray, lidar, gpu_lidar, camera, depth, depth_camera, rgbd_camera, "
-            "imu, contact",
+            "imu, contact, gps, magnetometer, air_pressure, altimeter, force_torque",
             kind=PLUGIN_UNSUPPORTED,
         )
         return
@@ -76,6 +76,11 @@ def read_sensor(g: ReaderBase, el: Any, link: str | None) -> None:
 def _lidar_sensor(g: ReaderBase, s: _Sensor) -> bool:
     params = {**s.common, **_lidar(g, s.r, s.el, s.context)}
     ros = read_sensor_plugins(g, s.plugins, s.context, ("out", "scan"), s.name, s.kind)
+    if ros.get("nothing"):  # its plugin publishes nothing, as said (gazebo_ros_range, ray_sensor)
+        g.ignored(s.r, s.context)
+        return False
+    if "rate" not in (ros.get("params") or {}):
+        _plugin_rate(params, s.rate, ros)  # gazebo_ros_range's <updateRate> throttles the sensor
     params["topic"] = ros.get("topic") or s.base_topic or "scan"
     params["frame_id"] = ros.get("frame") or s.frame
     if ros.get("noise"):  # gazebo_ros_block_laser adds its <gaussianNoise> to the sensor's noise
@@ -141,6 +146,7 @@ def _depth_sensor(g: ReaderBase, s: _Sensor) -> bool:
             points_topic=ros["points"],
         )
     params["frame_id"] = ros.get("frame") or s.frame
+    params.update(ros.get("params") or {})  # the plugin's depth limits (sensor_plugins._depth_clip)
     _plugin_rate(params, s.rate, ros)
     g.add(s.el, "depth_camera", s.name, params)
     return True
@@ -185,6 +191,11 @@ _KINDS: dict[str, Callable[[ReaderBase, _Sensor], bool]] = {
     **dict.fromkeys(("depth", "depth_camera", "rgbd_camera", "rgbd"), _depth_sensor),
     "imu": _imu_sensor,
     "contact": _contact_sensor,
+    # runner/compile/gazebo/field_sensors.py
+    "magnetometer": field_sensors.magnetometer,
+    "air_pressure": field_sensors.air_pressure,
+    "altimeter": field_sensors.altimeter,
+    "force_torque": field_sensors.force_torque,
 }
 
 

@@ -279,9 +279,75 @@ def hector_gps(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> tuple[str,
     return "gps", params
 
 
+def hector_magnetic(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> tuple[str, dict[str, Any]]:
+    """hector_gazebo_plugins' magnetometer (`libhector_gazebo_ros_magnetic.so`, gazebo_ros_magnetic.cpp).
+    Its parameters -> `magnetometer`:
+
+    | hector | ours |
+    |---|---|
+    | bodyName (default: the model's first link) | link |
+    | topicName (`magnetic`) | topic |
+    | frameId (default: the link's name) | frame_id |
+    | updateRate / updatePeriod (default: every physics step) | rate |
+    | magnitude (1), referenceHeading (0 deg), declination (0 deg), inclination (60 deg) | field (:121-130) |
+    | useMagneticFieldMsgs (false: geometry_msgs/Vector3Stamped) | message |
+    | offset, drift, driftFrequency, gaussianNoise | noise_mean, drift, drift_frequency, noise_stddev |
+
+    Each of the error parameters is per axis. The field is in Gazebo's world frame, a compass heading
+    turning it about z."""
+    filename = r.el.get("filename")
+    topic = ros_topic(r.text("topicName")) or "magnetic"
+    link = r.text("bodyName") or _root_link(g)
+    frame = r.text("frameId")
+
+    def deg(tag: str, default: float) -> float:
+        value = r.float(tag)
+        return math.radians(default if value is None else value)
+
+    magnitude = r.float("magnitude")
+    magnitude = 1.0 if magnitude is None else magnitude
+    heading, declination, inclination = (
+        deg("referenceHeading", 0.0),
+        deg("declination", 0.0),
+        deg("inclination", 60.0),
+    )
+    field = [
+        magnitude * math.cos(inclination) * math.cos(heading - declination),
+        magnitude * math.cos(inclination) * math.sin(heading - declination),
+        -magnitude * math.sin(inclination),
+    ]
+    params: dict[str, Any] = {
+        "link": link,
+        "topic": remap.get(topic) or topic,
+        "frame_id": g.frame(frame or link),
+        "rate": _rate(g, r),
+        "field": field,
+        "message": "sensor_msgs/msg/MagneticField"
+        if r.bool("useMagneticFieldMsgs")
+        else "geometry_msgs/msg/Vector3Stamped",
+    }
+    if params["rate"] is None:
+        g.note(
+            r.el,
+            f"{filename!r} has no <updateRate> (or 0): Gazebo publishes it at every physics step; here at "
+            "the magnetometer plugin's 50 Hz",
+            hint="add <updateRate> (or set `rate` in the scenario's plugin params)",
+        )
+    offset, drift, frequency, noise = _hector_model(g, r, "", "fields", "", per_axis=True)
+    if any(offset):
+        params["noise_mean"] = offset
+    if any(drift):
+        params["drift"] = [abs(v) for v in drift]
+        params["drift_frequency"] = frequency
+    if any(noise):
+        params["noise_stddev"] = [abs(v) for v in noise]
+    return "magnetometer", params
+
+
 MODEL_PLUGINS = {
     "hector_gazebo_ros_imu": hector_imu,
     "hector_gazebo_ros_gps": hector_gps,
+    "hector_gazebo_ros_magnetic": hector_magnetic,
 }
 
 
