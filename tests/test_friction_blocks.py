@@ -322,3 +322,32 @@ def test_a_box_slides_as_far_as_coulomb_friction_with_the_blocks_mu_says(tmp_pat
     slid = samples[-1][1].pose.pose.position.x - before
     expected = 1.0 / (2 * 9.81 * mu)
     assert math.isclose(slid, expected, rel_tol=0.1), (slid, expected)
+
+
+# ------------------------------------------------------------------------------------ a world's models
+def test_a_world_models_friction_direction_and_slip_are_said_with_why(tmp_path: Path):
+    """World SDF (runner.compile.sdf): mu/mu2 are used (the smaller); fdir1, slip1, slip2 are said with
+    the reason, at their lines."""
+    import mujoco
+
+    from runner.compile.packages import PackageMap
+    from runner.compile.sdf import load_sdf_world
+
+    path = tmp_path / "w.sdf"
+    path.write_text(
+        """<sdf version="1.9"><world name="w"><model name="m"><static>true</static><link name="l">
+<collision name="c"><geometry><box><size>1 1 1</size></box></geometry>
+<surface><friction><ode><mu>0.6</mu><mu2>0.3</mu2>
+<fdir1>1 0 0</fdir1>
+<slip1>0.1</slip1><slip2>0.1</slip2></ode></friction></surface></collision>
+</link></model></world></sdf>
+"""
+    )
+    notices = Notices()
+    spec = mujoco.MjSpec()
+    load_sdf_world(spec, path, PackageMap(roots=[tmp_path]), notices)
+    assert spec.compile().geom("m/l/c").friction[0] == pytest.approx(0.3)
+    said = {n.message: n.location.line for n in notices}
+    assert said["SDF <fdir1> ignored: anisotropic friction of world models is not simulated: the smaller "
+                "of mu and mu2 is used"] == 4  # fmt: skip
+    assert said["SDF <slip1> ignored: force-dependent slip is not simulated"] == 5

@@ -24,7 +24,7 @@ everything else:
 - fdir1 at another angle, fixed in a link the wheel turns on (`gz:expressed_in="base_link"`): a ring of 16
   short capsules around the wheel (radius half the wheel's, their outer points on its circle), each with
   its axis set so that it lies along fdir1 whenever that capsule is the one at the bottom. The wheel rolls
-  on a 16-gon of spheres (its centre moves up and down by 0.96 % of half its radius) and the friction
+  on a 16-gon of spheres (its centre moves up and down by 0.96 % of its radius) and the friction
   direction is off by at most a few degrees between two capsules.
 
 Measured (tests/test_gazebo_parity.py, tests/test_friction_blocks.py): a 4-wheel skid steer with mu1 = 1
