@@ -280,6 +280,46 @@ def test_a_diagonal_fdir1_in_the_wheels_own_frame_turns_with_it_as_in_gazebo_and
     assert 'gz:expressed_in="base_link"' in text
 
 
+_CONTROLLERS = """
+/**:
+  controller_manager:
+    ros__parameters:
+      update_rate: 100
+      base: {type: mecanum_drive_controller/MecanumDriveController}
+  base:
+    ros__parameters:
+      reference_timeout: 0.5
+      front_left_wheel_command_joint_name: front_left_wheel_joint
+      front_right_wheel_command_joint_name: front_right_wheel_joint
+      rear_right_wheel_command_joint_name: rear_right_wheel_joint
+      rear_left_wheel_command_joint_name: rear_left_wheel_joint
+      kinematics: {wheels_radius: 0.05, sum_of_robot_center_projection_on_X_Y_axis: 0.29}
+"""
+
+
+@pytest.mark.timeout(60)
+def test_a_mecanum_controller_drives_wheels_that_grip_by_friction_as_described(tmp_path: Path):
+    """ros2_controllers' mecanum_drive_controller from a gz_ros2_control controllers file, on wheels whose
+    description gives them mecanum friction: no rollers of ours (Gazebo drives the wheels as described),
+    the friction rings instead; it strafes as its kinematics say."""
+    (tmp_path / "control.yaml").write_text(_CONTROLLERS)
+    control = f"""<gazebo><plugin filename="gz_ros2_control-system" name="gz_ros2_control::GazeboSimROS2ControlPlugin">
+      <parameters>{tmp_path / "control.yaml"}</parameters></plugin></gazebo>"""
+    (tmp_path / "robot.urdf").write_text(mecanum_bot().replace("\n</robot>", f"{control}\n</robot>"))
+    path = tmp_path / "scenario.yaml"
+    scenario = SCENARIO.split("      - type: mecanum_drive")[0]
+    path.write_text(scenario.format(duration=4.5) + "timeline:\n" + _reference(0.5, 3.5, vy=0.2).replace(
+        "r1/drive/reference", "r1/base/reference"))  # fmt: skip
+    plan, _ = compile_with_notices(path)
+    drive = next(p for p in plan.robots[0].plugins if p.type == "mecanum_drive")
+    assert drive.params["rollers"] is False
+    assert plan.mjcf.count("<pair") == 4 * 16 and "roller" not in plan.mjcf
+    _, bus = simulate(path)
+    samples = messages(bus, "r1/ground_truth")
+    y = samples[-1][1].pose.pose.position.y - samples[0][1].pose.pose.position.y
+    assert abs(y / STRAFE_M - 1) < 0.1, y
+
+
 # ------------------------------------------------------------------------------ Coulomb sliding distance
 _BOX = """<?xml version="1.0"?>
 <robot name="box">
