@@ -391,3 +391,12 @@ def test_a_world_models_friction_direction_and_slip_are_said_with_why(tmp_path: 
     assert said["SDF <fdir1> ignored: anisotropic friction of world models is not simulated: the smaller "
                 "of mu and mu2 is used"] == 4  # fmt: skip
     assert said["SDF <slip1> ignored: force-dependent slip is not simulated"] == 5
+
+
+def test_robot_description_with_an_undeclared_gz_prefix_gets_its_frames_prefixed():
+    """The robot_description the scene publishes names frames as TF does (`r1/base_link`), also for a
+    description with `gz:expressed_in` and no `xmlns:gz` (it used to come back unprefixed)."""
+    from runner.frames import prefixed_urdf
+
+    out = prefixed_urdf(mecanum_bot(), "r1")
+    assert '<link name="r1/base_link">' in out and '<gazebo reference="r1/front_left_wheel">' in out
