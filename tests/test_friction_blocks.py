@@ -128,6 +128,13 @@ def test_urdf_keys_win_over_the_surface_block_and_an_unknown_frame_is_said():
     assert (props.mu1, props.mu2, props.friction, props.kp) == (0.7, 0.2, 0.2, 5000)
     assert props.fdir1_frame is None
     assert any("'chassis', which is not a link of the robot" in m for m, _ in said), said
+    # one of mu, mu2 given: the other is SDF's default 1 for mu, mu for mu2 (dartsim)
+    info, _ = _read('<gazebo reference="wheel"><collision><surface><friction><ode><mu2>0.3</mu2>'
+                    "<fdir1>1 0 0</fdir1></ode></friction></surface></collision></gazebo>")  # fmt: skip
+    assert (info.links["wheel"].mu1, info.links["wheel"].mu2) == (1.0, 0.3)
+    info, _ = _read('<gazebo reference="wheel"><collision><surface><friction><ode><mu>0.4</mu>'
+                    "</ode></friction></surface></collision></gazebo>")  # fmt: skip
+    assert (info.links["wheel"].mu1, info.links["wheel"].mu2, info.links["wheel"].friction) == (0.4, 0.4, 0.4)
 
 
 # ------------------------------------------------------------------------- a mecanum robot by friction

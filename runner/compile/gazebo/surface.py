@@ -104,6 +104,12 @@ def _surface(g: Any, surface: Any, where: str, link: str, props: LinkProps) -> N
 def _friction_ode(g: Any, ode: Any, where: str, link: str, props: LinkProps) -> None:
     o = TagReader(ode)
     mu, mu2 = o.float("mu"), o.float("mu2")
+    if mu2 is not None and mu is None:
+        mu = 1.0  # SDF's default, in both engines
+    if mu is not None and mu2 is None:
+        # dartsim: setFrictionCoeff(mu) sets both directions, then mu2 only if given (SDFFeatures.cc); classic
+        # ODE takes SDF's default 1 for mu2 (said in docs/gazebo_parity.md §14)
+        mu2 = mu
     if mu is not None:
         props.mu1 = mu
     if mu2 is not None:
