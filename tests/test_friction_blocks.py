@@ -42,10 +42,10 @@ FULL_BLOCK = """<gazebo reference="wheel">
         <bullet><friction>1</friction><friction2>1</friction2><fdir1>0 0 0</fdir1><rolling_friction>1</rolling_friction></bullet>
       </friction>
       <contact>
-        <collide_without_contact>false</collide_without_contact>
+        <collide_without_contact>true</collide_without_contact>
         <collide_without_contact_bitmask>1</collide_without_contact_bitmask>
-        <collide_bitmask>0xffff</collide_bitmask>
-        <category_bitmask>0xffff</category_bitmask>
+        <collide_bitmask>0x01</collide_bitmask>
+        <category_bitmask>0x02</category_bitmask>
         <poissons_ratio>0.3</poissons_ratio>
         <elastic_modulus>-1</elastic_modulus>
         <ode><soft_cfm>0</soft_cfm><soft_erp>0.2</soft_erp><kp>100000</kp><kd>10</kd>
@@ -135,6 +135,23 @@ def test_urdf_keys_win_over_the_surface_block_and_an_unknown_frame_is_said():
     info, _ = _read('<gazebo reference="wheel"><collision><surface><friction><ode><mu>0.4</mu>'
                     "</ode></friction></surface></collision></gazebo>")  # fmt: skip
     assert (info.links["wheel"].mu1, info.links["wheel"].mu2, info.links["wheel"].friction) == (0.4, 0.4, 0.4)
+
+
+def test_elements_at_the_values_we_simulate_anyway_are_used_silently():
+    """slip 0, no restitution, torsion without a patch, contacts that touch, the default bitmasks: what
+    Gazebo does with them is what we do, so nothing is said (only what changes behaviour is)."""
+    block = """<gazebo reference="wheel"><collision><surface>
+      <bounce><restitution_coefficient>0</restitution_coefficient></bounce>
+      <friction><torsional><coefficient>1</coefficient></torsional>
+        <ode><mu>1</mu><mu2>1</mu2><slip1>0</slip1><slip2>0.0</slip2></ode></friction>
+      <contact><collide_without_contact>false</collide_without_contact><collide_bitmask>0xffff</collide_bitmask>
+        <category_bitmask>65535</category_bitmask></contact>
+    </surface></collision></gazebo>"""
+    info, said = _read(block)
+    assert said == [] and info.links["wheel"].friction == 1.0
+    # a torsional patch is friction Gazebo applies: said
+    _, said = _read(block.replace("<coefficient>1</coefficient>", "<patch_radius>0.02</patch_radius>"))
+    assert [m.split(" in ")[0] for m, _ in said] == ["<torsional>"]
 
 
 # ------------------------------------------------------------------------- a mecanum robot by friction

@@ -151,9 +151,48 @@ def _expressed_in(g: Any, el: Any, link: str) -> str | None:
     return None
 
 
+def _number(el: Any, tag: str, default: float) -> float:
+    text = el.findtext(tag)
+    try:
+        return float(text) if text is not None and text.strip() else default
+    except ValueError:
+        return float("nan")  # not a number: said
+
+
+def _no_torsion(el: Any) -> bool:
+    """Classic ODE's torsional friction acts on a patch: with use_patch_radius (the default) of radius
+    <patch_radius>, else of <surface_radius> and the depth; both 0 by default: no torque at all."""
+    use_patch = (el.findtext("use_patch_radius") or "true").strip().lower() in ("1", "true")
+    return _number(el, "patch_radius" if use_patch else "surface_radius", 0.0) == 0.0
+
+
+def _integer(text: str | None) -> int | None:
+    try:
+        return int((text or "").strip(), 0)
+    except ValueError:
+        return None
+
+
+# Elements whose value is what we do anyway (SDF's defaults, mostly): used as they are, nothing to say
+_SAME_IF = {
+    "slip1": lambda el: _number(el, ".", 0.0) == 0.0,
+    "slip2": lambda el: _number(el, ".", 0.0) == 0.0,
+    "torsional": _no_torsion,
+    "bounce": lambda el: _number(el, "restitution_coefficient", 0.0) == 0.0,
+    "collide_without_contact": lambda el: (el.text or "").strip().lower() in ("0", "false"),
+    "collide_bitmask": lambda el: _integer(el.text) == 0xFFFF,
+    "category_bitmask": lambda el: _integer(el.text) == 0xFFFF,
+}
+
+
 def _say_rest(g: Any, reader: TagReader, where: str) -> None:
-    """What nothing read in this element: said at each element's line, with what Gazebo does with it."""
+    """What nothing read in this element: said at each element's line, with what Gazebo does with it
+    (unless its value is what we do anyway)."""
     for el in reader.leftovers():
+        same = _SAME_IF.get(el.tag)
+        if same is not None and el.tag not in reader.single and same(el):
+            reader.mark(el.tag)
+            continue
         reason = _REASONS.get(el.tag)
         if reason is not None and el.tag not in reader.single:
             reader.mark(el.tag)
