@@ -128,6 +128,11 @@ def test_urdf_keys_win_over_the_surface_block_and_an_unknown_frame_is_said():
     assert (props.mu1, props.mu2, props.friction, props.kp) == (0.7, 0.2, 0.2, 5000)
     assert props.fdir1_frame is None
     assert any("'chassis', which is not a link of the robot" in m for m, _ in said), said
+    # <mu> is not a URDF key: Gazebo copies it into the link, where nothing reads it
+    info, said = _read('<gazebo reference="wheel"><mu>0.1</mu></gazebo>')
+    assert info.links["wheel"].friction is None
+    assert said == [('<mu> in <gazebo reference="wheel"> is ignored, as in Gazebo: the keys are <mu1> and <mu2> '
+                     "(<mu> belongs in <collision><surface><friction><ode>)", 6)]  # fmt: skip
     # one of mu, mu2 given: the other is SDF's default 1 for mu, mu for mu2 (dartsim)
     info, _ = _read('<gazebo reference="wheel"><collision><surface><friction><ode><mu2>0.3</mu2>'
                     "<fdir1>1 0 0</fdir1></ode></friction></surface></collision></gazebo>")  # fmt: skip

@@ -179,12 +179,21 @@ class GazeboReader(ReaderBase):
         for coll in r.children("collision"):
             read_collision_block(self, coll, link, props)
         mu1, mu2 = r.float("mu1"), r.float("mu2")
-        mu_key = r.float("mu")
         if mu1 is not None:
             props.mu1 = mu1
         if mu2 is not None:
             props.mu2 = mu2
-        mu = [v for v in (props.mu1, props.mu2, mu_key) if v is not None]
+        mu_el = r.child("mu")
+        if mu_el is not None:
+            # not a key of sdformat's URDF parser (parser_urdf.cc, ParseSDFExtension): copied into the <link>,
+            # where SDF has no <mu>, so Gazebo's friction stays as it was
+            self.note(
+                mu_el,
+                f'<mu> in <gazebo reference="{link}"> is ignored, as in Gazebo: the keys are <mu1> and <mu2> '
+                "(<mu> belongs in <collision><surface><friction><ode>)",
+                hint=f"write <mu1> and <mu2>, or a <collision><surface> block in the reference {link!r}",
+            )
+        mu = [v for v in (props.mu1, props.mu2) if v is not None]
         if mu:
             props.friction = min(mu)
         fdir_el = r.child("fdir1")
