@@ -176,19 +176,25 @@ def _mecanum_wheel(name: str, shape: str, frame: str | None) -> str:
     x, y = _AT[name]
     geometry = (
         f'<origin rpy="1.5708 0 0"/><geometry><cylinder radius="{_RADIUS}" length="0.04"/></geometry>'
-        if shape == "cylinder"
+        if shape in ("cylinder", "tyre")
         else f'<geometry><sphere radius="{_RADIUS}"/></geometry>'
     )
     expressed = f' gz:expressed_in="{frame}"' if frame else ""
+    # "tyre": the collision on a link fixed to the one the wheel joint turns (Gazebo lumps it into the wheel)
+    tyre = f"""<link name="{name}_tyre"><inertial><mass value="0.1"/>{_INERTIA.format(i=0.0001)}</inertial>
+    <collision>{geometry}</collision></link>
+  <joint name="{name}_tyre_joint" type="fixed"><parent link="{name}_wheel"/><child link="{name}_tyre"/></joint>"""
+    collision = f'<collision name="{name}_wheel_collision">{geometry}</collision>'
     return f"""
   <link name="{name}_wheel">
     <inertial><mass value="0.3"/>{_INERTIA.format(i=0.0004)}</inertial>
-    <collision name="{name}_wheel_collision">{geometry}</collision>
+    {collision if shape != "tyre" else ""}
   </link>
+  {tyre if shape == "tyre" else ""}
   <joint name="{name}_wheel_joint" type="continuous">
     <parent link="base_link"/><child link="{name}_wheel"/><origin xyz="{x} {y} -0.05"/><axis xyz="0 1 0"/>
   </joint>
-  <gazebo reference="{name}_wheel">
+  <gazebo reference="{name}_{"tyre" if shape == "tyre" else "wheel"}">
     <collision name="{name}_wheel_collision">
       <surface><friction><ode>
         <mu>1.0</mu><mu2>0.0</mu2><fdir1{expressed}>{_DIAGONAL[name]}</fdir1>
@@ -283,7 +289,7 @@ def mecanum_moves(
 
 
 @pytest.mark.timeout(120)
-@pytest.mark.parametrize(("shape", "xmlns"), [("cylinder", False), ("sphere", True)])
+@pytest.mark.parametrize(("shape", "xmlns"), [("cylinder", False), ("sphere", True), ("tyre", False)])
 def test_a_mecanum_robot_by_friction_strafes_and_turns_as_its_rollers_say(
     tmp_path: Path, shape: str, xmlns: bool
 ):

@@ -267,11 +267,18 @@ def _welded(a: Any, b: Any) -> bool:
 
 
 def _axle(body: Any) -> np.ndarray | None:
-    """The axis (in the body's frame) of the body's hinge: what the wheel turns about."""
-    for j in body.joints:
-        if j.type == mujoco.mjtJoint.mjJNT_HINGE:
-            a = np.array(j.axis, dtype=float)
+    """The axis (in the body's frame) of the hinge the body turns on: its own, or that of the link it is
+    fixed to (a tyre fixed to a hub that the wheel joint turns)."""
+    x = body
+    while x is not None and x.name != "world":
+        hinges = [j for j in x.joints if j.type == mujoco.mjtJoint.mjJNT_HINGE]
+        if hinges:
+            a = np.array(hinges[0].axis, dtype=float)
+            a = _mat(_world_quat(body)).T @ _mat(_world_quat(x)) @ a
             return a / np.linalg.norm(a)
+        if x.joints:
+            return None  # a joint of another kind: no single axle
+        x = x.parent
     return None
 
 
