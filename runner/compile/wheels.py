@@ -8,24 +8,23 @@ DefaultContactSurfaceHandler::computeWorldFirstFrictionDir), or in gz-sim in the
 Skid-steer descriptions rely on it (a low friction along the axle lets the wheels slide sideways so the
 robot turns in place), and so do mecanum-by-friction ones (mu 1 along a diagonal, mu2 0 across it).
 
-MuJoCo's friction is isotropic, except in an explicit contact `<pair>`, whose five friction values start
-with the two tangent directions of the contact frame. Of MuJoCo's colliders only plane-capsule orients that
-frame: its first tangent is the capsule's axis projected on the plane (engine_collision_primitive.c,
-mjc_PlaneCapsule "align contact frames with capsule axis"; mju_makeFrame orthogonalizes it); every other
-pair gets a tangent fixed in the world. So each round collision (cylinder, sphere) of such a link gets a
-capsule proxy paired with the ground plane, with friction (along its axis, across it), seen by no other
-collision and no camera, and its own geom stops touching the ground (collision bits) and still meets
-everything else:
-- fdir1 along the axle, or across it in the wheel's plane (a skid steer): a capsule on the axle, as wide
-  as the cylinder, with (mu1, mu2) or (mu2, mu1): the frame is the same at every wheel angle.
-- fdir1 at another angle, fixed in the wheel (no `expressed_in`, or a link fixed to the wheel): one short
-  capsule (a sphere of the wheel's radius, its axis along fdir1) turning with the wheel, as Gazebo's
-  direction does; said, since a mecanum wheel wants its direction fixed in the base.
-- fdir1 at another angle, fixed in a link the wheel turns on (`gz:expressed_in="base_link"`): a ring of 16
-  short capsules around the wheel (radius half the wheel's, their outer points on its circle), each with
-  its axis set so that it lies along fdir1 whenever that capsule is the one at the bottom. The wheel rolls
-  on a 16-gon of spheres (its centre moves up and down by 0.96 % of its radius) and the friction
-  direction is off by at most a few degrees between two capsules.
+MuJoCo's friction is isotropic, except in an explicit contact `<pair>`, whose five friction values start with
+the two tangent directions of the contact frame. Of MuJoCo's colliders only plane-capsule orients that frame:
+its first tangent is the capsule's axis projected on the plane (engine_collision_primitive.c 66-96,
+mjc_PlaneCapsule "align contact frames with capsule axis"; engine_util_spatial.c 512-537, mju_makeFrame
+orthogonalizes it, or picks world y when none is set); every other pair gets a tangent fixed in the world. So
+each round collision (cylinder, sphere) of such a link gets a capsule proxy paired with the ground plane, with
+friction (along its axis, across it), seen by no other collision and no camera, and its own geom stops
+touching the ground (collision bits) and still meets everything else: - fdir1 along the axle, or across it in
+the wheel's plane (a skid steer): a capsule on the axle, as wide as the cylinder, with (mu1, mu2) or (mu2,
+mu1): the frame is the same at every wheel angle. - fdir1 at another angle, fixed in the wheel (no
+`expressed_in`, or a link fixed to the wheel): one short capsule (a sphere of the wheel's radius, its axis
+along fdir1) turning with the wheel, as Gazebo's direction does; said, since a mecanum wheel wants its
+direction fixed in the base. - fdir1 at another angle, fixed in a link the wheel turns on
+(`gz:expressed_in="base_link"`): a ring of 16 short capsules around the wheel (radius half the wheel's, their
+outer points on its circle), each with its axis set so that it lies along fdir1 whenever that capsule is the
+one at the bottom. The wheel rolls on a 16-gon of spheres (its centre moves up and down by 0.96 % of its
+radius) and the friction direction is off by at most a few degrees between two capsules.
 
 Measured (tests/test_gazebo_parity.py, tests/test_friction_blocks.py): a 4-wheel skid steer with mu1 = 1
 along the rolling direction and mu2 = 0.1 turns in place at ~95 % of its command, against ~30 % with

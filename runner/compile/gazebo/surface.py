@@ -1,14 +1,16 @@
 """`<collision>` blocks of a `<gazebo reference="link">`: the SDF `<surface>` a URDF link's collisions get.
 
-sdformat's URDF parser (src/parser_urdf.cc) keeps each child of such a `<collision>` as a blob and copies it
-into **every** collision of the link (`ParseSDFExtension`, "are treated as blobs that gets inserted into
-all collisions and visuals for the link"; `InsertSDFExtensionCollision`: a `<surface>` blob replaces the
-collision's surface, then the URDF keys `mu1`/`mu2`/`fdir1`/`kp`/`kd` are written over it). The block's own
-`name` attribute is not read there: the blob goes to all of the link's own collisions, whatever it says.
+sdformat's URDF parser (src/parser_urdf.cc, main 2ace536) keeps each child of such a `<collision>` as a blob
+and copies it into **every** collision of the link (`ParseSDFExtension`, lines 1322-1363: "are treated as
+blobs that gets inserted into all collisions and visuals for the link"; `InsertSDFExtensionCollision`,
+1604-1900: a `<surface>` blob replaces the collision's surface (1695-1717), then the URDF keys
+`mu1`/`mu2`/`fdir1`/`kp`/`kd` are written over it (1859-1882); the keys it knows: 1366-1480, no `mu`). The
+block's own `name` attribute is not read there: the blob goes to all of the link's own collisions, whatever it
+says.
 
 What the engines then do with a `<surface>` (cited where it is used):
 - `<friction><ode><mu>`, `<mu2>`: classic ODE (gazebo/physics/ode/ODEPhysics.cc, `ODEPhysics::Collide`)
-  and gz-physics dartsim (dartsim/src/SDFFeatures.cc, `ConstructSdfCollision`: `setFrictionCoeff`,
+  and gz-physics dartsim (dartsim/src/SDFFeatures.cc 925-960, `ConstructSdfCollision`: `setFrictionCoeff`,
   `setSecondaryFrictionCoeff`; DART's ContactSurface.cpp, `DefaultContactSurfaceHandler::createParams`)
   both combine two surfaces by the **smaller** value, per direction.
 - `<fdir1>`: the first friction direction, in the collision's frame (both engines rotate it with the
