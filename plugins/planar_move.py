@@ -52,22 +52,7 @@ class PlanarMove(Plugin):
 
     @classmethod
     def build(cls, params: PlanarMoveParams, ctx: BuildContext, name: str) -> list[Topic]:
-        base = ctx.body(ctx.root)
-        if not any(j.type == mujoco.mjtJoint.mjJNT_FREE for j in base.joints):
-            raise PluginConfigError(
-                f"robot {ctx.robot!r} has no free base to move", hint="planar_move needs `fixed: false`"
-            )
-        site = f"{name}_base"
-        if ctx.spec.site(site) is not None:
-            raise PluginConfigError(f"a site named {site!r} already exists", hint="give the plugin a `name:`")
-        base.add_site(name=site, size=[0.005, 0.005, 0.005], group=4)
-        gears = ([1, 0, 0, 0, 0, 0], [0, 1, 0, 0, 0, 0], [0, 0, 0, 0, 0, 1])
-        for axis, gear in zip(_AXES, gears, strict=True):
-            act = ctx.spec.add_actuator(name=f"{name}/{axis}", target=site, trntype=mujoco.mjtTrn.mjTRN_SITE)
-            act.gear = gear
-            act.set_to_velocity(kv=1.0)  # gains and limits are set in setup(), from the compiled model
-            act.forcelimited = True
-            act.forcerange = [-1.0, 1.0]
+        add_planar_servos(ctx, name)
         return drive_topics(params)
 
     def setup(self) -> None:
@@ -135,6 +120,28 @@ class PlanarMove(Plugin):
             self.odom_out.publish(now_ns, pos, quat, self.vel[3:], self.vel[:3])
         if self.tf_out:
             self.tf_out.publish(now_ns, pos, quat)
+
+
+def add_planar_servos(ctx: BuildContext, name: str) -> None:
+    """Three velocity servos on a site at the base link's origin: along its x and y axes and about its z
+    axis (`<name>/x`, `<name>/y`, `<name>/yaw`); gains and limits are set in setup(), from the compiled
+    model. Also used by plugins.force_based_move."""
+    base = ctx.body(ctx.root)
+    if not any(j.type == mujoco.mjtJoint.mjJNT_FREE for j in base.joints):
+        raise PluginConfigError(
+            f"robot {ctx.robot!r} has no free base to move", hint=f"{name} needs `fixed: false`"
+        )
+    site = f"{name}_base"
+    if ctx.spec.site(site) is not None:
+        raise PluginConfigError(f"a site named {site!r} already exists", hint="give the plugin a `name:`")
+    base.add_site(name=site, size=[0.005, 0.005, 0.005], group=4)
+    gears = ([1, 0, 0, 0, 0, 0], [0, 1, 0, 0, 0, 0], [0, 0, 0, 0, 0, 1])
+    for axis, gear in zip(_AXES, gears, strict=True):
+        act = ctx.spec.add_actuator(name=f"{name}/{axis}", target=site, trntype=mujoco.mjtTrn.mjTRN_SITE)
+        act.gear = gear
+        act.set_to_velocity(kv=1.0)
+        act.forcelimited = True
+        act.forcerange = [-1.0, 1.0]
 
 
 def _servo_inertia(m: mujoco.MjModel, d: mujoco.MjData, site: int) -> np.ndarray:

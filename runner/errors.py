@@ -213,13 +213,46 @@ class Problems:
             raise ScenarioError(self.ordered(), note)
 
 
+# The kinds of notice that the checks give by name (`Notices.add(..., kind=...)`); any other notice's kind is
+# its message with the parts that vary (quoted names, <tags>, numbers) taken out (`kind_of`). `scenario
+# validate` prints one line per kind (and what it is about), and leads with the kinds that change what the
+# run does (runner.cli.plans: LEADING).
+UNSUBSCRIBED = "command-unsubscribed"  # a timeline entry or bridge publishes where nothing subscribes
+DRIVE_GEOMETRY = "drive-geometry"  # a drive's declared wheel values are not the robot's: it is scaled
+PLUGIN_UNSUPPORTED = "plugin-unsupported"  # a Gazebo plugin or sensor left out (its topics, motion)
+NO_PUBLISHER = "sensor-no-publisher"  # a sensor that publishes nothing (as in Gazebo)
+TAG_IGNORED = "tag-ignored"  # a tag read but not acted on (about: the tag)
+
+_VARYING = re.compile(
+    r"'[^']*'|\"[^\"]*\"|`[^`]*`"  # quoted names and values
+    r"|</?[A-Za-z_][\w:.-]*(?:\s[^<>]*)?/?>"  # <tags>, with their attributes
+    r"|-?\d+(?:\.\d+)?(?:e-?\d+)?"  # numbers
+)
+
+
+def kind_of(message: str) -> str:
+    """The kind of a notice not given one: its message with quoted names, <tags> and numbers written as
+    `…`, so that "<always_on> in <sensor name='imu'> is ignored" and the same of another sensor are one
+    kind."""
+    return _VARYING.sub("…", message)
+
+
+def varying_parts(message: str) -> list[str]:
+    """What `kind_of` takes out of `message`, in order: the quoted names, <tags> and numbers."""
+    return _VARYING.findall(message)
+
+
 @dataclass(frozen=True)
 class Notice:
-    """A warning: something in an input that we read but do not act on (never fatal, never silent)."""
+    """A warning: something in an input that we read but do not act on (never fatal, never silent).
+    `kind` says which check gave it (see `kind_of`), `about` what it is about where notices of one kind
+    about different things are to be told apart (a topic, a tag)."""
 
     message: str
     location: Location = field(default_factory=Location)
     hint: str | None = None
+    kind: str = ""
+    about: str | None = None
 
     def render(self) -> str:
         text = f"{self.location}: {self.message}"
@@ -234,12 +267,19 @@ class Notices:
         self._seen: set[tuple[str, str]] = set()
 
     def add(
-        self, message: str, file: Path | None = None, line: int | None = None, hint: str | None = None
+        self,
+        message: str,
+        file: Path | None = None,
+        line: int | None = None,
+        hint: str | None = None,
+        *,
+        kind: str | None = None,
+        about: str | None = None,
     ) -> None:
         key = (message, str(file))
         if key not in self._seen:
             self._seen.add(key)
-            self.items.append(Notice(message, Location(file, line), hint))
+            self.items.append(Notice(message, Location(file, line), hint, kind or kind_of(message), about))
 
     def __iter__(self):  # type: ignore[no-untyped-def]
         return iter(self.items)

@@ -213,6 +213,19 @@ class RecordPlan(BaseModel):
     compression: Literal["zstd", "none"] = "zstd"  # the chunks' (recordings of older plans: zstd)
 
 
+class NoticePlan(BaseModel):
+    """One warning of compile, as data (`scenario validate --json`; the CLI groups them by kind): its
+    message, where, its hint, its kind (runner.errors.kind_of) and what it is about (a topic, a tag)."""
+
+    message: str
+    file: str | None = None
+    line: int | None = None
+    hint: str | None = None
+    kind: str = ""
+    about: str | None = None
+    text: str = ""  # as printed: "file:line: message" and the hint
+
+
 class RunPlan(BaseModel):
     name: str
     scenario_file: str | None
@@ -231,6 +244,7 @@ class RunPlan(BaseModel):
     notices: list[str] = []  # warnings from compile: tags read but not acted on, and the scenario's own
     # warnings about the scenario file itself (a window past its end, a typo'd topic): errors with --strict
     scenario_warnings: list[str] = []
+    notice_items: list[NoticePlan] = []  # `notices` as data, each with its kind: what validate groups
     assertions: list[dict[str, Any]] = []  # the scenario's assertion models, as plain data
     assertion_keys: list[str] = []  # the key each assertion reads
     # what of the scenario a robot spawned at run time is compiled against (runner.compile.spawn)

@@ -54,7 +54,12 @@ def _script() -> list[dict[str, Any]]:
         "initial_pose": {"position": {"x": 2.0, "y": 1.0, "z": 0.11}, "orientation": {"w": 1.0}},
     }
     return [
-        {"topics": True, "wait_for": ["/bot/tf"]},
+        # as `ros2 service call` waits for its service: the bridge offers one once the world answers it, and
+        # the plan's topics (`/bot/tf`) are there before that; the SDK's client does not wait by itself
+        {
+            "list": True,
+            "wait_for": ["/spawn_entity", "/delete_entity", "/get_entity_state", "/world/sp/create"],
+        },
         {"call": "/spawn_entity", "type": "gazebo_msgs/srv/SpawnEntity", "request": spawn},
         {"topics": True, "wait_for": ["/r9/odom", "/r9/cmd_vel", "/r9/joint_states"]},
         {"echo": "/r9/odom", "type": ODOM},
@@ -68,7 +73,9 @@ def _script() -> list[dict[str, Any]]:
         {
             "call": "/world/sp/create",
             "type": "ros_gz_interfaces/srv/SpawnEntity",
-            "request": {"entity_factory": {"name": "r9", "sdf": diffbot(), "pose": {"position": {"x": -1.0}}}},
+            "request": {
+                "entity_factory": {"name": "r9", "sdf": diffbot(), "pose": {"position": {"x": -1.0}}}
+            },
         },
         {"topics": True, "wait_for": ["/r9/odom"]},
         {"echo": "/r9/odom", "type": ODOM},

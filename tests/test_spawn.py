@@ -222,6 +222,15 @@ BLOCK = (
     "<visual><geometry><box size='0.4 0.4 0.4'/></geometry><material name='red'><color rgba='1 0 0 1'/>"
     "</material></visual><collision><geometry><box size='0.4 0.4 0.4'/></geometry></collision></link></robot>"
 )
+# a box with a camera of its own (a Gazebo camera sensor with gazebo_ros's plugin), spawned facing r1
+EYE = (
+    "<robot name='eye'><link name='base'><inertial><mass value='2'/>"
+    "<inertia ixx='0.01' iyy='0.01' izz='0.01' ixy='0' ixz='0' iyz='0'/></inertial>"
+    "<collision><geometry><box size='0.1 0.1 0.1'/></geometry></collision></link>"
+    "<gazebo reference='base'><sensor type='camera' name='eye_cam'><update_rate>20</update_rate>"
+    "<camera><horizontal_fov>1.0</horizontal_fov><image><width>16</width><height>12</height></image></camera>"
+    "<plugin name='cam' filename='libgazebo_ros_camera.so'/></sensor></gazebo></robot>"
+)
 CAMERA_SCENE = """
 name: sp
 duration: 0.8
@@ -238,6 +247,7 @@ robots:
 timeline:
   - {{t: 0.3, call: /spawn_entity, data: {{name: r2, xml: "{block}", initial_pose: {{position: {{x: 1.2, z: 0.2}}}}}}}}
   - {{t: 0.55, call: /delete_entity, data: {{name: r2}}}}
+  - {{t: 0.3, call: /spawn_entity, data: {{name: r3, xml: "{eye}", initial_pose: {{position: {{x: 2.0, z: 0.1}}, orientation: {{z: 1.0, w: 0.0}}}}}}}}
 """
 
 
@@ -252,17 +262,23 @@ def test_a_camera_sees_a_spawned_robot_and_not_a_deleted_one(
 
     from tests.conftest import run_cli
 
-    path = write_scenario(CAMERA_SCENE.format(renderers=renderers, block=BLOCK), f"{renderers}.yaml")
+    path = write_scenario(CAMERA_SCENE.format(renderers=renderers, block=BLOCK, eye=EYE), f"{renderers}.yaml")
     mcap = tmp_path / f"{renderers}.mcap"
     proc = run_cli("run", str(path), "--record", str(mcap), "-q", "--no-judge", timeout=200)
     assert proc.returncode == 0, proc.stderr
     with open(mcap, "rb") as f:
-        frames = [
-            (m.log_time, msgs.decode(bytes(m.data), "sensor_msgs/msg/Image"))
+        images = [
+            (ch.topic, m.log_time, msgs.decode(bytes(m.data), "sensor_msgs/msg/Image"))
             for _s, ch, m in make_reader(f).iter_messages(log_time_order=True)
-            if ch.topic == "sp/r1/camera/image_raw"
+            if ch.topic.endswith("image_raw")
         ]
+    frames = [(t, i) for topic, t, i in images if topic == "sp/r1/camera/image_raw"]
     assert len(frames) >= 14
+    # the spawned camera renders too (in the renderer process when cameras render there), from its spawn
+    eye = [(t, i) for topic, t, i in images if topic.startswith("sp/r3/")]
+    assert len(eye) >= 8 and min(t for t, _ in eye) >= 300_000_000, [topic for topic, *_ in images][-5:]
+    assert (eye[-1][1].width, eye[-1][1].height) == (16, 12)
+    assert len(set(bytes(eye[-1][1].data))) > 1  # it sees something (r1, the ground), not a blank frame
 
     def pixels(img: Any) -> np.ndarray:
         return np.asarray(img.data, dtype=np.uint8).reshape(img.height, img.width, 3).astype(float)

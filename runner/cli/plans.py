@@ -1,5 +1,5 @@
-"""A scenario file as the commands get it: its matrix variants compiled to plans (`load_variants`), the
-warnings about it (`print_notices`) and `--strict`, which makes the scenario's own warnings errors."""
+"""A scenario file as the commands get it: its matrix variants compiled to plans (`load_variants`) and
+`--strict`, which makes the scenario's own warnings errors (runner.cli.notices prints the warnings)."""
 
 from __future__ import annotations
 
@@ -51,15 +51,3 @@ def strict_failure(plan: Any) -> None:
             style="red",
         )
         raise typer.Exit(1)
-
-
-def print_notices(notices: list[str], verbose: bool) -> None:
-    """The warnings compiling the scenario gave: each of them, or (not verbose) how many."""
-    if not notices:
-        return
-    if not verbose:
-        err.print(f"{len(notices)} warning(s): `scenario validate` lists them", markup=False)
-        return
-    err.print(f"{len(notices)} warning(s):", markup=False)
-    for text in notices:
-        err.print("warning: " + text, markup=False, style="yellow")

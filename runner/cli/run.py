@@ -20,8 +20,9 @@ from rich.text import Text
 
 from runner import interrupts
 from runner.cli.console import err, fail, out
+from runner.cli.notices import print_notices
 from runner.cli.options import AllOpt, AllowUndecided
-from runner.cli.plans import drawn_line, load_variants, print_notices, strict_failure
+from runner.cli.plans import drawn_line, load_variants, strict_failure
 from runner.cli.results import plot_failure, print_events, print_results
 from runner.errors import RunError, ScenarioError
 
@@ -287,7 +288,7 @@ def _run_one(plan: Any, label: str, options: RunOptions) -> tuple[Any, int]:
     started = _now()
     host = options.host
     if not options.quiet:
-        print_notices(plan.notices, verbose=False)
+        print_notices(plan.notice_items, verbose=False)
     member = bool(plan.hosts) and host not in (None, plan.main_host)
     endpoints = _endpoints(plan, options.listen, host)
     use_run_settings(plan.zenoh)  # the scenario's zenoh: (TLS...) for every session of the run

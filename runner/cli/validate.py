@@ -11,7 +11,8 @@ import typer
 from rich.table import Table
 
 from runner.cli.console import err, fail, out
-from runner.cli.plans import drawn_line, load_variants, print_notices, strict_failure
+from runner.cli.notices import print_notices
+from runner.cli.plans import drawn_line, load_variants, strict_failure
 from runner.errors import ScenarioError
 from runner.plan import RobotPlan
 
@@ -29,6 +30,14 @@ def validate(
     file: Annotated[Path, typer.Argument(help="Scenario YAML file.")],
     as_json: Annotated[bool, typer.Option("--json", help="Print the compiled plan as JSON.")] = False,
     strict: StrictValidate = False,
+    every: Annotated[
+        bool,
+        typer.Option(
+            "--all",
+            help="Say every warning: without it, a kind of warning said 3 times or more (a tag ignored in "
+            "every sensor) is one line, with how many more and where.",
+        ),
+    ] = False,
 ) -> None:
     """Check a scenario and print what would run: robots, plugins, topics with types and rates,
     services and actions.
@@ -68,7 +77,7 @@ def validate(
         first, last = plan.timeline[0].t_ns / 1e9, plan.timeline[-1].t_ns / 1e9
         out.print(f"timeline: {what} from t={first:g} s to t={last:g} s")
     out.print(f"record: {plan.record.path if plan.record.enabled else 'off'}")
-    print_notices(plan.notices, verbose=True)
+    print_notices(plan.notice_items, verbose=True, every=every)
     if strict:
         for _, p in plans:
             strict_failure(p)

@@ -17,7 +17,7 @@ from runner.compile.sanity import check_vacuous, window_edge
 from runner.compile.world import compile_world
 from runner.compile.worlds import compile_worlds
 from runner.errors import Notices, Problems
-from runner.plan import FoxglovePlan, RunPlan
+from runner.plan import FoxglovePlan, NoticePlan, RunPlan
 from runner.scenario.loader import Document, MappedDocument, PathKey
 from runner.scenario.schema import Scenario
 
@@ -132,6 +132,18 @@ def compile_plan(
     check_exposure(sc, doc, notices)
     check_vacuous(plan, sc, doc, notices)
     plan.notices = [n.render() for n in notices]  # (with those of the checks over the whole run)
+    plan.notice_items = [
+        NoticePlan(
+            message=n.message,
+            file=str(n.location.file) if n.location.file is not None else None,
+            line=n.location.line,
+            hint=n.hint,
+            kind=n.kind,
+            about=n.about,
+            text=n.render(),
+        )
+        for n in notices
+    ]
     own = doc.file.resolve() if doc.file is not None else None
     plan.scenario_warnings = [
         n.render()

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import mujoco
+import numpy as np
 
 from runner.checks import truth_robots
 from runner.checks.judge import TRUTH_RATE, TRUTH_TOPIC
@@ -89,6 +90,14 @@ def add_robot(
     rot = list(rpy_to_quat(robot.pose.rpy) if quat is None else quat)
     frame = world.worldbody.add_frame(pos=pos, quat=rot)
     prefix = f"{robot.ns}/"
+    # the description's own <mujoco><size memory="..."/>: the world gets at least that much; its other
+    # settings (<option>: said by the URDF reader) are the world's, which MuJoCo keeps with a warning each
+    world.memory = max(int(world.memory), int(model.spec.memory))
+    model.spec.memory = world.memory
+    for name in dir(world.option):  # (MuJoCo would warn of each difference as it compiles the world)
+        value = getattr(world.option, name)
+        if not name.startswith("_") and isinstance(value, int | float | np.ndarray):
+            setattr(model.spec.option, name, value)
     world.attach(model.spec, prefix=prefix, frame=frame)
     # every link with friction differing along and across an fdir1: drive wheels, mecanum wheels by friction
     anisotropic_wheels(world, prefix, anisotropic_links(model.gazebo), model.gazebo, notices)
@@ -218,6 +227,7 @@ def robot_model(
                 notices=notices,
                 sources=result.sources,
                 expanded=True,
+                origins=result.origins,
                 timestep=timestep,
                 controllers=controllers,
                 spawn=spawn,

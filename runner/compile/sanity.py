@@ -9,7 +9,7 @@ from typing import Any
 
 import mujoco
 
-from runner.errors import Notices
+from runner.errors import UNSUBSCRIBED, Notices
 from runner.plan import RunPlan
 from runner.scenario.loader import Document
 from runner.scenario.schema import Scenario
@@ -65,12 +65,20 @@ def check_vacuous(plan: RunPlan, sc: Scenario, doc: Document, notices: Notices) 
                         hint="to mean 'leave, then come back', add `leave: 1.0` (metres) or `after: <s>`",
                     )
     taken: set[str] = set()
+    # who listens on what, with its type: said next to a command that goes nowhere (a drive that listens on
+    # `r1/diff_cont/cmd_vel_unstamped` while the timeline publishes on `r1/cmd_vel`)
+    listeners: list[tuple[str, str, str]] = []  # (key relative to the run, type, "diff_drive 'base'")
     for part in plan.every_plan():
-        taken |= {t.key for r in part.robots for p in r.plugins for t in p.topics if t.direction == "sub"}
+        for r in part.robots:
+            for p in r.plugins:
+                for t in p.topics:
+                    if t.direction == "sub":
+                        taken.add(t.key)
+                        listeners.append((t.key[len(plan.name) + 1 :], t.type, f"{p.type} {p.name!r}"))
     taken |= {b.sim_key for b in plan.bridges if b.direction != "ZENOH_TO_SIM"}
     rel = sorted(k[len(plan.name) + 1 :] for k in taken)
 
-    def check(key: str, what: str, where_path: tuple[Any, ...], text: str) -> None:
+    def check(key: str, what: str, where_path: tuple[Any, ...], text: str, type_: str | None) -> None:
         if key in taken:
             return
         near = difflib.get_close_matches(text.lstrip("/"), rel, n=1, cutoff=0.7)
@@ -79,20 +87,48 @@ def check_vacuous(plan: RunPlan, sc: Scenario, doc: Document, notices: Notices) 
         where = doc.locate(where_path)
         notices.add(
             f"{what} publishes on {text!r}, which nothing in the run subscribes to"
-            + (" (no plugin; a node may)" if plan.nodes else ""),
+            + (" (no plugin; a node may)" if plan.nodes else "")
+            + _listening(listeners, type_),
             where.file,
             where.line,
             hint=(f"did you mean {near[0]!r}? " if near else "")
             + (f"topics taken in this run: {', '.join(rel[:8])}" if rel else "no plugin takes messages"),
+            kind=UNSUBSCRIBED,
+            about=key,
         )
 
     for i, ev in enumerate(sc.timeline):
         if ev.topic is not None:  # (a `call` names a service: checked by runner.compile.timeline)
-            check(f"{sc.name}/{ev.topic.lstrip('/')}", f"timeline[{i}]", ("timeline", i, "topic"), ev.topic)
+            key = f"{sc.name}/{ev.topic.lstrip('/')}"
+            check(key, f"timeline[{i}]", ("timeline", i, "topic"), ev.topic, ev.type)
     for i, b in enumerate(plan.bridges):
         if b.direction != "SIM_TO_ZENOH":
             text = b.sim_key[len(plan.name) + 1 :]
-            check(b.sim_key, f"bridge {i}", ("bridges", i), text)
+            check(b.sim_key, f"bridge {i}", ("bridges", i), text, b.type)
+
+
+def _listening(listeners: list[tuple[str, str, str]], type_: str | None, limit: int = 3) -> str:
+    """ "; diff_drive 'base' listens on 'r1/cmd_vel_unstamped'": who takes messages of the type a command
+    is sent as, else of its stamped or unstamped twin (a TwistStamped sent to a drive that takes Twist),
+    else anyone who takes messages, each with its type where it is not the command's; so that the warning
+    says where the commands should go. "" when no plugin takes messages."""
+
+    def short(t: str | None) -> str:  # geometry_msgs/msg/Twist and geometry_msgs/Twist are one type
+        return (t or "").replace("/msg/", "/")
+
+    def twin(t: str | None) -> str:
+        return short(t).removesuffix("Stamped")
+
+    same = [ln for ln in listeners if short(ln[1]) == short(type_)]
+    same = same or [ln for ln in listeners if twin(ln[1]) == twin(type_)] or listeners
+    if not same:
+        return ""
+    said = [
+        f"{who} listens on {key!r}" + ("" if short(t) == short(type_) else f" ({t})")
+        for key, t, who in same[:limit]
+    ]
+    more = f" (and {len(same) - limit} more)" if len(same) > limit else ""
+    return "; " + ", ".join(said) + more
 
 
 def check_start_overlaps(m: mujoco.MjModel, sc: Scenario, doc: Document, notices: Notices) -> None:

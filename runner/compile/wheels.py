@@ -41,7 +41,7 @@ import mujoco
 import numpy as np
 
 from runner.compile.gazebo import GazeboInfo
-from runner.errors import Notices
+from runner.errors import DRIVE_GEOMETRY, Notices
 from runner.geometry import colliding_geoms, wheel_radius
 from runner.plan import ParityLine, PluginPlan, RobotPlan
 
@@ -309,7 +309,7 @@ def check_geometry(m: mujoco.MjModel, robots: list[RobotPlan], notices: Notices)
                     fatal.append((i, f"{p.type} {p.name!r}: its wheel {link!r} ({j}) has no collision shape"))
             file = Path(p.source_file) if p.source_file else None
             for message, hint in _geometry_mismatches(m, d, robot.prefix + robot.root, robot.prefix, p):
-                notices.add(message, file, p.source_line, hint=hint)
+                notices.add(message, file, p.source_line, hint=hint, kind=DRIVE_GEOMETRY, about=p.name)
                 robot.gazebo.append(
                     ParityLine(kind="geometry", text=message, file=p.source_file, line=p.source_line)
                 )

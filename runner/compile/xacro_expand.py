@@ -58,6 +58,14 @@ _lock = threading.Lock()
 class Expanded:
     urdf: str
     sources: list[Path]  # the xacro file and every file it included, for pointing at lines
+    # per element of the output, in document order: the file and line it was written at (a macro's
+    # element: in the macro's file), or None for one xacro made up (`xacro:element`)
+    origins: list[tuple[Path, int] | None] | None = None
+
+
+# the attribute that carries an element's origin through xacro (its file's index, its line): set on every
+# element as its file is parsed, copied with it into macro calls and includes, taken off the output
+ORIGIN = "scenario_origin_"
 
 
 def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
@@ -76,12 +84,15 @@ def expand(path: Path, args: dict[str, str], packages: PackageMap) -> Expanded:
         xacro.parse = _cycle_guard(real_parse, path, packages)
         stderr = io.StringIO()
         xacro.all_includes = []
+        files: list[Path] = []
+        xacro.parse = _with_origins(xacro.parse, files)
         try:
             with contextlib.redirect_stderr(stderr):
                 doc = xacro.process_file(str(path), mappings={k: str(v) for k, v in args.items()})
             sources = [path] + [Path(f) for f in dict.fromkeys(xacro.all_includes)]
             _check_readable(sources, path, packages)
-            return Expanded(doc.toprettyxml(indent="  "), sources)
+            origins = _take_origins(doc, files)
+            return Expanded(doc.toprettyxml(indent="  "), sources, origins)
         except (MissingPackage, IncludeCycle, OutsidePackages, TooLarge):
             raise
         except xml.parsers.expat.ExpatError as e:
@@ -153,6 +164,45 @@ def _cycle_guard(real_parse: Callable[..., Any], path: Path, packages: PackageMa
         return real_parse(inp, filename)
 
     return parse
+
+
+def _with_origins(parse: Callable[..., Any], files: list[Path]) -> Callable[..., Any]:
+    """xacro's `parse`, marking every element of a file it reads with its line (`ORIGIN`): the lines are
+    lxml's, of the same file, element for element in document order (minidom keeps none). xacro's own
+    tags are left alone (xacro warns of attributes it does not know on them)."""
+
+    def parse_marked(inp, filename=None):  # type: ignore[no-untyped-def]
+        doc = parse(inp, filename)
+        if inp is None and filename:
+            file = Path(os.path.join(getattr(xacro, "root_dir", ""), filename))
+            with contextlib.suppress(Exception):  # (no origins: the locator's older search takes over)
+                from lxml import etree
+
+                tree = etree.parse(str(file), etree.XMLParser(resolve_entities=False, no_network=True))
+                lines = [e.sourceline for e in tree.getroot().iter() if isinstance(e.tag, str)]
+                elements = doc.getElementsByTagName("*")
+                if len(lines) == len(elements):
+                    files.append(file)
+                    for el, line in zip(elements, lines, strict=True):
+                        if not el.tagName.startswith("xacro:"):
+                            el.setAttribute(ORIGIN, f"{len(files) - 1}:{line}")
+        return doc
+
+    return parse_marked
+
+
+def _take_origins(doc: Any, files: list[Path]) -> list[tuple[Path, int] | None]:
+    """Each output element's origin, in document order, its mark taken off."""
+    out: list[tuple[Path, int] | None] = []
+    for el in doc.getElementsByTagName("*"):
+        mark = el.getAttribute(ORIGIN) if el.hasAttribute(ORIGIN) else ""
+        if mark:
+            el.removeAttribute(ORIGIN)
+            index, line = mark.split(":")
+            out.append((files[int(index)], int(line)))
+        else:
+            out.append(None)
+    return out
 
 
 def _trusted_load_yaml(real: Callable[[str], Any], path: Path, packages: PackageMap) -> Callable[[str], Any]:

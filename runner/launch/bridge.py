@@ -11,6 +11,9 @@ at `SCENARIO_ENDPOINT` (and a ROS 2 Zenoh router, if one is named). For each map
   and the command-line tools stamp theirs.
 - with `ros2`, the other side speaks rmw_zenoh (`runner.wire.ros2`): its key, liveliness tokens for the node
   and each publisher/subscription (so `ros2 topic list` sees them), its attachment on every message.
+- with `ros2: {topics: all}`, also what the worlds and nodes declare mid-run (a robot spawned, a node
+  started), as their graph tokens appear, until they are withdrawn (a robot deleted, a node stopped):
+  `runner.launch.bridge_follow`.
 
 Subscriptions take only messages from other processes, so a BIDIRECTIONAL mapping never feeds itself.
 The process is ready (and the run starts) once everything is declared: nothing the world publishes first
@@ -34,13 +37,13 @@ from typing import Any
 import zenoh
 import zenoh.ext
 
+from runner.launch.bridge_follow import Holders, endpoint_of, service_plan, topic_plans
+from runner.launch.bridge_ros2 import RosNode, RosOut
 from runner.plan import BridgePlan, Ros2Plan, ServiceBridgePlan
 from runner.wire import msgs, ros2
-from runner.wire.graph import GraphTokens
-from runner.wire.interfaces import known_service
+from runner.wire.graph import Endpoint, GraphTokens
 from runner.wire.transport import (
     encoding_for,
-    hidden_topic,
     make_config,
     meta_key,
     pack_attachment,
@@ -76,60 +79,7 @@ class _Complaints:
             print(f"bridge: {where}: {message} (dropped; said once)", file=sys.stderr, flush=True)
 
 
-class _RosNode:
-    """One ROS 2 node as rmw_zenoh announces it: its token, and ids for its entities."""
-
-    def __init__(self, session: zenoh.Session, plan: Ros2Plan, node_id: int):
-        self.session = session
-        self.plan = plan
-        self.zid = str(session.zid())
-        self.node_id = node_id
-        self.next_id = node_id + 1
-        self.token = session.liveliness().declare_token(
-            ros2.node_token(plan.domain, self.zid, node_id, "/", plan.node)
-        )
-
-    def entity(self, kind: str, topic: str, type_name: str, qos: ros2.Qos) -> tuple[Any, bytes]:
-        """A publisher ("MP"), subscription ("MS") or service server ("SS") token; returns it and the
-        entity's GID."""
-        key = ros2.entity_token(
-            self.plan.domain,
-            self.zid,
-            self.node_id,
-            self.next_id,
-            kind,
-            "/",
-            self.plan.node,
-            topic,
-            type_name,
-            qos,
-        )
-        self.next_id += 1
-        return self.session.liveliness().declare_token(key), ros2.gid(key)
-
-
-class _RosOut:
-    """One ROS 2 publisher of the bridge's node: every mapping to its topic goes out through it (one
-    entity per topic, as a node has), numbered in one sequence. On a TRANSIENT_LOCAL TFMessage topic
-    (`/tf_static`), what it sends is the whole static tree received so far, each frame's latest transform,
-    as tf2_ros' StaticTransformBroadcaster does: the one message a late subscriber gets from the cache
-    holds every frame, whichever robot or world sent it."""
-
-    def __init__(self, pub: Any, gid: bytes, merge_tf: bool):
-        self.pub = pub
-        self.gid = gid
-        self.seq = 0
-        self.lock = threading.Lock()
-        self.tree: dict[str, Any] | None = {} if merge_tf else None
-
-    def put(self, payload: bytes) -> None:
-        with self.lock:
-            if self.tree is not None:
-                for t in msgs.decode(payload, TF).transforms:
-                    self.tree[t.child_frame_id] = t
-                payload = msgs.encode(msgs.T[TF](transforms=list(self.tree.values())), TF)
-            self.seq += 1  # rmw_zenoh numbers each publisher's messages from 1
-            self.pub.put(payload, attachment=ros2.pack_attachment(self.seq, time.time_ns(), self.gid))
+Ident = tuple[str, str, str]  # a mapping: (sim key, other side's key or ROS 2 topic, direction)
 
 
 class Bridge:
@@ -140,23 +90,32 @@ class Bridge:
         clocks: list[str],
         plans: list[BridgePlan],
         services: Sequence[ServiceBridgePlan] = (),
+        mirror: Ros2Plan | None = None,
     ):
+        """`mirror` (`ros2: {topics: all}`): besides `plans` and `services`, what the worlds and nodes
+        publish, subscribe to and answer as their graph tokens appear (a robot spawned, a node started),
+        and no more once they are withdrawn (a robot deleted, a node stopped)."""
         self.session = session
         self.run = run
         self.sim_ns = 0
         self.complain = _Complaints()
         self.graph = GraphTokens(session, run, os.environ.get("SCENARIO_NODE", "bridge"), "bridge")
         self._keep: list[Any] = []
-        self._ros_nodes: dict[tuple[int, str, str | None], _RosNode] = {}
-        self._ros_outs: dict[str, _RosOut] = {}  # ROS 2 key -> its one publisher
+        self._ros_nodes: dict[tuple[int, str, str | None], RosNode] = {}
+        self._ros_outs: dict[str, RosOut] = {}  # ROS 2 key -> its one publisher
         self.forwarded: dict[str, int] = {}
         self.last_forward = 0.0  # time.monotonic() of the last message forwarded, either way
         for clock in clocks:
             self._keep.append(session.declare_subscriber(clock, self._on_clock))
-        self._seen: set[tuple[str, str, str]] = set()
+        # the worlds' names (`<run>`, or `<run>/<world>` each): a service is named under its world's
+        self._parts = [c.removesuffix("/clock") for c in clocks]
+        self._seen: set[Ident] = set()
         self._lock = threading.Lock()
         for p in plans:
             self._add(p)
+        # the sim keys the plan mirrors to ROS 2: a world's (or its renderer's) endpoint on one of them is
+        # the plan's to map
+        self._planned = {p.sim_key for p in plans if p.ros2 is not None}
         self._served: set[str] = set()  # the sim keys of the services offered or waiting to be
         # a service is offered to ROS 2 once the world answers it (its graph token, declared after its
         # queryable): a client that finds the SS token and calls at once is answered, not left waiting
@@ -164,117 +123,161 @@ class Bridge:
         for sp in services:
             self._served.add(sp.sim_key)
             self._pending[sp.sim_key] = sp
-        if self._pending:
+        self._mirror = mirror
+        # what was mirrored as a token appeared, undone when the last token of its endpoint goes
+        self._holders = Holders()
+        self._dynamic: dict[Ident, list[Any]] = {}  # mapping -> its entities
+        self._idents_of: dict[tuple[str, str], list[Ident]] = {}  # (pub|sub, sim key) -> its mappings
+        self._dynamic_services: dict[str, list[Any]] = {}  # sim key -> its entities
+        self._closing = False
+        if self._pending or mirror is not None:
+            # one subscription follows the run's graph for both
             key = meta_key(run, "graph", "**")
-            self._keep.append(session.liveliness().declare_subscriber(key, self._on_server, history=True))
+            self._keep.append(session.liveliness().declare_subscriber(key, self._on_token, history=True))
 
-    def _on_server(self, sample: zenoh.Sample) -> None:
-        from runner.wire.graph import Graph
-
-        if sample.kind != zenoh.SampleKind.PUT:
+    def _on_token(self, sample: zenoh.Sample) -> None:
+        found = endpoint_of(self.run, str(sample.key_expr))
+        if found is None:
             return
-        graph = Graph(self.run)
-        graph.add_token(str(sample.key_expr))
-        for e in graph.endpoints:
-            if e.kind != "srv":
-                continue
-            with self._lock:
+        e, role = found
+        put = sample.kind == zenoh.SampleKind.PUT
+        with self._lock:
+            if self._closing:
+                return
+            if put and e.kind == "srv":
                 sp = self._pending.pop(e.key, None)
                 if sp is not None:
                     try:
-                        self._serve_ros(sp)
+                        self._serve_ros(sp, self._keep)
                     except Exception as err:  # (the session closing as the run ends)
                         self.complain(sp.where, f"could not offer the service: {err}")
+            if self._mirror is not None:
+                (self._follow_endpoint if put else self._forget_endpoint)(e, role, self._mirror)
 
-    def _add(self, p: BridgePlan) -> None:
+    def _follow_endpoint(self, e: Endpoint, role: str, ros: Ros2Plan) -> None:
+        """A world's or node's endpoint that appeared, mirrored (under `self._lock`)."""
+        if e.kind == "srv":
+            sp = service_plan(e, role, self.run, self._parts, ros)
+            if sp is None:
+                return
+            self._holders.hold(e)
+            if e.key in self._served:
+                return  # (the plan's, or a node's answering it too)
+            self._served.add(e.key)
+            held = self._dynamic_services[e.key] = []
+            try:
+                self._serve_ros(sp, held)
+            except Exception as err:  # (the session closing as the run ends)
+                self._undo(held)
+                self._dynamic_services.pop(e.key, None)
+                self._served.discard(e.key)
+                self.complain(sp.where, f"could not offer the service: {err}")
+            return
+        plans = topic_plans(e, role, self.run, ros)
+        if not plans or (role != "node" and e.key in self._planned):
+            return  # (a world's topic the plan mirrors since the start, as it says)
+        self._holders.hold(e)
+        for p in plans:
+            self._idents_of.setdefault((e.kind, e.key), []).extend(self._add(p, dynamic=True))
+
+    def _forget_endpoint(self, e: Endpoint, _role: str, _ros: Ros2Plan) -> None:
+        """A token withdrawn: once no world or node holds the endpoint any more, what it was mirrored as
+        goes (under `self._lock`), and comes again with a new token (a robot spawned again)."""
+        if not self._holders.let_go(e):
+            return
+        if e.kind == "srv":
+            held = self._dynamic_services.pop(e.key, None)
+            if held is not None:
+                self._served.discard(e.key)
+                self._undo(held)
+            return
+        for ident in self._idents_of.pop((e.kind, e.key), []):
+            held = self._dynamic.pop(ident, None)
+            self._seen.discard(ident)
+            if held is not None:
+                self._undo(held)
+
+    @staticmethod
+    def _undo(held: list[Any]) -> None:
+        for ent in reversed(held):
+            with contextlib.suppress(Exception):
+                ent.undeclare()
+        held.clear()
+
+    def _add(self, p: BridgePlan, dynamic: bool = False) -> list[Ident]:
+        """Map `p` in each of its directions not mapped yet; the mappings made. `dynamic`: each keeps its
+        entities apart (in `_dynamic`), to be undone on its own."""
         other = p.ros_topic if p.ros2 else p.key
         directions = ("SIM_TO_ZENOH", "ZENOH_TO_SIM") if p.direction == "BIDIRECTIONAL" else (p.direction,)
+        made = []
         for direction in directions:
             ident = (p.sim_key, str(other), direction)
             if ident in self._seen:
                 continue
             self._seen.add(ident)
-            (self._outbound if direction == "SIM_TO_ZENOH" else self._inbound)(p)
-
-    def mirror_nodes(self, ros: Ros2Plan) -> None:
-        """`ros2: {topics: all}`: the topics nodes publish and subscribe to, and the services they answer
-        (announced in the run's graph as the nodes start) appear to ROS 2 too, as `/<ns>/<name>`."""
-        from runner.wire.graph import Graph
-
-        def on_token(sample: zenoh.Sample) -> None:
-            if sample.kind != zenoh.SampleKind.PUT:
-                return
-            graph = Graph(self.run)
-            graph.add_token(str(sample.key_expr))
-            for e in graph.endpoints:
-                rel = e.key[len(self.run) + 1 :] if e.key.startswith(self.run + "/") else ""
-                if graph.processes.get(e.process) != "node" or not rel or hidden_topic(rel) or "*" in rel:
-                    continue
-                if e.kind == "srv":  # a service a node answers
-                    if e.type and known_service(e.type):
-                        sp = ServiceBridgePlan(
-                            where=f"ros2 (/{rel}, node {e.process})",
-                            sim_key=e.key,
-                            type=e.type,
-                            ros_name="/" + rel,
-                            ros2=ros,
-                        )
-                        with self._lock, contextlib.suppress(Exception):
-                            if e.key not in self._served:
-                                self._served.add(e.key)
-                                self._serve_ros(sp)
-                    continue
-                if e.kind not in ("pub", "sub"):
-                    continue
-                if not e.type:
-                    continue
-                if not msgs.is_known(e.type):
-                    continue
-                direction = "SIM_TO_ZENOH" if e.kind == "pub" else "ZENOH_TO_SIM"
-                plan = BridgePlan(
-                    where=f"ros2 (/{rel}, node {e.process})",
-                    sim_key=e.key,
-                    type=e.type,
-                    direction=direction,  # type: ignore[arg-type]
-                    ros_topic="/" + rel,
-                    ros2=ros,
-                )
-                with self._lock, contextlib.suppress(Exception):
-                    self._add(plan)
-
-        key = meta_key(self.run, "graph", "**")
-        self._keep.append(self.session.liveliness().declare_subscriber(key, on_token, history=True))
+            held = self._keep if not dynamic else self._dynamic.setdefault(ident, [])
+            try:
+                (self._outbound if direction == "SIM_TO_ZENOH" else self._inbound)(p, held)
+            except Exception as err:
+                if not dynamic:
+                    raise
+                self._undo(held)  # (the session closing as the run ends)
+                self._dynamic.pop(ident, None)
+                self._seen.discard(ident)
+                self.complain(p.where, f"could not mirror the topic: {err}")
+                continue
+            made.append(ident)
+        return made
 
     def _on_clock(self, sample: zenoh.Sample) -> None:
         att = unpack_attachment(sample.attachment.to_bytes()) if sample.attachment is not None else None
         if att is not None and att[1] > self.sim_ns:
             self.sim_ns = att[1]
 
-    def _ros_node(self, plan: Ros2Plan) -> _RosNode:
+    def _ros_node(self, plan: Ros2Plan) -> RosNode:
         ident = (plan.domain, plan.node, plan.router)
         node = self._ros_nodes.get(ident)
         if node is None:
-            node = self._ros_nodes[ident] = _RosNode(self.session, plan, len(self._ros_nodes))
+            node = self._ros_nodes[ident] = RosNode(self.session, plan, len(self._ros_nodes))
             self._keep.append(node.token)
         return node
 
-    def _ros_entity(self, p: BridgePlan, kind: str, qos: ros2.Qos | None = None) -> tuple[str, bytes]:
+    def _ros_entity(self, p: BridgePlan, kind: str, qos: ros2.Qos | None = None) -> tuple[str, bytes, Any]:
         """The rmw_zenoh key of a mapping's ROS 2 side, with its entity announced ("MP"/"MS") with `qos`
-        (the default QoS if None); its GID."""
+        (the default QoS if None); its GID, and its liveliness token."""
         assert p.ros2 is not None and p.ros_topic is not None
         token, gid = self._ros_node(p.ros2).entity(kind, p.ros_topic, p.type, qos or ros2.Qos())
-        self._keep.append(token)
-        return ros2.topic_key(p.ros2.domain, p.ros_topic, p.type), gid
+        return ros2.topic_key(p.ros2.domain, p.ros_topic, p.type), gid, token
 
-    def _ros_out(self, p: BridgePlan) -> _RosOut:
-        """The ROS 2 publisher of a mapping's topic, made by the first mapping to it."""
+    def _ros_out(self, p: BridgePlan, keep: list[Any]) -> RosOut:
+        """The ROS 2 publisher of a mapping's topic, made by the first mapping to it; it goes when the last
+        mapping that uses it is undone (`keep` holds its part in that)."""
         assert p.ros2 is not None and p.ros_topic is not None
         key = ros2.topic_key(p.ros2.domain, p.ros_topic, p.type)
         out = self._ros_outs.get(key)
-        if out is not None:
-            return out
+        if out is None:
+            out = self._new_ros_out(p)
+        out.users += 1
+        keep.append(_Undeclare(lambda: self._release(out, p.sim_key)))
+        return out
+
+    def _release(self, out: RosOut, source: str) -> None:
+        out.users -= 1
+        if not self._closing:
+            with contextlib.suppress(Exception):  # (the session closing as the run ends)
+                out.forget(source)
+        if out.users > 0 or self._ros_outs.get(out.key) is not out:
+            return
+        del self._ros_outs[out.key]
+        for ent in (out.pub, out.token):
+            with contextlib.suppress(Exception):
+                ent.undeclare()
+        self.graph.withdraw("pub", out.key, out.type)
+
+    def _new_ros_out(self, p: BridgePlan) -> RosOut:
+        assert p.ros_topic is not None
         qos = ros2.topic_qos(p.ros_topic)
-        key, gid = self._ros_entity(p, "MP", qos)
+        key, gid, token = self._ros_entity(p, "MP", qos)
         # as rmw_zenoh does for the KEEP_LAST history its tokens announce: drop rather than block
         drop = zenoh.CongestionControl.DROP
         latched = qos.durability == "transient_local"
@@ -291,20 +294,20 @@ class Bridge:
             )
         else:
             pub = self.session.declare_publisher(key, congestion_control=drop)
-        self._keep.append(pub)
         self.graph.publisher(key, p.type)
-        out = self._ros_outs[key] = _RosOut(pub, gid, merge_tf=latched and p.type == TF)
+        out = self._ros_outs[key] = RosOut(key, p.type, pub, token, gid, merge_tf=latched and p.type == TF)
         return out
 
     # ---------------------------------------------------------------------------------- sim -> outside
-    def _outbound(self, p: BridgePlan) -> None:
+    def _outbound(self, p: BridgePlan, keep: list[Any]) -> None:
+        """`keep`: where what it declares is kept, to be undeclared in reverse order."""
         type_name = p.type
-        ros_out: _RosOut | None = None
+        ros_out: RosOut | None = None
         if p.ros2 is not None:
-            ros_out = self._ros_out(p)
+            ros_out = self._ros_out(p, keep)
             pub: Any = ros_out.pub
         else:
-            pub = self._zenoh_out(p)
+            pub = self._zenoh_out(p, keep)
         period_ns = round(1e9 / p.rate) if p.rate else 0
         state = {"seq": 0, "last": None}
         as_json = p.encoding == "json" and p.ros2 is None
@@ -326,7 +329,7 @@ class Bridge:
                 payload = json.dumps(data, default=_json_default, separators=(",", ":")).encode()
             if ros_out is not None:
                 try:
-                    ros_out.put(payload)
+                    ros_out.put(payload, p.sim_key)
                 except Exception as e:  # (a TFMessage that does not decode, on a merged topic)
                     self.complain(p.where, f"a message on {p.sim_key} does not decode as {type_name}: {e}")
                     return
@@ -336,9 +339,9 @@ class Bridge:
             self.forwarded[p.where] = self.forwarded.get(p.where, 0) + 1
             self.last_forward = time.monotonic()
 
-        self._follow(p, pub, on_sample)
+        self._follow(p, pub, on_sample, keep)
 
-    def _zenoh_out(self, p: BridgePlan) -> Any:
+    def _zenoh_out(self, p: BridgePlan, keep: list[Any]) -> Any:
         """The publisher of a mapping's other side on Zenoh (not ROS 2): CDR, or JSON with the type as its
         encoding's schema."""
         assert p.key is not None
@@ -358,11 +361,14 @@ class Bridge:
             else zenoh.CongestionControl.BLOCK,
             reliability=zenoh.Reliability.BEST_EFFORT if p.best_effort else zenoh.Reliability.RELIABLE,
         )
-        self._keep.append(pub)
+        keep.append(pub)
         self.graph.publisher(key, type_name)
+        keep.append(_Undeclare(lambda: self.graph.withdraw("pub", key, type_name)))
         return pub
 
-    def _follow(self, p: BridgePlan, pub: Any, on_sample: Callable[[zenoh.Sample], None]) -> None:
+    def _follow(
+        self, p: BridgePlan, pub: Any, on_sample: Callable[[zenoh.Sample], None], keep: list[Any]
+    ) -> None:
         """Subscribe `on_sample` to the mapping's sim key: for good, or, when `lazy`, only while something
         subscribes to `pub` (a cache that late subscribers read is kept filled: a TRANSIENT_LOCAL topic is
         never lazy)."""
@@ -388,19 +394,21 @@ class Bridge:
                 with lock:
                     (subscribe if status.matching else unsubscribe)()
 
-            self._keep.append(pub.declare_matching_listener(on_matching))
+            keep.append(pub.declare_matching_listener(on_matching))
             with lock:
                 if pub.matching_status.matching:
                     subscribe()
         else:
             subscribe()
-        self._keep.append(_Undeclare(unsubscribe))
+        keep.append(_Undeclare(unsubscribe))
 
     # ---------------------------------------------------------------------------------- outside -> sim
-    def _inbound(self, p: BridgePlan) -> None:
+    def _inbound(self, p: BridgePlan, keep: list[Any]) -> None:
+        """`keep`: where what it declares is kept, to be undeclared in reverse order."""
         session, type_name = self.session, p.type
         if p.ros2 is not None:
-            key, _gid = self._ros_entity(p, "MS")
+            key, _gid, token = self._ros_entity(p, "MS")
+            keep.append(token)
         else:
             assert p.key is not None
             key = p.key
@@ -410,9 +418,11 @@ class Bridge:
             congestion_control=zenoh.CongestionControl.BLOCK,
             reliability=zenoh.Reliability.RELIABLE,
         )
-        self._keep.append(sim_pub)
+        keep.append(sim_pub)
         self.graph.subscriber(key, type_name)
         self.graph.publisher(p.sim_key, type_name)
+        keep.append(_Undeclare(lambda: self.graph.withdraw("sub", key, type_name)))
+        keep.append(_Undeclare(lambda: self.graph.withdraw("pub", p.sim_key, type_name)))
         period_ns = round(1e9 / p.rate) if p.rate else 0
         state = {"seq": 0, "last": None}
         as_json = p.encoding == "json" and p.ros2 is None
@@ -439,20 +449,21 @@ class Bridge:
             self.forwarded[p.where] = self.forwarded.get(p.where, 0) + 1
             self.last_forward = time.monotonic()
 
-        self._keep.append(session.declare_subscriber(key, on_sample, allowed_origin=REMOTE))
+        keep.append(session.declare_subscriber(key, on_sample, allowed_origin=REMOTE))
 
     # ---------------------------------------------------------------------------------- ROS 2 services
-    def _serve_ros(self, sp: ServiceBridgePlan) -> None:
+    def _serve_ros(self, sp: ServiceBridgePlan, keep: list[Any]) -> None:
         """A service the world answers, offered as rmw_zenoh's ServiceData offers one
         (rmw_zenoh_cpp/src/detail/rmw_service_data.cpp, rolling 2025): a queryable on the service's key
         declared `complete`, an `SS` liveliness token, and each reply carrying the request's sequence
         number, a new source timestamp and the client's GID (attachment_helpers.cpp). The request goes on
         to the world's queryable as it came (CDR, and the client's attachment, which the world records);
         the world's reply comes back the same way. An error from the world (a request that does not
-        decode, a handler that failed) is a Zenoh error reply, which rmw_zenoh's client logs and drops."""
+        decode, a handler that failed) is a Zenoh error reply, which rmw_zenoh's client logs and drops.
+        `keep`: where what it declares is kept, to be undeclared in reverse order."""
         node = self._ros_node(sp.ros2)
         token, _gid = node.entity("SS", sp.ros_name, sp.type, ros2.Qos())
-        self._keep.append(token)
+        keep.append(token)
         key = ros2.topic_key(sp.ros2.domain, sp.ros_name, sp.type)
         # get_result waits for the end of the goal (rmw_zenoh's client waits for ever there, too)
         timeout = 10 * 365 * 86400.0 if sp.ros_name.endswith("/_action/get_result") else SERVICE_TIMEOUT_S
@@ -505,10 +516,17 @@ class Bridge:
                 encoding=service_encoding(f"{sp.type}_Request"),
             )
 
-        self._keep.append(session.declare_queryable(key, on_query, complete=True))
+        keep.append(session.declare_queryable(key, on_query, complete=True))
         self.graph.service(key, sp.type)
+        keep.append(_Undeclare(lambda: self.graph.withdraw("srv", key, sp.type)))
 
     def close(self) -> None:
+        with self._lock:
+            self._closing = True  # (nothing followed any more, no smaller /tf_static tree sent)
+            for held in [*self._dynamic.values(), *self._dynamic_services.values()]:
+                self._undo(held)
+            self._dynamic.clear()
+            self._dynamic_services.clear()
         for ent in reversed(self._keep):
             with contextlib.suppress(Exception):
                 ent.undeclare()
@@ -547,9 +565,9 @@ def main() -> int:
         # sessions do (its default config enables timestamping)
         conf.insert_json5("timestamping/enabled", "true")
     with zenoh.open(conf) as session:
-        bridge = Bridge(session, spec["run"], list(spec["clocks"]), plans, services)
-        if spec.get("mirror_nodes"):
-            bridge.mirror_nodes(Ros2Plan.model_validate(spec["mirror_nodes"]))
+        # `mirror_nodes` (`ros2: {topics: all}`): the worlds' endpoints that come and go are followed too
+        mirror = Ros2Plan.model_validate(spec["mirror_nodes"]) if spec.get("mirror_nodes") else None
+        bridge = Bridge(session, spec["run"], list(spec["clocks"]), plans, services, mirror)
         ready = session.liveliness().declare_token(meta_key(spec["run"], "bridge", "alive"))
         try:
             while not stop.wait(0.2):

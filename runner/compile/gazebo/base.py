@@ -15,7 +15,7 @@ from runner.compile.gazebo.info import DescribedPlugin, GazeboInfo, Spawn, Where
 from runner.compile.gazebo.tables import IGNORED_REASONS
 from runner.compile.gazebo.tags import TagReader, ros_topic
 from runner.compile.locate import Locator
-from runner.errors import Notices
+from runner.errors import TAG_IGNORED, Notices
 from runner.frames import frame_id
 
 
@@ -47,9 +47,19 @@ class ReaderBase:
         self.lumped_into: dict[str, str] = {}  # the Gazebo link each URDF link becomes
         self.harmonic = False  # a description for Gazebo Harmonic (gz-sim systems)
 
-    def note(self, el: Any, message: str, hint: str | None = None) -> None:
+    def note(
+        self,
+        el: Any,
+        message: str,
+        hint: str | None = None,
+        *,
+        kind: str | None = None,
+        about: str | None = None,
+    ) -> None:
+        """Say `message` at `el`'s own file:line; `kind` and `about` as in runner.errors.Notice (what
+        `scenario validate` groups the notices by)."""
         file, line = self.where(el)
-        self.notices.add(message, file, line, hint)
+        self.notices.add(message, file, line, hint, kind=kind, about=about)
 
     def ignored(self, reader: TagReader, context: str) -> None:
         seen: set[int] = set()
@@ -72,7 +82,12 @@ class ReaderBase:
                 )
                 continue
             reason = IGNORED_REASONS.get(el.tag)
-            self.note(el, f"<{el.tag}> in {context} is ignored" + (f" ({reason})" if reason else ""))
+            self.note(
+                el,
+                f"<{el.tag}> in {context} is ignored" + (f" ({reason})" if reason else ""),
+                kind=TAG_IGNORED,
+                about=f"<{el.tag}>",
+            )
 
     def unique(self, name: str) -> str:
         base = re.sub(r"[^A-Za-z0-9_]+", "_", name).strip("_") or "plugin"

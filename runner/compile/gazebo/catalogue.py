@@ -104,6 +104,149 @@ CATALOGUE: tuple[PluginDoc, ...] = (
             _p("covariance_x covariance_y covariance_yaw"),
         ),
     ),
+    # --- third-party force-based drives and world odometry (runner.compile.gazebo.drives3p) ---
+    PluginDoc(
+        ("gazebo_ros_force_based_move",),
+        "model",
+        "hector_gazebo_plugins (ROS 1; tu-darmstadt-ros-pkg/hector_gazebo melodic-devel, kinetic-devel): "
+        "hector_gazebo_plugins/src/gazebo_ros_force_based_move.cpp:56-144 (parameters), :200-256 (force), "
+        ":285-398 (odometry); its ROS 2 port in the gazebo_plugins namespace (e.g. "
+        "eduardoespino2002/dots_gazebo2: gazebo_plugins/src/gazebo_ros_force_based_move.cpp:155-217, "
+        ":270-333, :380-394), told apart by its snake_case parameters",
+        "force_based_move (a force and a torque on the base tracking cmd_vel through P gains)",
+        (
+            *_COMMON,
+            _p("commandTopic odometryTopic odometryFrame publishOdometryTf"),
+            _p(
+                "robotBaseFrame robot_base_frame",
+                "approx",
+                "the odometry's child frame; the force acts on the robot's root at its origin (Gazebo: on "
+                "that link, at its centre of mass); a name the robot lacks is said",
+            ),
+            _p(
+                "odometryRate",
+                "approx",
+                "Gazebo publishes once more than 1/rate has passed (a step late each period: 19.6 Hz for 20 "
+                "at 1 ms); here at exactly the rate; 0 or less: nothing published, as in Gazebo",
+            ),
+            _p(
+                "x_velocity_p_gain y_velocity_p_gain yaw_velocity_p_gain",
+                "approx",
+                "a MuJoCo velocity actuator of that gain, integrated implicitly: the same lag m/kp; where "
+                "kp·dt/m nears 1 it settles in a step or two without the explicit step's overshoot",
+            ),
+            _p("allowLateralMotion commandTimeoutDuration"),
+            _p("odometry_frame publish_rate publish_odom publish_odom_tf"),
+            _p("vel_p_gain omega_p_gain force_lim torque_lim"),
+            _p(
+                "vel_i_gain omega_i_gain vel_i_lim omega_i_lim",
+                "approx",
+                "the integral is updated at the control rate (every physics step up to 1 kHz)",
+            ),
+            _p(
+                "update_rate",
+                "ignored",
+                "the ROS 2 port computes a period from it but applies the force at every step; so do we",
+            ),
+            _p(
+                "covariance_x covariance_y covariance_yaw",
+                "ignored",
+                "the ROS 2 port's fixed covariances; the odometry carries hector's (x, y 0.001, yaw 0.01 "
+                "still / 100 turning)",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("robotnik_force_based_move",),
+        "model",
+        "robotnik_gazebo_plugins (ROS 1; RobotnikAutomation/robotnik_gazebo_plugins master): "
+        "robotnik_force_based_move/src/robotnik_force_based_move.cpp:56-157 (parameters), :215-299 "
+        "(force, watchdog), :335-448 (odometry, hector's)",
+        "force_based_move with hold_on_timeout",
+        (
+            *_COMMON,
+            _p("commandTopic odometryTopic odometryFrame publishOdometryTf"),
+            _p(
+                "robotBaseFrame",
+                "approx",
+                "the odometry's child frame; the force acts on the robot's root at its origin",
+            ),
+            _p("odometryRate", "approx", "published at exactly the rate (Gazebo: a step late each period)"),
+            _p(
+                "x_velocity_p_gain y_velocity_p_gain yaw_velocity_p_gain",
+                "approx",
+                "a velocity actuator of that gain, integrated implicitly (the lag m/kp)",
+            ),
+            _p(
+                "commandWatchdog",
+                "approx",
+                "after it (2 s) no force and the base put back where it was, at rest, before every step "
+                "(Gazebo: after the step), so one step of gravity and contact shows in its velocity",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_p3d",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_p3d.cpp:65-128 parameters, :278-340 pose and twist; "
+        "ROS 2 Humble/Jazzy: src/gazebo_ros_p3d.cpp:102-190)",
+        "ground_truth (twist in the world frame)",
+        (
+            *_COMMON,
+            _p("bodyName body_name topicName topic_name"),
+            _p(
+                "frameName frame_name",
+                "same",
+                "world/map: the world; a link's name: the pose relative to it, as the source computes it",
+            ),
+            _p("xyzOffset xyz_offset xyz_offsets rpyOffset rpy_offset rpy_offsets"),
+            _p(
+                "gaussianNoise gaussian_noise",
+                "same",
+                "white noise on the twist only; variance in covariance",
+            ),
+            _p(
+                "updateRate update_rate",
+                "approx",
+                "0 (its default): every physics step, here too (asked as 1 kHz, capped by the step)",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_world_odometry",),
+        "model",
+        "pal_gazebo_plugins (ROS 1 melodic-devel: src/gazebo_world_odometry.cpp:36-73 parameters, :132-181 "
+        "message; ROS 2 humble-devel: src/gazebo_world_odometry.cpp:102-192, :234-297)",
+        "ground_truth (ROS 1: linear twist in the world frame, angular in the link's; ROS 2: both the "
+        "link's)",
+        (
+            *_COMMON,
+            _p("topicName frameName bodyName"),
+            _p("updateRate", "approx", "default 1000 Hz: every physics step of ours (capped by the step)"),
+            _p("body_name topic_name xyz_offset xyz_offsets rpy_offset rpy_offsets gaussian_noise"),
+            _p(
+                "frame_name",
+                "approx",
+                "a link's name gives the pose relative to it; the source leaves the twist as it is, here "
+                "it is taken relative too (p3d's way)",
+            ),
+            _p("update_rate", "approx", "0 (its default): every physics step"),
+        ),
+    ),
+    PluginDoc(
+        ("robotnik_gazebo_ground_truth_odom",),
+        "model",
+        "robotnik_gazebo_plugins (ROS 1 master): robotnik_gazebo_ground_truth_odom/src/"
+        "robotnik_gazebo_ground_truth_odom.cpp:58-150 parameters, :239-413 message",
+        "ground_truth (twist in the link's frame, TF when broadcastTF)",
+        (
+            *_COMMON,
+            _p("bodyName topicName frameName worldFrameName broadcastTF xyzOffset rpyOffset"),
+            _p("worldBodyName", "same", "world/map: the world; a link: the pose relative to it"),
+            _p("gaussianNoise", "same", "white noise on the twist only"),
+            _p("updateRate", "approx", "0 (its default): every physics step"),
+        ),
+    ),
 )
 
 

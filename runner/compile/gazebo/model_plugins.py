@@ -1,7 +1,8 @@
 """Model plugins (`<plugin>` in a `<gazebo>` block) -> our plugins: gazebo_ros's diff drive, skid steer,
-planar move, joint state publisher, imu, p3d (ROS 1 and ROS 2 spellings), gz-sim's diff drive, joint
-state publisher and odometry publisher, ros_control (runner.compile.gazebo.controllers) and hector's
-(runner.compile.gazebo.thirdparty). Each handler reads its plugin's parameters as the real plugin does,
+planar move, joint state publisher, imu, gz-sim's diff drive, joint
+state publisher and odometry publisher, ros_control (runner.compile.gazebo.controllers), hector's
+(runner.compile.gazebo.thirdparty) and the force-based drives, p3d and world-odometry plugins
+(runner.compile.gazebo.drives3p). Each handler reads its plugin's parameters as the real plugin does,
 defaults included; gz-sim systems our world always runs are no-ops, any other plugin is said."""
 
 from __future__ import annotations
@@ -9,12 +10,13 @@ from __future__ import annotations
 import re
 from typing import Any
 
-from runner.compile.gazebo import catalogue, thirdparty
+from runner.compile.gazebo import catalogue, drives3p, thirdparty
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.control.drives import by_wheels
 from runner.compile.gazebo.controllers import ros_control
 from runner.compile.gazebo.tables import IGNORED_REASONS, NOOP_PLUGINS
 from runner.compile.gazebo.tags import TagReader, floats, plugin_base, ros_topic
+from runner.errors import PLUGIN_UNSUPPORTED
 
 
 def read_model_plugin(g: ReaderBase, p: Any, link: str | None) -> None:
@@ -38,6 +40,7 @@ def read_model_plugin(g: ReaderBase, p: Any, link: str | None) -> None:
             f"plugin {filename!r} is not supported and is ignored",
             hint="model plugins we map: " + ", ".join(sorted(_MODEL_PLUGINS)) + ". Add a plugin of ours "
             "under the robot's `plugins:` in the scenario instead.",
+            kind=PLUGIN_UNSUPPORTED,
         )
         return
     ros = g.ros_block(r)
@@ -246,17 +249,6 @@ def _imu_model(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> tuple[str,
     return "imu", params
 
 
-def _p3d(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> tuple[str, dict[str, Any]]:
-    params: dict[str, Any] = {
-        "link": r.text("bodyName", "body_name"),
-        "topic": ros_topic(r.text("topicName", "topic_name")) or remap.get("odom") or "ground_truth",
-        "frame_id": r.text("frameName", "frame_name"),
-        "rate": r.float("updateRate", "update_rate") or None,
-    }
-    r.mark("xyzOffsets", "rpyOffsets", "gaussianNoise", "xyz_offsets", "rpy_offsets", "gaussian_noise")
-    return "ground_truth", params
-
-
 def _odometry_publisher(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> tuple[str, dict[str, Any]]:
     params: dict[str, Any] = {
         "topic": ros_topic(r.text("odom_topic")) or f"model/{g.model}/odometry",
@@ -284,7 +276,6 @@ _MODEL_PLUGINS = {
     "gazebo_ros_joint_state_publisher": _joint_states,
     "gz-sim-joint-state-publisher-system": _joint_states,
     "gazebo_ros_imu": _imu_model,
-    "gazebo_ros_p3d": _p3d,
     "gz-sim-odometry-publisher-system": _odometry_publisher,
     "gazebo_ros_control": ros_control,
     "gazebo_ros2_control": ros_control,
@@ -292,5 +283,6 @@ _MODEL_PLUGINS = {
     "ign_ros2_control-system": ros_control,
 }
 _MODEL_PLUGINS.update(thirdparty.MODEL_PLUGINS)  # hector_gazebo_plugins (.thirdparty)
+_MODEL_PLUGINS.update(drives3p.MODEL_PLUGINS)  # force-based drives, p3d, world odometry (.drives3p)
 # forks of gz_ros2_control / ign_ros2_control / gazebo_ros2_control / gazebo_ros_control keep the name's tail
 _CONTROL_FORK = re.compile(r"(^|[_-])(gz|ign|gazebo)_ros2?_control(-system|_plugin)?$")

@@ -23,6 +23,7 @@ from runner.compile.gazebo.sensors import read_sensor
 from runner.compile.gazebo.surface import read_collision_block
 from runner.compile.gazebo.tables import JOINT_LIST_PARAMS, JOINT_PARAMS
 from runner.compile.gazebo.tags import TagReader, floats, plugin_base
+from runner.compile.locate import Locator
 from runner.compile.materials import gazebo_material
 from runner.errors import Notices, SourceError
 
@@ -273,8 +274,12 @@ def read_gazebo(
     notices: Notices,
     controllers: list[Path] | None = None,
     spawn: Spawn | None = None,
+    where: Locator | None = None,
 ) -> GazeboInfo:
+    """`where`: the URDF reader's locator (it knows where xacro wrote each element)."""
     reader = GazeboReader(root, file, sources or [], expanded, namespace, notices, model)
+    if where is not None:
+        reader.where = where
     reader.controller_files = list(controllers or [])
     reader.spawn = spawn or Spawn()
     return reader.read()

@@ -22,6 +22,7 @@ from runner.compile.gazebo.tables import (
     ROS_SENSOR_PLUGINS,
 )
 from runner.compile.gazebo.tags import TagReader, floats, is_zero, join_topic, plugin_base, ros_topic
+from runner.errors import PLUGIN_UNSUPPORTED
 
 _SENSOR_PLUGINS = ROS_SENSOR_PLUGINS | thirdparty.SENSOR_PLUGINS  # velodyne_simulator, hector's sonar
 
@@ -40,6 +41,7 @@ def read_sensor_plugins(
                 p,
                 f"plugin {filename!r} in {context} is not supported and is ignored",
                 hint="sensor plugins we read: " + ", ".join(sorted(_SENSOR_PLUGINS)),
+                kind=PLUGIN_UNSUPPORTED,
             )
             continue
         ros = g.ros_block(r)

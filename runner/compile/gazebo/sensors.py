@@ -18,6 +18,7 @@ from runner.compile.gazebo.noise import NoiseSpec, classic_noise_spec, noise_spe
 from runner.compile.gazebo.sensor_plugins import read_sensor_plugins
 from runner.compile.gazebo.tables import FORMATS, IMU_TAGS
 from runner.compile.gazebo.tags import TagReader, floats, join_topic, put_number, ros_topic, sibling_topic
+from runner.errors import PLUGIN_UNSUPPORTED
 
 
 @dataclass
@@ -66,6 +67,7 @@ def read_sensor(g: ReaderBase, el: Any, link: str | None) -> None:
             f"sensor type {kind!r} is not supported yet; {context} is ignored",
             hint="supported: ray, gpu_ray, lidar, gpu_lidar, camera, depth, depth_camera, rgbd_camera, "
             "imu, contact",
+            kind=PLUGIN_UNSUPPORTED,
         )
         return
     g.ignored(r, context)

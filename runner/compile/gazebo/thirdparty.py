@@ -29,6 +29,7 @@ from typing import Any
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.noise import noise_spec
 from runner.compile.gazebo.tags import TagReader, floats, is_zero, join_topic, plugin_base, ros_topic
+from runner.errors import NO_PUBLISHER, PLUGIN_UNSUPPORTED
 
 # hector's defaults (hector_gazebo_plugins/src/gazebo_ros_gps.cpp, sensor_model.h)
 _HECTOR_REFERENCE = {"latitude": 49.9, "longitude": 8.9, "heading": 0.0, "altitude": 0.0}
@@ -129,7 +130,8 @@ def hector_imu(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> tuple[str,
     filename = r.el.get("filename")
     topic_text = r.text("topicName")
     if topic_text is not None and not topic_text.strip():
-        g.note(r.el, f"{filename!r} has an empty <topicName>: it publishes nothing (as in Gazebo)")
+        said = f"{filename!r} has an empty <topicName>: it publishes nothing (as in Gazebo)"
+        g.note(r.el, said, kind=NO_PUBLISHER)
         r.mark(*[c.tag for c in r.el if isinstance(c.tag, str)])
         return None
     topic = ros_topic(topic_text) or "imu"
@@ -479,6 +481,7 @@ def sensor(
                 p,
                 f"plugin {filename!r} in {context} is not supported and is ignored",
                 hint="GPS sensor plugins we read: libgazebo_ros_gps_sensor.so",
+                kind=PLUGIN_UNSUPPORTED,
             )
             continue
         found = True

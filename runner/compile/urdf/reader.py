@@ -20,6 +20,7 @@ from runner.compile.locate import Locator
 from runner.compile.packages import PackageMap
 from runner.compile.urdf.checks import DescriptionError, check_numbers, check_structure, drop_empty_shapes
 from runner.compile.urdf.inertia import repair_inertias, weigh_massless_links
+from runner.compile.urdf.ledger import Ledger
 from runner.compile.urdf.link_props import apply_link_props, self_collision
 from runner.compile.urdf.mesh_files import rewrite_mesh
 from runner.compile.urdf.transmissions import Transmission, read_transmissions, velocity_limits
@@ -58,16 +59,19 @@ def urdf_to_model(
     notices: Notices | None = None,
     sources: list[Path] | None = None,
     expanded: bool = False,
+    origins: list[tuple[Path, int] | None] | None = None,
     timestep: float = 0.002,
     controllers: list[Path] | None = None,
     spawn: Spawn | None = None,
 ) -> RobotModel:
     notices = notices if notices is not None else Notices()
     base_dir = file.parent if file else Path.cwd()
-    where = Locator(file, sources or ([file] if file else []), expanded)
+    where = Locator(file, sources or ([file] if file else []), expanded, origins)
     root = _parse(urdf, file, expanded, where)
+    where.bind(root)
     root_link = check_structure(root, where)
     check_numbers(root, where)
+    Ledger(where, notices).sweep(root)  # what nothing here reads, said at its line
     adjusted: list[ParityLine] = []
     world = world_root(root, root_link, where, notices, adjusted)
     repair_inertias(root, where, notices, adjusted)
@@ -89,10 +93,11 @@ def urdf_to_model(
         notices=notices,
         controllers=controllers,
         spawn=spawn,
+        where=where,
     )
     transmissions = read_transmissions(root, where, notices, controllers)
     vlimits = velocity_limits(root)
-    spec = _load(root, where, file, shell)
+    spec = _load(root, where, file, shell, notices)
     apply_link_props(spec, gazebo, timestep)
     # A root link named `world` is MuJoCo's world body: what hangs from it is welded (or jointed) to the
     # world, whatever `fixed:` says, as in Gazebo (.world_link); the robot's root is its first child.
@@ -154,17 +159,39 @@ def _malformed_hint(msg: str) -> str:
     return "check that every tag is closed and attribute values are quoted"
 
 
-def _load(root: Any, where: Any, file: Path | None, shell: set[str]) -> mujoco.MjSpec:
+def _load(root: Any, where: Any, file: Path | None, shell: set[str], notices: Notices) -> mujoco.MjSpec:
     """MuJoCo's spec of the URDF tree, with the tags it does not know taken out, fixed links and visuals
-    kept, shell inertia for the meshes without a volume and collisions in `COLLISION_GROUP`."""
-    # MuJoCo's URDF defaults fuse fixed links away and drop visuals: turn both off.
-    for old in root.findall("mujoco"):
-        root.remove(old)
+    kept, shell inertia for the meshes without a volume and collisions in `COLLISION_GROUP`. The
+    description's own `<mujoco>` block (compiler, option, size: what MuJoCo's URDF reader takes from it) is
+    kept, but for the three compiler settings that keep the robot as Gazebo has it."""
     for tag in ("gazebo", "transmission", "ros2_control"):
         for el in root.findall(tag):
             root.remove(el)
-    mj = etree.Element("mujoco")
-    etree.SubElement(mj, "compiler", discardvisual="false", fusestatic="false", strippath="false")
+    blocks = root.findall("mujoco")
+    for extra in blocks[1:]:  # (MuJoCo's reader takes the first)
+        notices.add("a second <mujoco> block is not read: MuJoCo reads the first", *where(extra))
+        root.remove(extra)
+    mj = blocks[0] if blocks else etree.Element("mujoco")
+    if blocks:
+        root.remove(mj)
+    for option in mj.findall("option"):
+        notices.add(
+            "the description's <mujoco><option> is not used: the world's physics are the scenario's "
+            "(`world.physics`), one for every robot",
+            *where(option),
+        )
+    compiler = mj.find("compiler")
+    if compiler is None:
+        compiler = etree.SubElement(mj, "compiler")
+    # MuJoCo's URDF defaults fuse fixed links away and drop visuals: both kept, as Gazebo keeps them
+    for key in ("discardvisual", "fusestatic", "strippath"):
+        if compiler.get(key) not in (None, "false"):
+            notices.add(
+                f'<compiler {key}="{compiler.get(key)}"> is not used: links joined by fixed joints, visuals '
+                "and mesh paths are kept, as Gazebo keeps them",
+                *where(compiler),
+            )
+        compiler.set(key, "false")
     root.insert(0, mj)
     _unique_shape_names(root)
     text = etree.tostring(root, encoding="unicode")
