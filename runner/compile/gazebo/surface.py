@@ -200,3 +200,18 @@ def _say_rest(g: Any, reader: TagReader, where: str) -> None:
             reader.mark(el.tag)
             g.note(el, f"<{el.tag}> in {where} is ignored ({reason})")
     g.ignored(reader, where)
+
+
+def grips_by_friction(g: Any, joints: list[str]) -> bool:
+    """Every joint's child link has friction differing along and across an fdir1: the description's own
+    model of mecanum rollers (mu2 0 across a diagonal), which runner.compile.wheels simulates."""
+    child = {
+        j.get("name"): j.find("child").get("link")
+        for j in g.root.findall("joint")
+        if j.find("child") is not None
+    }
+    links = [g.info.links.get(child.get(j, "")) for j in joints]
+    return bool(links) and all(
+        p is not None and p.fdir1 is not None and p.mu1 is not None and p.mu2 is not None and p.mu1 != p.mu2
+        for p in links
+    )

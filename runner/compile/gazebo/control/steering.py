@@ -19,6 +19,7 @@ from runner.compile.gazebo.control.mobile_params import (
     unknown,
 )
 from runner.compile.gazebo.control.params import flat
+from runner.compile.gazebo.surface import grips_by_friction
 
 _MECANUM_WHEELS = ("front_left", "front_right", "rear_right", "rear_left")
 _MECANUM = (
@@ -94,28 +95,13 @@ def mecanum_drive_controller(ctx: ControlContext, spec: ControllerSpec) -> bool:
         **reference(ctx, spec),
         **odometry_params(ctx, spec),
     }
-    if _grip_by_friction(ctx, [str(j) for j in joints.values()]):
+    if grips_by_friction(ctx.g, [str(j) for j in joints.values()]):
         # mecanum by friction (mu2 0 across a diagonal fdir1 on each wheel): Gazebo drives the wheels as
         # described, and so do we (runner.compile.wheels); our rollers would model the same thing twice
         params["rollers"] = False
     unknown(ctx, spec, _MECANUM, {})
     ctx.add(spec, "mecanum_drive", params)
     return True
-
-
-def _grip_by_friction(ctx: ControlContext, joints: list[str]) -> bool:
-    """Every wheel's link has friction differing along and across an fdir1 (the description's own model of
-    its rollers)."""
-    child = {
-        j.get("name"): j.find("child").get("link")
-        for j in ctx.g.root.findall("joint")
-        if j.find("child") is not None
-    }
-    links = [ctx.g.info.links.get(child.get(j, "")) for j in joints]
-    return all(
-        p is not None and p.fdir1 is not None and p.mu1 is not None and p.mu2 is not None and p.mu1 != p.mu2
-        for p in links
-    )
 
 
 def _husarion_mecanum(ctx: ControlContext, spec: ControllerSpec) -> bool:
