@@ -250,6 +250,11 @@ def _run(tmp_path: Path, urdf: str, timeline: str, duration: float) -> tuple[np.
     (tmp_path / "robot.urdf").write_text(urdf)
     path = tmp_path / "scenario.yaml"
     path.write_text(SCENARIO.format(duration=duration, timeline=timeline, radius=_RADIUS))
+    return _run_path(path)
+
+
+def _run_path(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """(t, [x, y, yaw]) of robot r1's true pose in the run of a scenario file."""
     _, bus = simulate(path)
     samples = messages(bus, "r1/ground_truth")
     t = np.array([s / 1e9 for s, _ in samples])
@@ -358,6 +363,62 @@ def test_a_mecanum_controller_drives_wheels_that_grip_by_friction_as_described(t
     samples = messages(bus, "r1/ground_truth")
     y = samples[-1][1].pose.pose.position.y - samples[0][1].pose.pose.position.y
     assert abs(y / STRAFE_M - 1) < 0.1, y
+
+
+GZ_MECANUM = """
+  <gazebo>
+    <plugin filename="gz-sim-mecanum-drive-system" name="gz::sim::systems::MecanumDrive">
+      <front_left_joint>front_left_wheel_joint</front_left_joint>
+      <front_right_joint>front_right_wheel_joint</front_right_joint>
+      <back_left_joint>rear_left_wheel_joint</back_left_joint>
+      <back_right_joint>rear_right_wheel_joint</back_right_joint>
+      <wheel_separation>0.34</wheel_separation>
+      <wheelbase>0.24</wheelbase>
+      <wheel_radius>0.05</wheel_radius>
+      <min_acceleration>-5</min_acceleration>
+      <max_acceleration>5</max_acceleration>
+    </plugin>
+  </gazebo>"""
+
+
+def _twist(t: float, vy: float = 0.0, wz: float = 0.0) -> str:
+    return (
+        f"  - {{t: {t}, topic: r1/model/r1/cmd_vel, type: geometry_msgs/msg/Twist, "
+        f"data: {{linear: {{y: {vy}}}, angular: {{z: {wz}}}}}}}\n"
+    )
+
+
+@pytest.mark.timeout(60)
+def test_gz_sims_mecanum_drive_on_wheels_that_grip_by_friction(tmp_path: Path):
+    """gz-sim's MecanumDrive system, as its demo and the descriptions using it: a Twist on
+    /model/<model>/cmd_vel, held until the next; 0.2 m/s sideways for 3 s (0.6 m), then 0.5 rad/s for 3 s
+    (1.5 rad), each within 10 %; its wheels' friction is the rollers (no rollers of ours)."""
+    (tmp_path / "robot.urdf").write_text(mecanum_bot().replace("\n</robot>", f"{GZ_MECANUM}\n</robot>"))
+    path = tmp_path / "scenario.yaml"
+    timeline = _twist(0.5, vy=0.2) + _twist(3.5) + _twist(4.5, wz=0.5) + _twist(7.5)
+    path.write_text(
+        SCENARIO.split("      - type: mecanum_drive")[0].format(duration=8.5) + "timeline:\n" + timeline
+    )
+    plan, text = compile_with_notices(path)
+    drive = next(p for p in plan.robots[0].plugins if p.type == "mecanum_drive")
+    assert drive.params["rollers"] is False and drive.params["reference_topic"] == "model/r1/cmd_vel"
+    assert drive.params["sum_of_robot_center_projection_on_X_Y_axis"] == pytest.approx(0.29)
+    assert drive.params["linear_y_limits"]["max_acceleration"] == 5, drive.params
+    assert "MecanumDrive" not in text, text
+    t, pose = _run_path(path)
+    strafed = _at(t, pose, 4.4) - _at(t, pose, 0.4)
+    turned = _at(t, pose, 8.5)[2] - _at(t, pose, 4.4)[2]
+    assert abs(strafed[1] / 0.6 - 1) < 0.1 and abs(strafed[0]) < 0.05, strafed
+    assert abs(turned / 1.5 - 1) < 0.1, turned
+    # wheels without mecanum friction: Gazebo's would scrub; our rollers stand in, said
+    (tmp_path / "robot.urdf").write_text(
+        mecanum_bot()
+        .replace("<mu2>0.0</mu2>", "<mu2>1.0</mu2>")
+        .replace("\n</robot>", f"{GZ_MECANUM}\n</robot>")
+    )
+    plan, text = compile_with_notices(path)
+    drive = next(p for p in plan.robots[0].plugins if p.type == "mecanum_drive")
+    assert drive.params["rollers"] is True and "the wheels have no mecanum friction" in text, text
 
 
 # ------------------------------------------------------------------------------ Coulomb sliding distance
