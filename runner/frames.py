@@ -27,8 +27,11 @@ def prefixed_urdf(urdf: str, namespace: str) -> str:
         return urdf
     try:
         root = etree.fromstring(urdf.encode("utf-8"))
-    except etree.XMLSyntaxError:
-        return urdf
+    except etree.XMLSyntaxError as e:
+        if "Namespace prefix" not in str(e.msg):
+            return urdf
+        # an undeclared prefix (`<fdir1 gz:expressed_in=...>`), which the description was read with too
+        root = etree.fromstring(urdf.encode("utf-8"), etree.XMLParser(recover=True))
     links = {el.get("name") for el in root.iter("link") if el.get("name")}
     for el in root.iter("link"):
         name = el.get("name")

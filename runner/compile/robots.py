@@ -22,7 +22,7 @@ from runner.compile.packages import PackageMap
 from runner.compile.parity import summarize
 from runner.compile.plugins import build_plugins
 from runner.compile.urdf import RobotModel, urdf_to_model
-from runner.compile.wheels import anisotropic_wheels, wheel_links
+from runner.compile.wheels import anisotropic_links, anisotropic_wheels
 from runner.compile.xacro_expand import expand
 from runner.errors import Location, Notices, Problem, Problems, ScenarioError, SourceError, missing_file_hint
 from runner.geometry import rpy_to_quat
@@ -90,7 +90,6 @@ def add_robot(
     rot = list(rpy_to_quat(robot.pose.rpy) if quat is None else quat)
     frame = world.worldbody.add_frame(pos=pos, quat=rot)
     prefix = f"{robot.ns}/"
-    wheels = wheel_links(plugins, model.spec)
     # the description's own <mujoco><size memory="..."/>: the world gets at least that much; its other
     # settings (<option>: said by the URDF reader) are the world's, which MuJoCo keeps with a warning each
     world.memory = max(int(world.memory), int(model.spec.memory))
@@ -100,7 +99,8 @@ def add_robot(
         if not name.startswith("_") and isinstance(value, int | float | np.ndarray):
             setattr(model.spec.option, name, value)
     world.attach(model.spec, prefix=prefix, frame=frame)
-    anisotropic_wheels(world, prefix, wheels, model.gazebo, notices)
+    # every link with friction differing along and across an fdir1: drive wheels, mecanum wheels by friction
+    anisotropic_wheels(world, prefix, anisotropic_links(model.gazebo), model.gazebo, notices)
     # a robot's camera may have grown its framebuffer: the world's is the one cameras render into
     g, rg = world.visual.global_, model.spec.visual.global_
     g.offwidth, g.offheight = max(g.offwidth, rg.offwidth), max(g.offheight, rg.offheight)

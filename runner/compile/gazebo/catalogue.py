@@ -482,6 +482,27 @@ CATALOGUE: tuple[PluginDoc, ...] = (
             ),
         ),
     ),
+    # --- gz-sim's MecanumDrive (runner.compile.gazebo.gz_mecanum), its wheels' friction (.surface) ---
+    PluginDoc(
+        ("gz-sim-mecanum-drive-system",),
+        "model",
+        "gz-sim (Fortress to Harmonic): src/systems/mecanum_drive/MecanumDrive.cc (Configure: parameters; "
+        "UpdateVelocity: the inverse kinematics; PostUpdate: MecanumDriveOdometry)",
+        "mecanum_drive (its wheels' mecanum friction, or else rollers, said)",
+        (
+            _p(
+                "front_left_joint front_right_joint back_left_joint back_right_joint",
+                "approx",
+                "the first joint of each corner is driven; further ones are said",
+            ),
+            _p("wheel_separation wheelbase wheel_radius"),
+            _p("topic odom_topic tf_topic frame_id child_frame_id odom_publish_frequency"),
+            _p("min_velocity max_velocity min_linear_velocity max_linear_velocity min_angular_velocity"),
+            _p("max_angular_velocity min_acceleration max_acceleration min_linear_acceleration"),
+            _p("max_linear_acceleration min_angular_acceleration max_angular_acceleration min_jerk"),
+            _p("max_jerk min_linear_jerk max_linear_jerk min_angular_jerk max_angular_jerk"),
+        ),
+    ),
 )
 
 

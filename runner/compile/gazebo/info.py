@@ -44,7 +44,9 @@ class LinkProps:
     gravity_off: bool = False
     mu1: float | None = None  # friction along fdir1 ...
     mu2: float | None = None  # ... and across it: a drive's wheels keep the two apart (runner.compile.wheels)
-    fdir1: tuple[float, float, float] | None = None  # in the collision's frame
+    fdir1: tuple[float, float, float] | None = None  # in the collision's frame, or in fdir1_frame's
+    fdir1_frame: str | None = None  # `gz:expressed_in` (or `ignition:`): the link whose frame fdir1 is in
+    fdir1_at: Where = (None, None)  # the <fdir1> tag, for what is said about it
     self_collide: bool | None = None  # <selfCollide> (or <self_collide>) of the link; None: the model's
     self_collide_at: Where = (None, None)
 

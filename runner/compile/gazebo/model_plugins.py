@@ -10,7 +10,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
-from runner.compile.gazebo import catalogue, drives3p, field_sensors, thirdparty
+from runner.compile.gazebo import catalogue, drives3p, field_sensors, gz_mecanum, thirdparty
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.control.drives import by_wheels
 from runner.compile.gazebo.controllers import ros_control
@@ -285,5 +285,6 @@ _MODEL_PLUGINS = {
 _MODEL_PLUGINS.update(thirdparty.MODEL_PLUGINS)  # hector_gazebo_plugins (.thirdparty)
 _MODEL_PLUGINS.update(drives3p.MODEL_PLUGINS)  # force-based drives, p3d, world odometry (.drives3p)
 _MODEL_PLUGINS.update(field_sensors.MODEL_PLUGINS)  # gazebo_ros_ft_sensor (.field_sensors)
+_MODEL_PLUGINS.update(gz_mecanum.MODEL_PLUGINS)  # gz-sim's MecanumDrive (.gz_mecanum)
 # forks of gz_ros2_control / ign_ros2_control / gazebo_ros2_control / gazebo_ros_control keep the name's tail
 _CONTROL_FORK = re.compile(r"(^|[_-])(gz|ign|gazebo)_ros2?_control(-system|_plugin)?$")

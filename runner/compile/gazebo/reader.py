@@ -20,6 +20,7 @@ from runner.compile.gazebo.controllers import run_controller_files
 from runner.compile.gazebo.info import DescribedPlugin, GazeboInfo, LinkProps, Spawn
 from runner.compile.gazebo.model_plugins import read_model_plugin
 from runner.compile.gazebo.sensors import read_sensor
+from runner.compile.gazebo.surface import read_collision_block
 from runner.compile.gazebo.tables import JOINT_LIST_PARAMS, JOINT_PARAMS
 from runner.compile.gazebo.tags import TagReader, floats, plugin_base
 from runner.compile.locate import Locator
@@ -174,15 +175,36 @@ class GazeboReader(ReaderBase):
             vm = visual.find("material")
             if vm is not None:
                 props.rgba = self._material(vm) or props.rgba
+        # `<collision>` blobs first: sdformat copies them into the link's collisions, then writes the URDF
+        # keys (mu1, mu2, fdir1, kp, kd) over them (parser_urdf.cc, InsertSDFExtensionCollision)
+        for coll in r.children("collision"):
+            read_collision_block(self, coll, link, props)
         mu1, mu2 = r.float("mu1"), r.float("mu2")
-        mu = [v for v in (mu1, mu2, r.float("mu")) if v is not None]
+        if mu1 is not None:
+            props.mu1 = mu1
+        if mu2 is not None:
+            props.mu2 = mu2
+        mu_el = r.child("mu")
+        if mu_el is not None:
+            # not a key of sdformat's URDF parser (parser_urdf.cc, ParseSDFExtension): copied into the <link>,
+            # where SDF has no <mu>, so Gazebo's friction stays as it was
+            self.note(
+                mu_el,
+                f'<mu> in <gazebo reference="{link}"> is ignored, as in Gazebo: the keys are <mu1> and <mu2> '
+                "(<mu> belongs in <collision><surface><friction><ode>)",
+                hint=f"write <mu1> and <mu2>, or a <collision><surface> block in the reference {link!r}",
+            )
+        mu = [v for v in (props.mu1, props.mu2) if v is not None]
         if mu:
             props.friction = min(mu)
-        props.mu1, props.mu2 = mu1, mu2
+        fdir_el = r.child("fdir1")
         fdir = floats(r.text("fdir1"), 3)
         if fdir is not None and any(fdir):
             props.fdir1 = (fdir[0], fdir[1], fdir[2])
-        props.kp = r.float("kp")
+            props.fdir1_frame, props.fdir1_at = None, self.where(fdir_el)
+        kp = r.float("kp")
+        if kp is not None:
+            props.kp = kp
         r.mark("kd")
         if r.float("kd") is not None:
             self.note(
@@ -264,5 +286,18 @@ def read_gazebo(
 
 
 def parse(text: str) -> Any:
+    """The description's XML. An undeclared namespace prefix (`<fdir1 gz:expressed_in="base_link">`,
+    whose `xmlns:gz` descriptions seldom declare) is taken as Gazebo's TinyXML2 takes it: the attribute
+    keeps its prefixed name. Any other error is still an error."""
     parser = etree.XMLParser(remove_comments=True)
-    return etree.fromstring(text.encode(), parser)
+    try:
+        return etree.fromstring(text.encode(), parser)
+    except etree.XMLSyntaxError as e:
+        if "Namespace prefix" not in str(e.msg):
+            raise
+    parser = etree.XMLParser(remove_comments=True, recover=True)
+    root = etree.fromstring(text.encode(), parser)
+    for entry in parser.error_log:
+        if entry.type != etree.ErrorTypes.NS_ERR_UNDEFINED_NAMESPACE:
+            raise etree.XMLSyntaxError(entry.message, entry.type, entry.line, entry.column)
+    return root

@@ -126,6 +126,11 @@ _WHY = {
     "laser_retro": "laser retro-reflectivity is not simulated",
     "bounce": "restitution is not simulated",
     "torsional": "torsional friction is not mapped",
+    # a world model's friction direction: the capsule proxies that give robots' wheels Gazebo's anisotropic
+    # friction on the ground (runner.compile.wheels) need a round shape on a moving link and the ground plane
+    "fdir1": "anisotropic friction of world models is not simulated: the smaller of mu and mu2 is used",
+    "slip1": "force-dependent slip is not simulated",
+    "slip2": "force-dependent slip is not simulated",
     "axis2": "the second axis of universal/revolute2 joints is not supported",
     "placement_frame": "placement frames are not supported; <pose> places the model's own frame",
 }

@@ -218,7 +218,7 @@ def _mujoco_error(e: ValueError, root: Any, text: str, where: Any, file: Path | 
     if m:
         tag, line = m.group(1), int(m.group(2))
         ours = [el for el in root.iter() if isinstance(el.tag, str)]
-        given = [el for el in etree.fromstring(text.encode()).iter() if isinstance(el.tag, str)]
+        given = [el for el in parse(text).iter() if isinstance(el.tag, str)]  # as the URDF was read
         for mine, theirs in zip(ours, given, strict=False):
             if theirs.sourceline == line and theirs.tag == tag:
                 return DescriptionError(

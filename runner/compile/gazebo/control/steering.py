@@ -19,6 +19,7 @@ from runner.compile.gazebo.control.mobile_params import (
     unknown,
 )
 from runner.compile.gazebo.control.params import flat
+from runner.compile.gazebo.surface import grips_by_friction
 
 _MECANUM_WHEELS = ("front_left", "front_right", "rear_right", "rear_left")
 _MECANUM = (
@@ -94,6 +95,10 @@ def mecanum_drive_controller(ctx: ControlContext, spec: ControllerSpec) -> bool:
         **reference(ctx, spec),
         **odometry_params(ctx, spec),
     }
+    if grips_by_friction(ctx.g, [str(j) for j in joints.values()]):
+        # mecanum by friction (mu2 0 across a diagonal fdir1 on each wheel): Gazebo drives the wheels as
+        # described, and so do we (runner.compile.wheels); our rollers would model the same thing twice
+        params["rollers"] = False
     unknown(ctx, spec, _MECANUM, {})
     ctx.add(spec, "mecanum_drive", params)
     return True
