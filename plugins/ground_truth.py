@@ -52,6 +52,16 @@ class GroundTruthParams(RatedParams):
     angular_velocity_frame: Frame = Field("world", description="Frame of the twist's angular part.")
     publish_tf: bool = Field(False, description="Also publish frame_id -> child_frame_id on `tf_topic`.")
     tf_topic: str = Field("tf", description="TF topic (tf2_msgs/TFMessage), when `publish_tf`.")
+    offset_frame: Frame = Field(
+        "world",
+        description="`world`: the offsets are added in the world frame (p3d); `body`: composed after the "
+        "link's pose, `pose * offset` (gz-sim's OdometryPublisher).",
+    )
+    planar: bool = Field(
+        False,
+        description="2D odometry (gz-sim OdometryPublisher's `<dimensions>2`): no z, no roll or pitch rate, "
+        "no vertical velocity (their noise only).",
+    )
 
 
 class GroundTruth(Plugin):
@@ -100,9 +110,15 @@ class GroundTruth(Plugin):
             pos, quat = pos.copy(), quat.copy()
             if self.ref is not None:
                 pos, quat, lin, ang = self._relative(pos, quat, lin, ang)
-            pos += self.offset
             out = np.empty(4)
-            mujoco.mju_mulQuat(out, self.rot_offset, quat)
+            if p.offset_frame == "body":  # gz-sim OdometryPublisher.cc:386: rawPose * offset
+                rot = np.empty(9)
+                mujoco.mju_quat2Mat(rot, quat)
+                pos = pos + rot.reshape(3, 3) @ self.offset
+                mujoco.mju_mulQuat(out, quat, self.rot_offset)
+            else:
+                pos += self.offset
+                mujoco.mju_mulQuat(out, self.rot_offset, quat)
             mujoco.mju_normalize4(out)
             quat = out
         frame = d.xmat[self.body].reshape(3, 3)
@@ -110,6 +126,10 @@ class GroundTruth(Plugin):
             lin = frame.T @ lin
         if p.angular_velocity_frame == "body":
             ang = frame.T @ ang
+        if p.planar:  # OdometryPublisher.cc:387-425: x, y and the yaw rate only
+            pos = np.array([pos[0], pos[1], 0.0])
+            lin = np.array([lin[0], lin[1], 0.0])
+            ang = np.array([0.0, 0.0, ang[2]])
         if self.rng is not None:
             noise = self.rng.normal(0.0, p.twist_noise, 6)
             lin, ang = lin + noise[:3], ang + noise[3:]

@@ -503,6 +503,25 @@ CATALOGUE: tuple[PluginDoc, ...] = (
             _p("max_jerk min_linear_jerk max_linear_jerk min_angular_jerk max_angular_jerk"),
         ),
     ),
+    # --- gz-sim's OdometryPublisher (runner.compile.gazebo.model_plugins._odometry_publisher) ---
+    PluginDoc(
+        ("gz-sim-odometry-publisher-system",),
+        "model",
+        "gz-sim (Fortress to Harmonic): src/systems/odometry_publisher/OdometryPublisher.cc at 93bbf3ed "
+        "(Configure :150-290, UpdateOdometry :360-470)",
+        "ground_truth (the model's world pose, body-frame twist)",
+        (
+            _p("odom_topic odom_frame robot_base_frame odom_publish_frequency tf_topic"),
+            _p("xyz_offset rpy_offset", "same", "composed after the pose, `rawPose * offset` (:386)"),
+            _p("dimensions", "same", "2: x, y and the yaw rate only; 3: everything"),
+            _p("gaussian_noise", "same", "on each twist component; the pose is not noised, as there"),
+            _p(
+                "odom_covariance_topic",
+                "ignored",
+                "gz-sim publishes the same odometry with the noise's variance there (said)",
+            ),
+        ),
+    ),
 )
 
 

@@ -250,20 +250,45 @@ def _imu_model(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> tuple[str,
 
 
 def _odometry_publisher(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> tuple[str, dict[str, Any]]:
+    """gz-sim's OdometryPublisher (src/systems/odometry_publisher/OdometryPublisher.cc at 93bbf3ed): the
+    model's world pose composed with `<xyz_offset>`/`<rpy_offset>` (:386 `rawPose * offset`), frames
+    `<odom_frame>` (default `<model>/odom`, :158) and `<robot_base_frame>` (`<model>/base_footprint`, :188),
+    `<dimensions>` 2 (default: x, y, yaw rate only) or 3, twist in the body frame with `<gaussian_noise>`
+    on each component (the pose is not noised), at `<odom_publish_frequency>` (50), and the pose again on
+    `<tf_topic>` (`/model/<model>/pose`). Its twist is the mean of the last 10 publishes' pose differences
+    (:128); ours is the body's velocity at the publish (the same at steady motion)."""
+    dims = r.float("dimensions")
     params: dict[str, Any] = {
         "topic": ros_topic(r.text("odom_topic")) or f"model/{g.model}/odometry",
         "frame_id": g.frame(r.text("odom_frame") or "odom"),
-        "rate": r.float("odom_publish_frequency") or None,
+        "child_frame_id": g.frame(r.text("robot_base_frame") or "base_footprint"),
+        "rate": r.float("odom_publish_frequency") or 50.0,
+        "planar": dims != 3,
+        "offset_frame": "body",
+        "linear_velocity_frame": "body",
+        "angular_velocity_frame": "body",
+        "publish_tf": True,
+        "tf_topic": ros_topic(r.text("tf_topic")) or f"model/{g.model}/pose",
     }
-    r.mark(
-        "robot_base_frame",
-        "dimensions",
-        "tf_topic",
-        "odom_covariance_topic",
-        "gaussian_noise",
-        "xyz_offset",
-        "rpy_offset",
-    )
+    if dims is not None and dims not in (2, 3):
+        g.note(
+            r.child("dimensions"),
+            f"<dimensions> {dims:g}: gz-sim accepts 2 or 3 (it then does not start); 2 is used",
+        )
+    for key, tag in (("xyz_offset", "xyz_offset"), ("rpy_offset", "rpy_offset")):
+        values = floats(r.text(tag), 3)
+        if values is not None:
+            params[key] = tuple(values)
+    noise = r.float("gaussian_noise")
+    if noise:
+        params["twist_noise"] = noise
+    cov = r.child("odom_covariance_topic")
+    if cov is not None:
+        g.note(
+            cov,
+            "<odom_covariance_topic> is not published: gz-sim's OdometryWithCovariance carries the same pose "
+            "and twist as the odometry topic, with the noise's variance",
+        )
     return "ground_truth", params
 
 
