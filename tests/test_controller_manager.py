@@ -509,6 +509,22 @@ def test_imu_and_force_torque_broadcasters_publish_their_sensors(tmp_path: Path)
     w = wrench[-1][1].wrench
     assert abs(abs(w.force.z) - 0.3 * 9.81) < 0.1, w
     assert abs(abs(w.torque.y) - 0.3 * 9.81 * 0.1) < 0.02, w
+    # the sensor's own direction, as gazebo_ros2_control reads its Force(): gz-sensors' default
+    # child_to_parent, and the opposite wrench with parent_to_child
+    (tmp_path / "arm.urdf").write_text(
+        (tmp_path / "arm.urdf")
+        .read_text()
+        .replace(
+            "<update_rate>50</update_rate></sensor></gazebo>\n</robot>",
+            "<update_rate>50</update_rate><force_torque><measure_direction>parent_to_child"
+            "</measure_direction></force_torque></sensor></gazebo>\n</robot>",
+        )
+    )
+    assert "parent_to_child" in (tmp_path / "arm.urdf").read_text()
+    _, bus = simulate(path)
+    flipped = messages(bus, "r1/ft_broadcaster/wrench")[-1][1].wrench
+    assert flipped.force.z == pytest.approx(-w.force.z, abs=0.05), (w, flipped)
+    assert flipped.torque.y == pytest.approx(-w.torque.y, abs=0.01), (w, flipped)
 
 
 @pytest.mark.timeout(60)

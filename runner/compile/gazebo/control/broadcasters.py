@@ -218,10 +218,12 @@ def force_torque_sensor_broadcaster(ctx: ControlContext, spec: ControllerSpec) -
     p = read(spec)
     sensor = str(p["sensor_name"] or "")
     joint = None
+    block = None  # the Gazebo sensor's <force_torque> (its frame and direction: read and said there)
     for gz in ctx.g.root.findall("gazebo"):
         for s in gz.iter("sensor"):
             if s.get("name") == sensor and gz.get("reference") in ctx.g.joint_names | ctx.g.fixed_joints:
                 joint = gz.get("reference")
+                block = s.find("force_torque")
     if joint is None and sensor:
         for j in ctx.g.root.findall("joint"):
             if j.get("name") == sensor:
@@ -240,6 +242,12 @@ def force_torque_sensor_broadcaster(ctx: ControlContext, spec: ControllerSpec) -
             "joint",
         )
         return False
+    # gazebo_ros2_control hands the broadcaster the sensor's own Force()/Torque(): in the sensor's
+    # <frame> and <measure_direction> (gz-sensors' defaults: child, child_to_parent)
+    direction = (
+        (block.findtext("measure_direction") if block is not None else None) or "child_to_parent"
+    ).strip()
+    frame = ((block.findtext("frame") if block is not None else None) or "child").strip()
     ctx.add(
         spec,
         "force_torque",
@@ -248,6 +256,8 @@ def force_torque_sensor_broadcaster(ctx: ControlContext, spec: ControllerSpec) -
             "topic": ctx.topic("~/wrench"),
             "frame_id": ctx.frame(str(p["frame_id"])) if p["frame_id"] else None,
             "rate": spec.update_rate,
+            "measure_direction": direction if direction in ("child_to_parent", "parent_to_child") else None,
+            "measure_frame": frame if frame in ("child", "parent", "sensor") else None,
         },
     )
     return True
