@@ -61,7 +61,9 @@ class ReaderBase:
         file, line = self.where(el)
         self.notices.add(message, file, line, hint, kind=kind, about=about)
 
-    def ignored(self, reader: TagReader, context: str) -> None:
+    def ignored(self, reader: TagReader, context: str, reasons: dict[str, str] | str | None = None) -> None:
+        """Say what nothing read of `reader`'s element, each at its own line, with why it is ignored:
+        `reasons` by tag for this block (a string: the reason for any tag), else tables.IGNORED_REASONS."""
         seen: set[int] = set()
         for el, text in reader.not_numbers:
             if el is None or id(el) in seen:
@@ -81,7 +83,8 @@ class ReaderBase:
                     hint="remove the repeated tag, or check which one you meant",
                 )
                 continue
-            reason = IGNORED_REASONS.get(el.tag)
+            reason = reasons if isinstance(reasons, str) else (reasons or {}).get(el.tag)
+            reason = reason or IGNORED_REASONS.get(el.tag)
             self.note(
                 el,
                 f"<{el.tag}> in {context} is ignored" + (f" ({reason})" if reason else ""),
