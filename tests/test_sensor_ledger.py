@@ -261,3 +261,71 @@ def test_the_values_read_reach_the_plan(tmp_path: Path) -> None:
     assert by_name["s_force_torque"].params["torque_noise_stddev"] == [0.01] * 3
     assert by_name["s_gps"].params["position_noise_stddev"] == [0.01] * 3
     assert by_name["s_altimeter"].params["velocity_noise_stddev"] == 0.01
+
+
+def _one_sensor(tmp_path: Path, sensor: str) -> tuple[Any, list[Any], list[Any]]:
+    """A robot with one link, `sensor` in its <gazebo reference>, compiled inside `reading()`."""
+    text = f"""<?xml version="1.0"?>
+<robot name="one">
+  <link name="base">{INERTIAL.replace("0.01", "1")}</inertial>
+    <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
+  <gazebo reference="base">
+{sensor}
+  </gazebo>
+</robot>
+"""
+    (tmp_path / "t.urdf").write_text(text)
+    path = tmp_path / "g.yaml"
+    path.write_text(
+        "name: g\nduration: 0.1\nrate: max\nseed: 1\nrobots:\n  - name: bot\n    description: t.urdf\n"
+        "    pose: {xyz: [0, 0, 0.2]}\n    plugins: []\n"
+    )
+    doc = load_file(path)
+    notices = Notices()
+    with reading() as taken:
+        plan = compile_plan(validate_scenario(doc), doc, notices=notices)
+    return plan, list(notices), taken
+
+
+def _line(tmp_path: Path, needle: str) -> int:
+    """The 1-based line of t.urdf holding `needle`."""
+    lines = (tmp_path / "t.urdf").read_text().splitlines()
+    return next(i for i, line in enumerate(lines, 1) if needle in line)
+
+
+def test_a_plugins_ros_block_is_read_or_said(tmp_path: Path) -> None:
+    """gazebo_ros' `<ros>`: namespace and remappings are read; a `<parameter>` (not applied) is said at its
+    line, where it vanished before."""
+    plan, notices, taken = _one_sensor(
+        tmp_path,
+        """    <sensor name="cam" type="camera">
+      <camera><horizontal_fov>1.0</horizontal_fov><image><width>8</width><height>6</height></image></camera>
+      <plugin name="p" filename="libgazebo_ros_camera.so">
+        <ros>
+          <namespace>bot</namespace>
+          <remapping>cam/image_raw:=front/image</remapping>
+          <parameter name="use_sim_time" type="bool">true</parameter>
+        </ros>
+      </plugin>
+    </sensor>""",
+    )
+    assert {el.tag for el in taken} >= {"namespace", "remapping"}
+    said = {n.location.line: n.message for n in notices}
+    assert "<parameter> in <ros> is ignored" in said.get(_line(tmp_path, "<parameter"), ""), said
+    assert declared(plan.robots[0])[0].params["image_topic"] == "front/image"
+
+
+def test_a_contact_sensor_with_a_pose_compiles_and_the_pose_is_said(tmp_path: Path) -> None:
+    """Our contact plugin has no pose: a `<pose>` in the sensor failed the compile; now it is said when it
+    is not zero (a contact sensor reports its link's contacts wherever it sits, in Gazebo too)."""
+    plan, notices, _ = _one_sensor(
+        tmp_path,
+        """    <sensor name="bump" type="contact">
+      <pose>0.1 0 0 0 0 0</pose>
+      <contact><collision>base_collision</collision></contact>
+    </sensor>""",
+    )
+    said = {n.location.line: n.message for n in notices}
+    pose = _line(tmp_path, "<pose>")
+    assert "<pose> in <sensor name='bump' type='contact'> is not applied" in said.get(pose, ""), said
+    assert declared(plan.robots[0])[0].type == "contact"

@@ -284,6 +284,7 @@ def _lidar(g: ReaderBase, r: TagReader, el: Any, context: str) -> dict[str, Any]
     noise = noise_stddev(g, rr, "a lidar", where)
     if noise:
         out["noise_stddev"] = noise
+    _visibility(g, rr, where, sensor_reasons.LIDAR["visibility_mask"])
     g.ignored(rr, where, sensor_reasons.LIDAR)
     return out
 
@@ -371,8 +372,23 @@ def _camera(g: ReaderBase, r: TagReader, el: Any, context: str) -> tuple[dict[st
                 "(and points as their plugin or gz-sensors does)",
             )
         g.ignored(dr, f"{where} <depth_camera>", sensor_reasons.DEPTH_CAMERA)
+    _visibility(g, cr, where, sensor_reasons.CAMERA["visibility_mask"])
     g.ignored(cr, where, sensor_reasons.CAMERA)
     return out, info_topic
+
+
+def _visibility(g: ReaderBase, r: TagReader, where: str, reason: str) -> None:
+    """`<visibility_mask>`: every bit set (SDF's default) is what we do, every visual is seen; any other
+    mask is said with `reason`."""
+    text = r.text("visibility_mask")
+    if text is None:
+        return
+    try:
+        every = int(text, 0) & 0xFFFFFFFF == 0xFFFFFFFF
+    except ValueError:
+        every = False
+    if not every:
+        g.note(r.child("visibility_mask"), f"<visibility_mask> {text} in {where} is ignored ({reason})")
 
 
 def _imu(g: ReaderBase, r: TagReader, el: Any, context: str) -> dict[str, Any]:
