@@ -329,3 +329,15 @@ def test_a_contact_sensor_with_a_pose_compiles_and_the_pose_is_said(tmp_path: Pa
     pose = _line(tmp_path, "<pose>")
     assert "<pose> in <sensor name='bump' type='contact'> is not applied" in said.get(pose, ""), said
     assert declared(plan.robots[0])[0].type == "contact"
+
+
+def test_a_pose_relative_to_another_frame_is_said(tmp_path: Path) -> None:
+    """SDF 1.7+ `<pose relative_to="frame">`: the attribute vanished, the pose taken on the link; said."""
+    _, notices, _ = _one_sensor(
+        tmp_path,
+        """    <sensor name="imu" type="imu">
+      <pose relative_to="base_footprint">0 0 0.1 0 0 0</pose>
+    </sensor>""",
+    )
+    said = {n.location.line: n.message for n in notices}
+    assert "relative_to='base_footprint'" in said.get(_line(tmp_path, "<pose"), ""), said

@@ -46,6 +46,14 @@ def read_sensor(g: ReaderBase, el: Any, link: str | None) -> None:
     context = f"<sensor name={name!r} type={kind!r}>"
     rate = r.float("update_rate", "updateRate")
     pose = floats(r.text("pose"), 6)
+    pose_el = r.child("pose")
+    relative_to = (pose_el.get("relative_to") or "").strip() if pose_el is not None else ""
+    if relative_to and relative_to != link:
+        g.note(
+            pose_el,
+            f"<pose relative_to={relative_to!r}> in {context} is taken relative to the sensor's link "
+            f"{link!r} (SDF: relative to the frame {relative_to!r})",
+        )
     base_topic = ros_topic(r.text("topic"))
     frame = g.frame(r.text("gz_frame_id", "ignition_frame_id", "frame_id", "frameName"))
     plugins = r.children("plugin")

@@ -135,13 +135,6 @@ def sibling_topic(topic: str, name: str) -> str:
     return join_topic(head, name)
 
 
-def put_number(out: dict[str, Any], key: str, el: Any, path: str) -> None:
-    """out[key] = the number at `path` under `el`, when there is one."""
-    text = el.findtext(path)
-    if text and text.strip():
-        out[key] = float(text)
-
-
 def plugin_base(filename: str) -> str:
     """`libgazebo_ros_diff_drive.so` -> `gazebo_ros_diff_drive`; `gz-sim-diff-drive-system` as is."""
     base = Path(filename).name
