@@ -199,8 +199,8 @@ def _contact_sensor(g: ReaderBase, s: _Sensor) -> bool:
     block = s.r.child("contact")
     if block is not None:
         cr = TagReader(block)
-        # <collision> names the link's collision that senses: a URDF link's collisions are all one Gazebo
-        # collision (<link>_collision, lumped), and we report every contact of the link
+        # <collision> names the link's collision that senses (a URDF link's become <link>_collision,
+        # <link>_collision_1, ...): we report every contact of the link, of any of its collisions
         cr.children("collision")
         gz_topic = (cr.text("topic") or "__default_topic__").strip()
         if gz_topic != "__default_topic__":
