@@ -18,6 +18,13 @@ from runner.compile.locate import Locator
 from runner.errors import TAG_IGNORED, Notices
 from runner.frames import frame_id
 
+# gazebo_ros's <ros> block (gazebo_ros/src/node.cpp: namespace, remapping, argument, parameter, qos): what
+# we do not apply, and why
+_ROS_REASONS = {
+    "parameter": "ROS parameters of the plugin's node are not set here: the plugin reads its own tags",
+    "qos": "gazebo_ros' QoS overrides are not applied",
+}
+
 
 class ReaderBase:
     def __init__(
@@ -61,7 +68,9 @@ class ReaderBase:
         file, line = self.where(el)
         self.notices.add(message, file, line, hint, kind=kind, about=about)
 
-    def ignored(self, reader: TagReader, context: str) -> None:
+    def ignored(self, reader: TagReader, context: str, reasons: dict[str, str] | str | None = None) -> None:
+        """Say what nothing read of `reader`'s element, each at its own line, with why it is ignored:
+        `reasons` by tag for this block (a string: the reason for any tag), else tables.IGNORED_REASONS."""
         seen: set[int] = set()
         for el, text in reader.not_numbers:
             if el is None or id(el) in seen:
@@ -81,7 +90,8 @@ class ReaderBase:
                     hint="remove the repeated tag, or check which one you meant",
                 )
                 continue
-            reason = IGNORED_REASONS.get(el.tag)
+            reason = reasons if isinstance(reasons, str) else (reasons or {}).get(el.tag)
+            reason = reason or IGNORED_REASONS.get(el.tag)
             self.note(
                 el,
                 f"<{el.tag}> in {context} is ignored" + (f" ({reason})" if reason else ""),
@@ -119,17 +129,19 @@ class ReaderBase:
         out: dict[str, Any] = {"remap": {}}
         ros = r.child("ros")
         if ros is not None:
-            for rm in ros.findall("remapping") + ros.findall("argument"):
+            rr = TagReader(ros)
+            for rm in rr.children("remapping", "argument"):
                 text = (rm.text or "").strip()
                 if ":=" in text:
                     src, dst = text.split(":=", 1)
                     src = re.sub(r"^(--ros-args\s+)?(-r\s+)?", "", src).strip()
                     out["remap"][ros_topic(src) or src] = ros_topic(dst)
-            ns = ros_topic(ros.findtext("namespace"))
+            ns = ros_topic(rr.text("namespace"))
             if ns and ns != self.namespace:
                 self.note(
                     ros, f"ROS namespace {ns!r} is replaced by the robot's namespace {self.namespace!r}"
                 )
+            self.ignored(rr, "<ros>", _ROS_REASONS)
         rn = r.text("robotNamespace")
         if rn and ros_topic(rn) and ros_topic(rn) != self.namespace:
             self.note(

@@ -17,29 +17,27 @@ from typing import Any
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.noise import NoiseSpec, noise_spec
 from runner.compile.gazebo.sensor_plugins import read_sensor_plugins
-from runner.compile.gazebo.tags import ros_topic
+from runner.compile.gazebo.sensor_reasons import NOT_SDF
+from runner.compile.gazebo.tags import TagReader, ros_topic
 from runner.errors import NO_PUBLISHER, PLUGIN_UNSUPPORTED
 
 # `s`: runner.compile.gazebo.sensors' `_Sensor` (one <sensor> as every kind reads it), which imports this
 _Sensor = Any
 
 
-def _noise(g: ReaderBase, parent: Any, what: str) -> NoiseSpec | None:
-    """An axis' `<noise>` (anything else in the axis is said); a bias (drawn once per run in gz-sensors) is
-    said and left out."""
-    if parent is not None:
-        _unknown(g, parent, {"noise"}, what)
-    spec = noise_spec(g, parent)
+def _noise(g: ReaderBase, block: TagReader, tag: str, what: str, context: str) -> NoiseSpec | None:
+    """The `<noise>` of the axis `tag` of `block` (anything else in the axis is said); a bias (drawn once
+    per run in gz-sensors) is said and left out."""
+    el = block.child(tag)
+    if el is None:
+        return None
+    r = TagReader(el)
+    where = f"{context} <{block.el.tag}><{tag}>"
+    spec = noise_spec(g, r, where)
+    g.ignored(r, where, NOT_SDF)
     if spec is not None and (spec.bias_mean or spec.bias_stddev):
         g.note(spec.el, f"a noise bias (<bias_mean>, <bias_stddev>) is not modelled for {what}")
     return spec
-
-
-def _unknown(g: ReaderBase, block: Any, known: set[str], context: str) -> None:
-    """What of `block` is none of the `known` SDF elements: said, as Gazebo's SDF parser warns of it."""
-    for child in block:
-        if isinstance(child.tag, str) and child.tag not in known:
-            g.note(child, f"<{child.tag}> in {context} <{block.tag}> is ignored (not an SDF element)")
 
 
 def _topic(g: ReaderBase, s: _Sensor, leaf: str, scope: str = "link") -> tuple[str, bool]:
@@ -79,11 +77,12 @@ def magnetometer(g: ReaderBase, s: _Sensor) -> bool:
     params: dict[str, Any] = {**s.common, "link": _link_of(g, s)}
     block = s.r.child("magnetometer")
     if block is not None:
-        specs = [_noise(g, block.find(axis), "a magnetometer") for axis in ("x", "y", "z")]
+        br = TagReader(block)
+        specs = [_noise(g, br, axis, "a magnetometer", s.context) for axis in ("x", "y", "z")]
         if any(specs):
             params["noise_stddev"] = [sp.stddev if sp else 0.0 for sp in specs]
             params["noise_mean"] = [sp.mean if sp else 0.0 for sp in specs]
-        _unknown(g, block, {"x", "y", "z"}, s.context)
+        g.ignored(br, f"{s.context} <magnetometer>", NOT_SDF)
     _own_plugins(g, s)
     params["topic"], implicit = _topic(g, s, "magnetometer")
     params["frame_id"] = s.frame
@@ -97,14 +96,15 @@ def air_pressure(g: ReaderBase, s: _Sensor) -> bool:
     params: dict[str, Any] = {**s.common, "link": _link_of(g, s)}
     block = s.r.child("air_pressure")
     if block is not None:
-        ref = block.findtext("reference_altitude")
-        if ref and ref.strip():
-            params["reference_altitude"] = float(ref)
-        spec = _noise(g, block.find("pressure"), "an air pressure sensor")
+        br = TagReader(block)
+        ref = br.float("reference_altitude")
+        if ref is not None:
+            params["reference_altitude"] = ref
+        spec = _noise(g, br, "pressure", "an air pressure sensor", s.context)
         if spec is not None:
             params["noise_stddev"] = spec.stddev
             params["noise_mean"] = spec.mean
-        _unknown(g, block, {"reference_altitude", "pressure"}, s.context)
+        g.ignored(br, f"{s.context} <air_pressure>", NOT_SDF)
     _own_plugins(g, s)
     params["topic"], implicit = _topic(g, s, "air_pressure")
     params["frame_id"] = s.frame
@@ -118,12 +118,13 @@ def altimeter(g: ReaderBase, s: _Sensor) -> bool:
     params: dict[str, Any] = {**s.common, "link": _link_of(g, s)}
     block = s.r.child("altimeter")
     if block is not None:
+        br = TagReader(block)
         for tag, key in (("vertical_position", "position"), ("vertical_velocity", "velocity")):
-            spec = _noise(g, block.find(tag), "an altimeter")
+            spec = _noise(g, br, tag, "an altimeter", s.context)
             if spec is not None:
                 params[f"{key}_noise_stddev"] = spec.stddev
                 params[f"{key}_noise_mean"] = spec.mean
-        _unknown(g, block, {"vertical_position", "vertical_velocity"}, s.context)
+        g.ignored(br, f"{s.context} <altimeter>", NOT_SDF)
     _own_plugins(g, s)
     params["topic"], implicit = _topic(g, s, "altimeter")
     params["frame_id"] = s.frame
@@ -155,14 +156,15 @@ def force_torque(g: ReaderBase, s: _Sensor) -> bool:
     params: dict[str, Any] = {**s.common, "link": _child_of(g, joint)}
     block = s.r.child("force_torque")
     if block is not None:
-        frame = (block.findtext("frame") or "child").strip().lower()
-        direction = (block.findtext("measure_direction") or "child_to_parent").strip().lower()
+        br = TagReader(block)
+        frame = (br.text("frame") or "child").strip().lower()
+        direction = (br.text("measure_direction") or "child_to_parent").strip().lower()
         if frame not in _FT_FRAMES:
-            g.note(block.find("frame"), f"<frame> {frame!r} is not child, parent or sensor: child is used")
+            g.note(br.child("frame"), f"<frame> {frame!r} is not child, parent or sensor: child is used")
             frame = "child"
         if direction not in _FT_DIRECTIONS:
             g.note(
-                block.find("measure_direction"),
+                br.child("measure_direction"),
                 f"<measure_direction> {direction!r} is not child_to_parent or parent_to_child: "
                 "child_to_parent is used",
             )
@@ -170,15 +172,16 @@ def force_torque(g: ReaderBase, s: _Sensor) -> bool:
         params["measure_frame"] = frame
         params["measure_direction"] = direction
         for part in ("force", "torque"):
-            el = block.find(part)
+            el = br.child(part)
             if el is None:
                 continue
-            specs = [_noise(g, el.find(axis), "a force/torque sensor") for axis in ("x", "y", "z")]
+            pr = TagReader(el)
+            specs = [_noise(g, pr, axis, "a force/torque sensor", s.context) for axis in ("x", "y", "z")]
             if any(specs):
                 params[f"{part}_noise_stddev"] = [sp.stddev if sp else 0.0 for sp in specs]
                 params[f"{part}_noise_mean"] = [sp.mean if sp else 0.0 for sp in specs]
-            _unknown(g, el, {"x", "y", "z"}, s.context)
-        _unknown(g, block, {"frame", "measure_direction", "force", "torque"}, s.context)
+            g.ignored(pr, f"{s.context} <force_torque><{part}>", NOT_SDF)
+        g.ignored(br, f"{s.context} <force_torque>", NOT_SDF)
     else:
         params["measure_frame"] = "child"
         params["measure_direction"] = "child_to_parent"

@@ -12,12 +12,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from runner.compile.gazebo import field_sensors, thirdparty
+from runner.compile.gazebo import field_sensors, sensor_reasons, thirdparty
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.noise import NoiseSpec, classic_noise_spec, noise_spec, noise_stddev
 from runner.compile.gazebo.sensor_plugins import read_sensor_plugins
-from runner.compile.gazebo.tables import FORMATS, IMU_TAGS
-from runner.compile.gazebo.tags import TagReader, floats, join_topic, put_number, ros_topic, sibling_topic
+from runner.compile.gazebo.tables import FORMATS
+from runner.compile.gazebo.tags import TagReader, floats, join_topic, ros_topic, sibling_topic
 from runner.errors import PLUGIN_UNSUPPORTED
 
 
@@ -46,13 +46,24 @@ def read_sensor(g: ReaderBase, el: Any, link: str | None) -> None:
     context = f"<sensor name={name!r} type={kind!r}>"
     rate = r.float("update_rate", "updateRate")
     pose = floats(r.text("pose"), 6)
+    pose_el = r.child("pose")
+    relative_to = (pose_el.get("relative_to") or "").strip() if pose_el is not None else ""
+    if relative_to and relative_to != link:
+        g.note(
+            pose_el,
+            f"<pose relative_to={relative_to!r}> in {context} is taken relative to the sensor's link "
+            f"{link!r} (SDF: relative to the frame {relative_to!r})",
+        )
     base_topic = ros_topic(r.text("topic"))
     frame = g.frame(r.text("gz_frame_id", "ignition_frame_id", "frame_id", "frameName"))
     plugins = r.children("plugin")
     common: dict[str, Any] = {"link": link}
     if rate:
         common["rate"] = rate
-    if pose:
+    if pose and kind in _NO_POSE:  # our plugin takes none: said where it would change something
+        if any(pose):
+            g.note(r.child("pose"), f"<pose> in {context} is not applied: {_NO_POSE[kind]}")
+    elif pose:
         common["pose"] = {"xyz": pose[:3], "rpy": pose[3:]}
     s = _Sensor(el, r, link, name, kind, context, rate, base_topic, frame, plugins, common)
     read = _KINDS.get(kind)
@@ -62,15 +73,24 @@ def read_sensor(g: ReaderBase, el: Any, link: str | None) -> None:
     elif kind in thirdparty.SENSOR_KINDS:  # gps: runner/compile/gazebo/thirdparty.py
         thirdparty.sensor(g, r, el, common, plugins, name, kind, context, base_topic, frame)
     else:
+        gazebo = sensor_reasons.UNSUPPORTED.get(kind)
         g.note(
             el,
-            f"sensor type {kind!r} is not supported yet; {context} is ignored",
+            f"sensor type {kind!r} is not supported yet; {context} is ignored, with all it holds"
+            + (f" ({gazebo})" if gazebo else ""),
             hint="supported: ray, gpu_ray, lidar, gpu_lidar, camera, depth, depth_camera, rgbd_camera, "
             "imu, contact, gps, magnetometer, air_pressure, altimeter, force_torque",
             kind=PLUGIN_UNSUPPORTED,
         )
         return
     g.ignored(r, context)
+
+
+# Sensor types whose plugin here has no pose -> what the sensor's <pose> would change in Gazebo
+_NO_POSE = {
+    "contact": "the sensor reports every contact of its link, wherever it sits (in Gazebo too)",
+    "gps": "the fix is the link origin's (Gazebo's is at the sensor's pose)",
+}
 
 
 def _lidar_sensor(g: ReaderBase, s: _Sensor) -> bool:
@@ -97,14 +117,14 @@ def _lidar_sensor(g: ReaderBase, s: _Sensor) -> bool:
 
 
 def _camera_sensor(g: ReaderBase, s: _Sensor) -> bool:
-    params = {**s.common, **_camera(g, s.r, s.el, s.context)}
+    cam, info_topic = _camera(g, s.r, s.el, s.context)
+    params = {**s.common, **cam}
     ros = read_sensor_plugins(g, s.plugins, s.context, ("image_raw", "image"), s.name, s.kind)
     # gz-sensors: <topic> carries the image, CameraInfo goes to <camera_info_topic> or a sibling
     image = ros.get("topic") or s.base_topic or "camera/image_raw"
     if g.harmonic and not (ros or s.base_topic):
         image = _gz_sensor_topic(g, s.link, s.name, "image")
     params["image_topic"] = image
-    info_topic = ros_topic(s.el.findtext("camera/camera_info_topic"))
     params["info_topic"] = (
         ros.get("info") or (info_topic if not ros else None) or sibling_topic(image, "camera_info")
     )
@@ -115,9 +135,9 @@ def _camera_sensor(g: ReaderBase, s: _Sensor) -> bool:
 
 
 def _depth_sensor(g: ReaderBase, s: _Sensor) -> bool:
-    params = {**s.common, **_camera(g, s.r, s.el, s.context)}
+    cam, info_topic = _camera(g, s.r, s.el, s.context)  # <camera_info_topic>: gz-sensors'; no ROS plugin's
+    params = {**s.common, **cam}
     ros = read_sensor_plugins(g, s.plugins, s.context, ("image_raw", "image"), s.name, s.kind)
-    info_topic = ros_topic(s.el.findtext("camera/camera_info_topic"))  # gz-sensors; no ROS plugin reads it
     if not ros and s.kind in ("depth", "depth_camera"):
         # Harmonic depth camera: depth image on <topic>, points on <topic>/points, CameraInfo beside
         topic = s.base_topic or "depth_camera"
@@ -176,7 +196,20 @@ def _contact_sensor(g: ReaderBase, s: _Sensor) -> bool:
     if s.link is None:
         g.note(s.el, f"{s.context} outside a <gazebo reference=...> block has no link; ignored")
         return False
-    s.r.child("contact")  # <collision> names: we report every contact of the link
+    block = s.r.child("contact")
+    if block is not None:
+        cr = TagReader(block)
+        # <collision> names the link's collision that senses (a URDF link's become <link>_collision,
+        # <link>_collision_1, ...): we report every contact of the link, of any of its collisions
+        cr.children("collision")
+        gz_topic = (cr.text("topic") or "__default_topic__").strip()
+        if gz_topic != "__default_topic__":
+            g.note(
+                cr.child("topic"),
+                f"<contact><topic> {gz_topic!r} in {s.context} is a Gazebo transport topic: not used (the "
+                "ROS topic is the plugin's, or the sensor's <topic>)",
+            )
+        g.ignored(cr, f"{s.context} <contact>")
     ros = read_sensor_plugins(g, s.plugins, s.context, ("bumper_states", "bumper"), s.name, s.kind)
     params = {**s.common, "topic": ros.get("topic") or s.base_topic or "bumper"}
     params["frame_id"] = ros.get("frame") or s.frame
@@ -225,73 +258,145 @@ def _lidar(g: ReaderBase, r: TagReader, el: Any, context: str) -> dict[str, Any]
     out: dict[str, Any] = {}
     if ray is None:
         return out
-    h = ray.find("scan/horizontal")
-    if h is not None:
-        samples = h.findtext("samples")
-        resolution = h.findtext("resolution")
-        n = int(float(samples)) if samples else 640
-        if resolution and float(resolution) not in (0.0, 1.0):
-            n = max(1, round(n * float(resolution)))  # Gazebo: beams = samples * resolution
-        out["samples"] = n
-        if h.findtext("min_angle"):
-            out["min_angle"] = float(h.findtext("min_angle"))
-        if h.findtext("max_angle"):
-            out["max_angle"] = float(h.findtext("max_angle"))
-    v = ray.find("scan/vertical")
-    if v is not None and v.findtext("samples") and int(float(v.findtext("samples"))) > 1:
-        out["vertical_samples"] = int(float(v.findtext("samples")))
-        if v.findtext("min_angle"):
-            out["vertical_min_angle"] = float(v.findtext("min_angle"))
-        if v.findtext("max_angle"):
-            out["vertical_max_angle"] = float(v.findtext("max_angle"))
-    rng = ray.find("range")
+    where = f"{context} <{ray.tag}>"
+    rr = TagReader(ray)
+    scan = rr.child("scan")
+    if scan is not None:
+        sr = TagReader(scan)
+        h = sr.child("horizontal")
+        if h is not None:
+            hr = TagReader(h)
+            samples = hr.float("samples")
+            resolution = hr.float("resolution")
+            n = int(samples) if samples is not None else 640
+            if resolution and resolution not in (0.0, 1.0):
+                n = max(1, round(n * resolution))  # Gazebo: beams = samples * resolution
+            out["samples"] = n
+            for tag in ("min_angle", "max_angle"):
+                value = hr.float(tag)
+                if value is not None:
+                    out[tag] = value
+            g.ignored(hr, f"{where} <horizontal>")
+        v = sr.child("vertical")
+        if v is not None:
+            _vertical(g, TagReader(v), out, where)
+        g.ignored(sr, f"{where} <scan>")
+    rng = rr.child("range")
     if rng is not None:
-        put_number(out, "range_min", rng, "min")
-        put_number(out, "range_max", rng, "max")
-        put_number(out, "resolution", rng, "resolution")
-    noise = noise_stddev(g, ray, "a lidar")
+        nr = TagReader(rng)
+        for tag, key in (("min", "range_min"), ("max", "range_max"), ("resolution", "resolution")):
+            value = nr.float(tag)
+            if value is not None:
+                out[key] = value
+        g.ignored(nr, f"{where} <range>")
+    noise = noise_stddev(g, rr, "a lidar", where)
     if noise:
         out["noise_stddev"] = noise
-    known = {"scan", "range", "noise", "visibility_mask"}
-    for child in ray:
-        if isinstance(child.tag, str) and child.tag not in known:
-            g.note(child, f"<{child.tag}> in {context} <{ray.tag}> is ignored")
+    _visibility(g, rr, where, sensor_reasons.LIDAR["visibility_mask"])
+    g.ignored(rr, where, sensor_reasons.LIDAR)
     return out
 
 
-def _camera(g: ReaderBase, r: TagReader, el: Any, context: str) -> dict[str, Any]:
+def _vertical(g: ReaderBase, vr: TagReader, out: dict[str, Any], where: str) -> None:
+    """`<scan><vertical>`: more than one sample makes a 3D lidar; one sample is the level scan plane."""
+    samples = vr.float("samples")
+    angles = {tag: vr.float(tag) for tag in ("min_angle", "max_angle")}
+    resolution = vr.float("resolution")
+    if samples and int(samples) > 1:
+        out["vertical_samples"] = int(samples)
+        for tag, value in angles.items():
+            if value is not None:
+                out[f"vertical_{tag}"] = value
+        if resolution and resolution != 1.0:
+            g.note(
+                vr.child("resolution"),
+                f"vertical <resolution> {resolution:g} in {where} is not applied: the lidar has <samples> "
+                "rows (Gazebo has samples * resolution)",
+            )
+    elif any(angles.values()):
+        g.note(
+            vr.el,
+            f"{where} has one vertical sample: its <min_angle>/<max_angle> are not applied, the scan is the "
+            "sensor's level plane",
+        )
+    g.ignored(vr, f"{where} <vertical>")
+
+
+def _camera(g: ReaderBase, r: TagReader, el: Any, context: str) -> tuple[dict[str, Any], str | None]:
+    """The camera's params and its `<camera_info_topic>` (gz-sensors' CameraInfo topic; no ROS plugin
+    reads it)."""
     cam = r.child("camera")
     out: dict[str, Any] = {}
     if cam is None:
-        return out
-    fov = cam.findtext("horizontal_fov")
-    if fov:
-        out["fov"] = float(fov)
-    w, h = cam.findtext("image/width"), cam.findtext("image/height")
-    if w:
-        out["width"] = int(float(w))
-    if h:
-        out["height"] = int(float(h))
-    fmt = (cam.findtext("image/format") or "").strip()
-    if fmt:
-        mapped = FORMATS.get(fmt.upper())
-        if mapped:
-            out["format"] = mapped
-        else:
-            g.note(cam, f"image format {fmt!r} is published as rgb8")
-    near, far = cam.findtext("clip/near"), cam.findtext("clip/far")
-    if near:
-        out["near"] = float(near)
-    if far:
-        out["far"] = float(far)
-    noise = noise_stddev(g, cam, "a camera")
+        return out, None
+    where = f"{context} <camera>"
+    cr = TagReader(cam)
+    fov = cr.float("horizontal_fov")
+    if fov is not None:
+        out["fov"] = fov
+    image = cr.child("image")
+    if image is not None:
+        ir = TagReader(image)
+        w, h = ir.float("width"), ir.float("height")
+        if w is not None:
+            out["width"] = int(w)
+        if h is not None:
+            out["height"] = int(h)
+        fmt = (ir.text("format") or "").strip()
+        if fmt:
+            mapped = FORMATS.get(fmt.upper())
+            if mapped:
+                out["format"] = mapped
+            else:
+                g.note(cam, f"image format {fmt!r} is published as rgb8")
+        g.ignored(ir, f"{where} <image>", sensor_reasons.IMAGE)
+    clip = cr.child("clip")
+    if clip is not None:
+        clr = TagReader(clip)
+        for tag in ("near", "far"):
+            value = clr.float(tag)
+            if value is not None:
+                out[tag] = value
+        g.ignored(clr, f"{where} <clip>")
+    noise = noise_stddev(g, cr, "a camera", where)
     if noise:
         out["noise_stddev"] = noise
-    known = {"horizontal_fov", "image", "clip", "noise", "camera_info_topic", "depth_camera"}
-    for child in cam:
-        if isinstance(child.tag, str) and child.tag not in known:
-            g.note(child, f"<{child.tag}> in {context} <camera> is ignored")
-    return out
+    info_topic = ros_topic(cr.text("camera_info_topic"))
+    if cr.bool("triggered"):
+        g.note(
+            cr.child("triggered"),
+            f"<triggered> in {where} is ignored: the camera publishes at its rate (gz-sensors renders a "
+            "frame per message on <trigger_topic>)",
+        )
+    cr.child("trigger_topic")  # read only when <triggered>, said above
+    depth = cr.child("depth_camera")
+    if depth is not None:
+        dr = TagReader(depth)
+        output = (dr.text("output") or "depths").strip()
+        if output != "depths":
+            g.note(
+                dr.child("output"),
+                f"<depth_camera><output> {output!r} in {where} is not applied: depth cameras publish depths "
+                "(and points as their plugin or gz-sensors does)",
+            )
+        g.ignored(dr, f"{where} <depth_camera>", sensor_reasons.DEPTH_CAMERA)
+    _visibility(g, cr, where, sensor_reasons.CAMERA["visibility_mask"])
+    g.ignored(cr, where, sensor_reasons.CAMERA)
+    return out, info_topic
+
+
+def _visibility(g: ReaderBase, r: TagReader, where: str, reason: str) -> None:
+    """`<visibility_mask>`: every bit set (SDF's default) is what we do, every visual is seen; any other
+    mask is said with `reason`."""
+    text = r.text("visibility_mask")
+    if text is None:
+        return
+    try:
+        every = int(text, 0) & 0xFFFFFFFF == 0xFFFFFFFF
+    except ValueError:
+        every = False
+    if not every:
+        g.note(r.child("visibility_mask"), f"<visibility_mask> {text} in {where} is ignored ({reason})")
 
 
 def _imu(g: ReaderBase, r: TagReader, el: Any, context: str) -> dict[str, Any]:
@@ -301,19 +406,49 @@ def _imu(g: ReaderBase, r: TagReader, el: Any, context: str) -> dict[str, Any]:
     out: dict[str, Any] = {}
     if imu is None:
         return out
+    where = f"{context} <imu>"
+    ir = TagReader(imu)
     for key in ("angular_velocity", "linear_acceleration"):
-        specs = [noise_spec(g, imu.find(f"{key}/{axis}")) for axis in ("x", "y", "z")]
+        block = ir.child(key)
+        if block is None:
+            continue
+        br = TagReader(block)
+        specs = []
+        for axis in ("x", "y", "z"):
+            axis_el = br.child(axis)
+            ar = TagReader(axis_el) if axis_el is not None else None
+            specs.append(noise_spec(g, ar, f"{where} <{key}><{axis}>"))
+            if ar is not None:
+                g.ignored(ar, f"{where} <{key}><{axis}>")
         _imu_noise(out, key, specs)
+        g.ignored(br, f"{where} <{key}>")
     # classic (SDF 1.4) style: <imu><noise><type/><rate>..</rate><accel>..</accel></noise>, for all axes
-    n = imu.find("noise")
+    n = ir.child("noise")
     if n is not None:
-        for block, key in (("rate", "angular_velocity"), ("accel", "linear_acceleration")):
-            spec = classic_noise_spec(n, block)
+        nr = TagReader(n)
+        for block_name, key in (("rate", "angular_velocity"), ("accel", "linear_acceleration")):
+            spec = classic_noise_spec(g, nr, block_name, where)
             if spec is not None:
                 _imu_noise(out, key, [spec] * 3)
-    for child in imu:
-        if isinstance(child.tag, str) and child.tag not in IMU_TAGS:
-            g.note(child, f"<{child.tag}> in {context} <imu> is ignored")
+        g.ignored(nr, f"{where} <noise>")
+    frame = ir.child("orientation_reference_frame")
+    if frame is not None:
+        fr = TagReader(frame)
+        localization = (fr.text("localization") or "").strip()
+        if localization.upper() not in ("", "ENU"):
+            g.note(
+                fr.child("localization"),
+                f"<localization> {localization!r} in {where} is not applied: the orientation is in the world "
+                "frame, ENU (REP 145), as gazebo_ros reports it (gz-sensors turns it into NED/NWU/CUSTOM)",
+            )
+        g.ignored(fr, f"{where} <orientation_reference_frame>", sensor_reasons.IMU_FRAME)
+    if ir.bool("enable_orientation") is False:
+        g.note(
+            ir.child("enable_orientation"),
+            f"<enable_orientation> false in {where} is not applied: the orientation is still reported "
+            "(gz-sensors leaves it out)",
+        )
+    g.ignored(ir, where)
     return out
 
 

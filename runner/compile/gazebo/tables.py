@@ -106,8 +106,6 @@ CAMERA_KNOWN = (
 )
 # Read by one ROS version and not the other, but with no effect on what is published.
 HARMLESS = {"hackBaseline", "hack_baseline", "borderCrop", "border_crop", "autoDistortion"}
-NOISE_TAGS = {"type", "mean", "stddev", "bias_mean", "bias_stddev"}
-IMU_TAGS = {"angular_velocity", "linear_acceleration", "noise"}
 CAMERA_PLUGINS = {
     "gazebo_ros_camera",
     "gazebo_ros_depth_camera",

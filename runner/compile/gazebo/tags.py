@@ -5,8 +5,33 @@ numbers, ROS topic names and plugin names."""
 from __future__ import annotations
 
 import re
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from pathlib import Path
 from typing import Any
+
+# While `reading()` is active: every element a TagReader handed out (tests/test_sensor_ledger.py checks
+# that each element of a description was read or said). The list keeps the elements alive, so that lxml's
+# proxies (and their ids) stay theirs.
+_READ: ContextVar[list[Any] | None] = ContextVar("gazebo_tags_read", default=None)
+
+
+@contextmanager
+def reading() -> Iterator[list[Any]]:
+    """Record every element `TagReader.child()`/`.children()` returns while active; yields the list."""
+    taken: list[Any] = []
+    token = _READ.set(taken)
+    try:
+        yield taken
+    finally:
+        _READ.reset(token)
+
+
+def _record(*els: Any) -> None:
+    taken = _READ.get()
+    if taken is not None:
+        taken.extend(els)
 
 
 class TagReader:
@@ -32,6 +57,7 @@ class TagReader:
                 self.single.add(n)
                 if not any(found is t for t in self._taken):
                     self._taken.append(found)
+                _record(found)
                 return found
         return None
 
@@ -42,6 +68,7 @@ class TagReader:
             if found:
                 self.used.add(n)
                 out += found
+                _record(*found)
         return out
 
     def text(self, *names: str) -> str | None:
@@ -106,13 +133,6 @@ def join_topic(*parts: str | None) -> str:
 def sibling_topic(topic: str, name: str) -> str:
     head = topic.rsplit("/", 1)[0] if "/" in topic else ""
     return join_topic(head, name)
-
-
-def put_number(out: dict[str, Any], key: str, el: Any, path: str) -> None:
-    """out[key] = the number at `path` under `el`, when there is one."""
-    text = el.findtext(path)
-    if text and text.strip():
-        out[key] = float(text)
 
 
 def plugin_base(filename: str) -> str:

@@ -27,7 +27,7 @@ import math
 from typing import Any
 
 from runner.compile.gazebo.base import ReaderBase
-from runner.compile.gazebo.noise import noise_spec
+from runner.compile.gazebo.noise import NoiseSpec, noise_spec
 from runner.compile.gazebo.tags import TagReader, floats, is_zero, join_topic, plugin_base, ros_topic
 from runner.errors import NO_PUBLISHER, PLUGIN_UNSUPPORTED
 
@@ -523,9 +523,9 @@ def sensor(
     params: dict[str, Any] = {**common, "reference_heading": 90.0, "velocity_axes": "ENU"}
     gps = r.child("gps")
     if gps is not None:
+        gr = TagReader(gps)
         for block, key in (("position_sensing", "position"), ("velocity_sensing", "velocity")):
-            h = noise_spec(g, gps.find(f"{block}/horizontal"))
-            v = noise_spec(g, gps.find(f"{block}/vertical"))
+            h, v = _gps_axes(g, gr, block, context)
             sd = [h.stddev if h else 0.0] * 2 + [v.stddev if v else 0.0]
             if any(sd):
                 params[f"{key}_noise_stddev"] = sd
@@ -535,9 +535,7 @@ def sensor(
             for spec in (h, v):
                 if spec is not None and (spec.bias_mean or spec.bias_stddev):
                     g.note(spec.el, "a GPS noise bias (<bias_mean>, <bias_stddev>) is not modelled")
-        for child in gps:
-            if isinstance(child.tag, str) and child.tag not in ("position_sensing", "velocity_sensing"):
-                g.note(child, f"<{child.tag}> in {context} <gps> is ignored")
+        g.ignored(gr, f"{context} <gps>")
     found = False
     topic, velocity = base_topic or "fix", None
     for p in plugins:
@@ -563,3 +561,21 @@ def sensor(
         g.ignored(pr, f"<plugin filename={filename!r}>")
     params.update(topic=topic, velocity_topic=velocity, frame_id=frame)
     g.add(el, "gps", name, params, implicit=not (found or base_topic))
+
+
+def _gps_axes(g: ReaderBase, gps: TagReader, block: str, context: str) -> list[NoiseSpec | None]:
+    """The `<noise>` of `<gps><block>`'s `<horizontal>` and `<vertical>` (None where there is none)."""
+    el = gps.child(block)
+    if el is None:
+        return [None, None]
+    br = TagReader(el)
+    out = []
+    for axis in ("horizontal", "vertical"):
+        axis_el = br.child(axis)
+        ar = TagReader(axis_el) if axis_el is not None else None
+        where = f"{context} <gps><{block}><{axis}>"
+        out.append(noise_spec(g, ar, where))
+        if ar is not None:
+            g.ignored(ar, where)
+    g.ignored(br, f"{context} <gps><{block}>")
+    return out
