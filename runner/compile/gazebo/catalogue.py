@@ -522,6 +522,828 @@ CATALOGUE: tuple[PluginDoc, ...] = (
             ),
         ),
     ),
+    # ---- issue 38, the catalogue of the plugins people use (mapped or not), each read from its source ----
+    # gazebo_ros_pkgs at noetic-devel f9e1a460 (ROS 1) and ros2 d52f7c47 (Humble/Jazzy); gz-sim at 93bbf3ed
+    # (Harmonic and later; Fortress's names are the same with `ignition-gazebo-`). An entry that says
+    # "not supported" is one no reader maps: its parameters are ignored (the plugin is said once, with why).
+    PluginDoc(
+        ("gazebo_ros_planar_move",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_planar_move.cpp:47-126; ROS 2 Humble/Jazzy: "
+        "src/gazebo_ros_planar_move.cpp:141-195)",
+        "planar_move (the base's velocity set to the command, in its own frame)",
+        (
+            *_COMMON,
+            _p("commandTopic odometryTopic odometryFrame robotBaseFrame odometry_frame robot_base_frame"),
+            _p(
+                "odometryRate publish_rate update_rate",
+                "approx",
+                "the odometry's rate (the pose is set every step)",
+            ),
+            _p("cmdTimeout cmd_timeout", "same", "ROS 1 Noetic: no command for that long stops the base"),
+            _p("publish_odom publish_odom_tf"),
+            _p("covariance_x covariance_y covariance_yaw", "ignored", "the odometry's fixed covariances"),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_joint_state_publisher", "gz-sim-joint-state-publisher-system"),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_joint_state_publisher.cpp:51-75; ROS 2 Humble/Jazzy: "
+        "src/gazebo_ros_joint_state_publisher.cpp:97-132); gz-sim: src/systems/joint_state_publisher/"
+        "JointStatePublisher.cc:69-107",
+        "joint_states (the named joints, or every joint where gz-sim names none)",
+        (
+            *_COMMON,
+            _p("jointName joint_name", "same", "ROS 1: one comma-separated list; ROS 2, gz-sim: repeated"),
+            _p("updateRate update_rate"),
+            _p("topic", "same", "gz-sim: default `world/<world>/model/<model>/joint_state`"),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_imu",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic): src/gazebo_ros_imu.cpp:70-136 (a model plugin; ROS 2 has only the "
+        "sensor plugin gazebo_ros_imu_sensor)",
+        "imu on `<bodyName>` (N(0, gaussianNoise) on every rate and acceleration)",
+        (
+            *_COMMON,
+            _p("bodyName body_name topicName topic_name frameName frame_name"),
+            _p("updateRate update_rate updateRateHZ", "same", "0 (the default): every physics step"),
+            _p("gaussianNoise", "same", "white noise on every rate and acceleration"),
+            _p("xyzOffset rpyOffset", "ignored", "offsets of the reported pose (said)"),
+            _p("serviceName", "ignored", "a ROS service that calibrates; no ROS services here"),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_control",),
+        "model",
+        "gazebo_ros_control (ROS 1 Noetic, gazebo_ros_pkgs): src/gazebo_ros_control_plugin.cpp:85-157",
+        "the scenario's `controllers:` (the controller manager's parameters a launch file loads)",
+        (
+            _p("robotNamespace", "approx", "the robot's namespace is the scenario's (said when it differs)"),
+            _p("robotParam", "same", "the description is the robot's"),
+            _p("legacyModeNS", "same", "the controllers' namespace"),
+            _p("controlPeriod", "approx", "controllers act at every physics step (said)"),
+            _p("robotSimType", "approx", "DefaultRobotHWSim's interfaces; a custom one is said"),
+            _p("eStopTopic", "ignored", "Gazebo stops the controllers on it; not subscribed (said)"),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros2_control", "gz_ros2_control-system", "ign_ros2_control-system"),
+        "model",
+        "gazebo_ros2_control (humble: gazebo_ros2_control/src/gazebo_ros2_control_plugin.cpp:174-231; "
+        "master: :252-287); gz_ros2_control (jazzy: gz_ros2_control/src/gz_ros2_control_plugin.cpp:281-338; "
+        "humble: ign_ros2_control/src/ign_ros2_control_plugin.cpp)",
+        "controller_manager with the controllers files of `<parameters>`",
+        (
+            _p("parameters", "same", "the controllers files (relative to the description's file)"),
+            _p("ros", "approx", "`<remapping>` kept; `<namespace>` replaced by the robot's (said)"),
+            _p("controller_manager_name controller_manager_prefix_node_name"),
+            _p("robot_param robot_param_node", "same", "the description is the robot's"),
+            _p("hold_joints position_proportional_gain"),
+        ),
+    ),
+    PluginDoc(
+        ("hector_gazebo_ros_imu",),
+        "model",
+        "hector_gazebo_plugins (ROS 1 melodic-devel): src/gazebo_ros_imu.cpp:75-153; include/"
+        "hector_gazebo_plugins/sensor_model.h:106-115 (the error model's tags per prefix), "
+        "update_timer.h:56-80",
+        "imu (hector's error model: offset, drifting bias, white noise; the orientation tilted by the bias)",
+        (
+            *_COMMON,
+            _p("bodyName frameId topicName biasTopicName"),
+            _p("updateRate updatePeriod", "same", "none or 0: every physics step"),
+            _p("updateOffset", "ignored", "readings are taken at multiples of the period"),
+            _p("accelOffset accelDrift accelDriftFrequency accelGaussianNoise"),
+            _p("rateOffset rateDrift rateDriftFrequency rateGaussianNoise"),
+            _p("yawOffset yawDrift yawDriftFrequency"),
+            _p("yawGaussianNoise", "ignored", "only fills hector's orientation covariance (said)"),
+            _p("gaussianNoise", "same", "the older spelling of both white noises"),
+            _p("accelScaleError rateScaleError yawScaleError", "ignored", "read by hector, used for nothing"),
+            _p("xyzOffset", "ignored", "read and not applied by hector either (said when not 0)"),
+            _p("rpyOffset", "ignored", "the IMU is mounted as its link (said when not 0)"),
+            _p("serviceName", "ignored", "hector's calibrate service; no ROS services here"),
+        ),
+    ),
+    PluginDoc(
+        ("hector_gazebo_ros_gps",),
+        "model",
+        "hector_gazebo_plugins (ROS 1 melodic-devel): src/gazebo_ros_gps.cpp:70-157; sensor_model.h:106-115, "
+        "update_timer.h:56-80",
+        "gps (a flat earth around the reference point, hector's error model, velocity north-west-up)",
+        (
+            *_COMMON,
+            _p("bodyName frameId topicName velocityTopicName status service"),
+            _p("referenceLatitude referenceLongitude referenceHeading referenceAltitude"),
+            _p("updateRate updatePeriod", "same", "default 4 Hz"),
+            _p("updateOffset", "ignored", "readings are taken at multiples of the period"),
+            _p("offset drift driftFrequency gaussianNoise"),
+            _p("velocityOffset velocityDrift velocityDriftFrequency velocityGaussianNoise"),
+            _p("scaleError velocityScaleError", "ignored", "read by hector, used for nothing"),
+            _p(
+                "useWorldSphericalCoordinates",
+                "ignored",
+                "Gazebo takes the world's <spherical_coordinates>; the plugin's reference is used (said)",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("hector_gazebo_ros_sonar",),
+        "sensor",
+        "hector_gazebo_plugins (ROS 1 melodic-devel): src/gazebo_ros_sonar.cpp:82-96; sensor_model.h, "
+        "update_timer.h",
+        "lidar with only a sensor_msgs/Range (the nearest ray, ULTRASOUND, hector's error model)",
+        (
+            *_COMMON,
+            _p("frameId topicName"),
+            _p("updateRate updatePeriod", "same", "default 10 Hz"),
+            _p("offset drift driftFrequency gaussianNoise"),
+            _p("scaleError", "ignored", "read by hector, used for nothing"),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_laser", "gazebo_ros_gpu_laser"),
+        "sensor",
+        "gazebo_plugins (ROS 1 Noetic): src/gazebo_ros_laser.cpp:88-103, src/gazebo_ros_gpu_laser.cpp:91-105",
+        "lidar (sensor_msgs/LaserScan on `<topicName>`)",
+        (*_COMMON, _p("frameName topicName")),
+    ),
+    PluginDoc(
+        ("gazebo_ros_block_laser",),
+        "sensor",
+        "gazebo_plugins (ROS 1 Noetic): src/gazebo_ros_block_laser.cpp:106-149",
+        "lidar (its points)",
+        (
+            *_COMMON,
+            _p("frameName topicName updateRate"),
+            _p("gaussianNoise", "same", "added to the sensor's noise"),
+            _p(
+                "hokuyoMinIntensity",
+                "ignored",
+                "a floor on the intensities; every return has intensity 0 here",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_bumper",),
+        "sensor",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_bumper.cpp:82-101; ROS 2 Humble/Jazzy: "
+        "src/gazebo_ros_bumper.cpp:99)",
+        "contact (gazebo_msgs/ContactsState on the bumper topic)",
+        (*_COMMON, _p("bumperTopicName frameName frame_name")),
+    ),
+    PluginDoc(
+        ("gazebo_ros_imu_sensor",),
+        "sensor",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_imu_sensor.cpp:48-55, :175-252; ROS 2 Humble/Jazzy: "
+        "src/gazebo_ros_imu_sensor.cpp:76-82, frame_name through gazebo_ros::SensorFrameID)",
+        "imu (the sensor's `<imu>` noise)",
+        (
+            *_COMMON,
+            _p("topicName frameName frame_name"),
+            _p("updateRateHZ", "same", "ROS 1: throttles the sensor's `<update_rate>`"),
+            _p("gaussianNoise", "same", "ROS 1: added to the sensor's noise"),
+            _p("xyzOffset", "ignored", "read and unused by the plugin itself"),
+            _p("rpyOffset", "ignored", "turns the reported orientation; said"),
+            _p(
+                "initialOrientationAsReference initial_orientation_as_reference",
+                "ignored",
+                "true: the orientation relative to the start; here always the world's (said)",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_multicamera",),
+        "sensor",
+        "gazebo_plugins (ROS 1 Noetic): src/gazebo_ros_multicamera.cpp:92-93, src/gazebo_ros_camera_utils.cpp"
+        ":125-254 (per camera); ROS 2 Humble/Jazzy: gazebo_ros_camera reads a multicamera sensor",
+        "camera (one per camera of the sensor)",
+        (
+            *_COMMON,
+            _p("cameraName imageTopicName cameraInfoTopicName frameName updateRate"),
+            _p("hackBaseline", "ignored", "the stereo baseline in the right camera's CameraInfo"),
+            _p("Cx Cy CxPrime focalLength", "ignored", "CameraInfo is the ideal pinhole of <horizontal_fov>"),
+            _p("triggerTopicName borderCrop autoDistortion", "ignored", "triggering; rectification only"),
+            _p(
+                "distortionK1 distortionK2 distortionK3 distortionT1 distortionT2",
+                "ignored",
+                "images are not distorted (said when not 0)",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_velodyne_laser", "gazebo_ros_velodyne_gpu_laser"),
+        "sensor",
+        "velodyne_simulator (Dataspeed; ROS 1, as in lmark1/velodyne_simulator e08185a3): "
+        "velodyne_gazebo_plugins/src/GazeboRosVelodyneLaser.cpp:115-158; its ROS 2 port reads `<ros>`, "
+        "`frame_name`, `gaussian_noise`, `tf_prefix`",
+        "lidar with only a PointCloud2 (x y z intensity ring time, the velodyne layout)",
+        (
+            *_COMMON,
+            _p("topicName frameName frame_name", "same", "ROS 1 default `/points`, `/world`"),
+            _p("min_range max_range", "same", "with the sensor's `<range>`: the narrower"),
+            _p("gaussianNoise gaussian_noise", "same", "added to the sensor's noise"),
+            _p("organize_cloud", "same", "1.0.10+: an organised cloud"),
+            _p("min_intensity", "ignored", "drops dimmer returns; every return has intensity 0 here"),
+            _p("tf_prefix", "ignored", "ROS 2: prefixes the frame; the frame is the robot's"),
+        ),
+    ),
+    # gz-sim systems our world always runs: read as no-ops (tables.NOOP_PLUGINS), their options unread
+    PluginDoc(
+        ("gz-sim-physics-system",),
+        "model",
+        "gz-sim: src/systems/physics/Physics.cc:905-945",
+        "nothing: our world always steps physics (MuJoCo)",
+        (
+            _p("engine", "ignored", "the physics engine's library (dartsim by default); MuJoCo here"),
+            _p("contacts enforce_fixed_constraint", "ignored", "contact naming; fixed-joint enforcement"),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-sensors-system",),
+        "model",
+        "gz-sim: src/systems/sensors/Sensors.cc:701-780",
+        "nothing: our world always runs the sensors",
+        (
+            _p(
+                "render_engine render_engine_api_backend background_color ambient_light",
+                "ignored",
+                "the rendering engine and scene; cameras here render with MuJoCo",
+            ),
+            _p(
+                "global_illumination resolution octant_count bounce_count high_quality anisotropic",
+                "ignored",
+                "global illumination of the rendering engine",
+            ),
+            _p("thin_wall_counter conserve_memory debug_vis_mode", "ignored", "global illumination options"),
+            _p("disable_on_drained_battery", "ignored", "no batteries here"),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-scene-broadcaster-system",),
+        "model",
+        "gz-sim: src/systems/scene_broadcaster/SceneBroadcaster.cc:329-332",
+        "nothing: the GUI's scene updates",
+        (_p("dynamic_pose_hertz state_hertz", "ignored", "rates of the GUI's pose and state messages"),),
+    ),
+    PluginDoc(
+        ("gz-sim-user-commands-system",),
+        "model",
+        "gz-sim: src/systems/user_commands/UserCommands.cc:564-636",
+        "nothing: the services that create, move and remove entities",
+        (_p("set_all_light_entities", "ignored", "light commands affect every light"),),
+    ),
+    PluginDoc(
+        ("gz-sim-imu-system", "gz-sim-contact-system", "gz-sim-forcetorque-system"),
+        "model",
+        "gz-sim: src/systems/imu/Imu.cc, src/systems/contact/Contact.cc, src/systems/force_torque/"
+        "ForceTorque.cc (no options of their own: each sensor's are in its `<sensor>`)",
+        "nothing: our world always runs these sensors",
+    ),
+    # gazebo_plugins we do not map (ROS 1 Noetic, ROS 2 Humble/Jazzy)
+    PluginDoc(
+        ("gazebo_ros_tricycle_drive",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_tricycle_drive.cpp:84-113; ROS 2 Humble/Jazzy: "
+        "src/gazebo_ros_tricycle_drive.cpp:248-354)",
+        "not supported: use the scenario's `steering_drive` plugin (a tricycle steering controller's "
+        "kinematics)",
+        (
+            _p(
+                "steeringJoint actuatedWheelJoint encoderWheelLeftJoint encoderWheelRightJoint "
+                "steering_joint actuated_wheel_joint encoder_wheel_left_joint encoder_wheel_right_joint",
+                "ignored",
+                "the steered and driven front wheel's joints; the rear wheels' joints for odometry",
+            ),
+            _p(
+                "actuatedWheelDiameter encoderWheelDiameter encoderWheelSeparation actuated_wheel_diameter "
+                "encoder_wheel_diameter wheel_separation",
+                "ignored",
+                "the geometry of the command's inverse kinematics and of the odometry",
+            ),
+            _p(
+                "wheelTorque wheelAcceleration wheelDeceleration wheelSpeedTolerance steeringSpeed "
+                "steeringAngleTolerance max_wheel_torque max_wheel_acceleration max_wheel_deceleration "
+                "max_wheel_speed_tolerance max_steering_speed max_steering_angle_tolerance",
+                "ignored",
+                "limits of the wheel's velocity servo and of the steering's rate",
+            ),
+            _p(
+                "commandTopic odometryTopic odometryFrame robotBaseFrame odometry_frame robot_base_frame",
+                "ignored",
+                "the Twist it subscribes and the odometry it publishes",
+            ),
+            _p(
+                "updateRate update_rate odometrySource odometry_source publishWheelTF publishWheelJointState "
+                "publish_wheel_tf publish_wheel_joint_state publish_odom",
+                "ignored",
+                "the control rate; odometry from the encoders or the world; what else it publishes",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_ackermann_drive",),
+        "model",
+        "gazebo_plugins (ROS 2 Humble/Jazzy): src/gazebo_ros_ackermann_drive.cpp:230-447",
+        "not supported: use the scenario's `steering_drive` plugin (ackermann steering kinematics)",
+        (
+            _p(
+                "front_left_joint front_right_joint rear_left_joint rear_right_joint left_steering_joint "
+                "right_steering_joint steering_wheel_joint",
+                "ignored",
+                "the four wheels' and two steering joints; the steering wheel turned with them",
+            ),
+            _p(
+                "max_speed max_steer max_steering_angle",
+                "ignored",
+                "the command's limits; the steering wheel's angle at max_steer",
+            ),
+            _p(
+                "left_steering_pid_gain left_steering_i_range right_steering_pid_gain right_steering_i_range "
+                "linear_velocity_pid_gain linear_velocity_i_range",
+                "ignored",
+                "PID gains (p i d) and integral ranges of the joint forces that track the command",
+            ),
+            _p(
+                "update_rate odometry_frame robot_base_frame publish_odom publish_odom_tf publish_wheel_tf "
+                "publish_distance publish_steerangle covariance_x covariance_y covariance_yaw",
+                "ignored",
+                "the control rate; the odometry, the distance and the steering angle it publishes",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_f3d",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic): src/gazebo_ros_f3d.cpp:63-96",
+        "not supported: no counterpart (the external force and torque on a link are not published)",
+        (
+            _p("robotNamespace", "ignored", "the namespace of its topic"),
+            _p("bodyName topicName frameName", "ignored", "the link; the WrenchStamped topic; its frame"),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_force",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_force.cpp:72-96; ROS 2 Humble/Jazzy: "
+        "src/gazebo_ros_force.cpp:68-88)",
+        "not supported: no counterpart (a wrench from a topic is not applied to a link)",
+        (
+            _p("robotNamespace ros", "ignored", "the namespace of its topic"),
+            _p("bodyName link_name", "ignored", "the link the wrench is applied to"),
+            _p("topicName", "ignored", "ROS 1: the geometry_msgs/Wrench topic it subscribes"),
+            _p("force_frame", "ignored", "ROS 2: world (default) or link, the frame of the wrench"),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_hand_of_god",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_hand_of_god.cpp:83-99; ROS 2 Humble/Jazzy: "
+        "src/gazebo_ros_hand_of_god.cpp:109-115)",
+        "not supported: no counterpart (a link is not pulled along a TF frame)",
+        (
+            _p("robotNamespace ros", "ignored", "the namespace of its TF"),
+            _p("frameId frame_id linkName link_name", "ignored", "the TF frame the link follows; the link"),
+            _p("kl ka", "ignored", "the linear and angular gains of the force and torque that pull it"),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_vacuum_gripper",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_vacuum_gripper.cpp:74-105; ROS 2 Humble/Jazzy: "
+        "src/gazebo_ros_vacuum_gripper.cpp:105-120)",
+        "not supported: no counterpart (nothing is pulled to a link); for a gripper's fingers use the "
+        "scenario's `gripper_action_controller`",
+        (
+            _p("robotNamespace ros", "ignored", "the namespace of its topics and services"),
+            _p("bodyName link_name", "ignored", "the gripper's link"),
+            _p("topicName", "ignored", "ROS 1: the Bool topic saying whether it grasps"),
+            _p("max_distance", "ignored", "ROS 2: how far objects are pulled from"),
+            _p("fixed", "ignored", "ROS 2: models never pulled"),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_joint_pose_trajectory",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_joint_pose_trajectory.cpp:77-103; ROS 2 Humble/Jazzy: "
+        "src/gazebo_ros_joint_pose_trajectory.cpp:119)",
+        "not supported: use the scenario's `joint_trajectory_controller` plugin (it drives the joints; this "
+        "plugin sets their positions without dynamics)",
+        (
+            _p("robotNamespace ros", "ignored", "the namespace of its topic"),
+            _p("serviceName topicName", "ignored", "ROS 1: the trajectory's service and topic"),
+            _p("updateRate update_rate", "ignored", "the rate at which it sets the joints' positions"),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_wheel_slip",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_wheel_slip.cpp:74-76, the rest read by Gazebo's "
+        "WheelSlipPlugin; ROS 2 Humble/Jazzy: src/gazebo_ros_wheel_slip.cpp:113-126, :337-351)",
+        "not supported: slip compliance is not modelled (the wheels' `<collision><surface>` friction is "
+        "read)",
+        (
+            _p("robotNamespace ros", "ignored", "the namespace of its parameters"),
+            _p("wheel link_name", "ignored", "a `<wheel link_name=...>` per wheel link"),
+            _p(
+                "slip_compliance_lateral slip_compliance_longitudinal",
+                "ignored",
+                "ODE slip (velocity per force) scaled by the wheel's speed, per wheel",
+            ),
+            _p("wheel_spin_tolerance publisher_update_rate", "ignored", "ROS 2: the slip it publishes"),
+        ),
+    ),
+    # gz-sim systems found in robot descriptions that we do not map
+    PluginDoc(
+        ("gz-sim-joint-position-controller-system",),
+        "model",
+        "gz-sim: src/systems/joint_position_controller/JointPositionController.cc:241-394",
+        "not supported: use the scenario's `joint_controller` plugin (mode position)",
+        (
+            _p("joint_name joint_index", "ignored", "the joint(s), and which axis of a multi-axis joint"),
+            _p(
+                "p_gain i_gain d_gain i_max i_min cmd_max cmd_min cmd_offset",
+                "ignored",
+                "the PID that turns the position error into a force (or a velocity)",
+            ),
+            _p("use_velocity_commands", "ignored", "command the joint's velocity instead of a force"),
+            _p("initial_position", "ignored", "the target before any command"),
+            _p(
+                "topic sub_topic use_actuator_msg actuator_number",
+                "ignored",
+                "the Double (or Actuators) topic",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-joint-controller-system",),
+        "model",
+        "gz-sim: src/systems/joint_controller/JointController.cc:113-245",
+        "not supported: use the scenario's `joint_controller` plugin (mode velocity)",
+        (
+            _p("joint_name", "ignored", "the joint(s)"),
+            _p("initial_velocity", "ignored", "the target before any command"),
+            _p(
+                "use_force_commands p_gain i_gain d_gain i_max i_min cmd_max cmd_min cmd_offset",
+                "ignored",
+                "with use_force_commands, a PID on the velocity error; else the velocity is set directly",
+            ),
+            _p("disable_braking", "ignored", "no velocity command while the target is 0"),
+            _p(
+                "topic sub_topic use_actuator_msg actuator_number",
+                "ignored",
+                "the Double (or Actuators) topic",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-apply-joint-force-system",),
+        "model",
+        "gz-sim: src/systems/apply_joint_force/ApplyJointForce.cc:93",
+        "not supported: use the scenario's `joint_controller` plugin (mode effort)",
+        (
+            _p(
+                "joint_name",
+                "ignored",
+                "the joint a Double on `/model/<model>/joint/<joint>/cmd_force` drives",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-joint-trajectory-controller-system",),
+        "model",
+        "gz-sim: src/systems/joint_traj_control/JointTrajectoryController.cc:367-378, :537, :720-754",
+        "not supported: use the scenario's `joint_trajectory_controller` plugin",
+        (
+            _p(
+                "topic use_header_start_time",
+                "ignored",
+                "the JointTrajectory topic; when a trajectory starts",
+            ),
+            _p("joint_name initial_position", "ignored", "the joints (default: every one) and their start"),
+            _p(
+                "position_p_gain position_i_gain position_d_gain position_i_min position_i_max "
+                "position_cmd_min position_cmd_max position_cmd_offset",
+                "ignored",
+                "the per-joint position PID (forces)",
+            ),
+            _p(
+                "velocity_p_gain velocity_i_gain velocity_d_gain velocity_i_min velocity_i_max "
+                "velocity_cmd_min velocity_cmd_max velocity_cmd_offset",
+                "ignored",
+                "the per-joint velocity PID (forces)",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-pose-publisher-system",),
+        "model",
+        "gz-sim: src/systems/pose_publisher/PosePublisher.cc:200-268",
+        "not supported: use the scenario's `tf` plugin (the link tree) or `ground_truth` (a link's world "
+        "pose)",
+        (
+            _p(
+                "publish_link_pose publish_nested_model_pose publish_model_pose publish_visual_pose "
+                "publish_collision_pose publish_sensor_pose",
+                "ignored",
+                "which poses it publishes (links by default) on `/model/<model>/pose`",
+            ),
+            _p(
+                "update_frequency static_publisher static_update_frequency",
+                "ignored",
+                "its rate; the fixed poses on their own topic at their own rate",
+            ),
+            _p("use_pose_vector_msg topic", "ignored", "one Pose_V per update; the topic"),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-ackermann-steering-system",),
+        "model",
+        "gz-sim: src/systems/ackermann_steering/AckermannSteering.cc:258-497",
+        "not supported: use the scenario's `steering_drive` plugin (ackermann steering kinematics)",
+        (
+            _p(
+                "left_joint right_joint left_steering_joint right_steering_joint",
+                "ignored",
+                "the driven wheels' and the steering joints",
+            ),
+            _p(
+                "wheel_radius kingpin_width wheel_separation wheel_base steering_limit steer_p_gain",
+                "ignored",
+                "the geometry of the steering angles; the steering servo's gain",
+            ),
+            _p(
+                "min_velocity max_velocity min_acceleration max_acceleration min_jerk max_jerk",
+                "ignored",
+                "the speed limiter on the command",
+            ),
+            _p(
+                "steering_only use_actuator_msg actuator_number",
+                "ignored",
+                "steering only (the wheels driven by something else); an Actuators command",
+            ),
+            _p(
+                "topic sub_topic odom_topic tf_topic frame_id child_frame_id odom_publish_frequency",
+                "ignored",
+                "the Twist it subscribes and the odometry it publishes",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-velocity-control-system",),
+        "model",
+        "gz-sim: src/systems/velocity_control/VelocityControl.cc:123-160",
+        "not supported: use the scenario's `planar_move` plugin (the base's velocity set to a Twist)",
+        (
+            _p("initial_linear initial_angular", "ignored", "the velocity before any command"),
+            _p("topic", "ignored", "the Twist topic (default `/model/<model>/cmd_vel`)"),
+            _p("link_name", "ignored", "links whose velocity it sets instead, each on its own topic"),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-wheel-slip-system",),
+        "model",
+        "gz-sim: src/systems/wheel_slip/WheelSlip.cc:183-220",
+        "not supported: slip compliance is not modelled (the wheels' `<collision><surface>` friction is "
+        "read)",
+        (
+            _p("wheel link_name", "ignored", "a `<wheel link_name=...>` per wheel link"),
+            _p(
+                "slip_compliance_lateral slip_compliance_longitudinal wheel_normal_force wheel_radius",
+                "ignored",
+                "ODE slip (velocity per force), scaled by the wheel's speed and its normal force",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-detachable-joint-system",),
+        "model",
+        "gz-sim: src/systems/detachable_joint/DetachableJoint.cc:56-209",
+        "not supported: no counterpart (no joint is made or broken during a run)",
+        (
+            _p("parent_link child_model child_link", "ignored", "the fixed joint it makes between them"),
+            _p(
+                "topic detach_topic attach_topic output_topic",
+                "ignored",
+                "the Empty topics that detach and attach; the state it publishes",
+            ),
+            _p("suppress_child_warning", "ignored", "a warning when the child model is missing"),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-touchplugin-system",),
+        "model",
+        "gz-sim: src/systems/touch_plugin/TouchPlugin.cc:140-300",
+        "not supported: use the scenario's `contact` plugin (the contacts of a link)",
+        (
+            _p("target collision", "ignored", "the model it must touch; the collisions that do"),
+            _p("time", "ignored", "how long the touch must last"),
+            _p("namespace enabled", "ignored", "its topics' namespace; whether it starts enabled"),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-triggered-publisher-system",),
+        "model",
+        "gz-sim: src/systems/triggered_publisher/TriggeredPublisher.cc:438-641",
+        "not supported: no counterpart (use the scenario's timeline to publish)",
+        (
+            _p("input output", "ignored", "the message (type, topic) that triggers; what it publishes"),
+            _p("match field logic_type tol", "ignored", "what the input must match"),
+            _p("delay_ms", "ignored", "the delay between the trigger and the output"),
+            _p("service", "ignored", "services it calls when triggered"),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-label-system",),
+        "model",
+        "gz-sim: src/systems/label/Label.cc:49-71",
+        "not supported: no counterpart (no segmentation cameras here)",
+        (_p("label", "ignored", "the semantic label (0-255) segmentation cameras see on its visuals"),),
+    ),
+    PluginDoc(
+        ("gz-sim-thruster-system",),
+        "model",
+        "gz-sim: src/systems/thruster/Thruster.cc:230-511",
+        "not supported: no counterpart (no fluid dynamics here)",
+        (
+            _p("namespace joint_name topic", "ignored", "the propeller's joint; the command topic"),
+            _p(
+                "thrust_coefficient propeller_diameter fluid_density wake_fraction alpha_1 alpha_2",
+                "ignored",
+                "the thrust the propeller's speed gives",
+            ),
+            _p(
+                "use_angvel_cmd velocity_control p_gain i_gain d_gain max_thrust_cmd min_thrust_cmd deadband",
+                "ignored",
+                "how the command drives the propeller; its limits",
+            ),
+            _p("power_load battery_name", "ignored", "the battery it drains"),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-buoyancy-system",),
+        "model",
+        "gz-sim: src/systems/buoyancy/Buoyancy.cc:487-551 (a world system)",
+        "not supported: no counterpart (no fluid here)",
+        (
+            _p("uniform_fluid_density", "ignored", "the fluid's density (1000 by default)"),
+            _p("graded_buoyancy", "ignored", "densities by depth (`<density_change>` `<above_depth>`)"),
+            _p("enable", "ignored", "the models it acts on"),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-lift-drag-system",),
+        "model",
+        "gz-sim: src/systems/lift_drag/LiftDrag.cc:162-230",
+        "not supported: no counterpart (no aerodynamics here)",
+        (
+            _p(
+                "cla cda cma alpha_stall cla_stall cda_stall cma_stall a0 cm_delta",
+                "ignored",
+                "lift, drag and moment coefficients and the stall",
+            ),
+            _p(
+                "air_density area cp forward upward radial_symmetry",
+                "ignored",
+                "the wing's geometry, the air",
+            ),
+            _p("link_name control_joint_name", "ignored", "the wing's link; a control surface's joint"),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-multicopter-motor-model-system",),
+        "model",
+        "gz-sim: src/systems/multicopter_motor_model/MulticopterMotorModel.cc:250-366",
+        "not supported: no counterpart (rotor thrust is not modelled)",
+        (
+            _p(
+                "robotNamespace jointName linkName motorNumber actuator_number commandSubTopic",
+                "ignored",
+                "the rotor's joint and link; its index in the Actuators command",
+            ),
+            _p(
+                "turningDirection motorType maxRotVelocity motorConstant momentConstant",
+                "ignored",
+                "the thrust and drag moment from the rotor's speed",
+            ),
+            _p(
+                "rotorDragCoefficient rollingMomentCoefficient timeConstantUp timeConstantDown "
+                "rotorVelocitySlowdownSim",
+                "ignored",
+                "the rotor's drag and rolling moment; the motor's lag",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-tracked-vehicle-system",),
+        "model",
+        "gz-sim: src/systems/tracked_vehicle/TrackedVehicle.cc:238-423",
+        "not supported: tracks are not modelled; use the scenario's `skid_steer` plugin on wheels",
+        (
+            _p("body_link left_track right_track", "ignored", "the body and each side's track links"),
+            _p("tracks_separation steering_efficiency", "ignored", "the skid-steer kinematics"),
+            _p(
+                "min_velocity max_velocity min_acceleration max_acceleration min_jerk max_jerk",
+                "ignored",
+                "the speed limiter on the command",
+            ),
+            _p(
+                "topic odom_topic tf_topic frame_id child_frame_id odom_publish_frequency "
+                "center_of_rotation_topic steering_efficiency_topic debug",
+                "ignored",
+                "the Twist it subscribes; the odometry; topics that change it while running",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-track-controller-system",),
+        "model",
+        "gz-sim: src/systems/track_controller/TrackController.cc:214-373",
+        "not supported: tracks are not modelled (the surface motion of a track link)",
+        (
+            _p("link max_command_age debug", "ignored", "the track link; a command's lifetime"),
+            _p(
+                "min_velocity max_velocity min_acceleration max_acceleration min_jerk max_jerk",
+                "ignored",
+                "the speed limiter on the track's velocity",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-apply-link-wrench-system",),
+        "model",
+        "gz-sim: src/systems/apply_link_wrench/ApplyLinkWrench.cc:154-226",
+        "not supported: no counterpart (a wrench from a topic is not applied to a link)",
+        (
+            _p(
+                "persistent entity_name entity_type force torque", "ignored", "wrenches applied at every step"
+            ),
+            _p(
+                "topic topic_persistent topic_clear verbose",
+                "ignored",
+                "the topics that apply and clear them",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-linearbatteryplugin-system",),
+        "model",
+        "gz-sim: src/systems/battery_plugin/LinearBatteryPlugin.cc:232-411",
+        "not supported: no counterpart (no batteries here)",
+        (
+            _p(
+                "battery_name voltage open_circuit_voltage_constant_coef open_circuit_voltage_linear_coef "
+                "capacity initial_charge resistance smooth_current_tau",
+                "ignored",
+                "the battery's model",
+            ),
+            _p("power_load start_draining fix_issue_225 invert_current_sign", "ignored", "how it drains"),
+            _p(
+                "enable_recharge charging_time recharge_by_topic power_draining_topic "
+                "stop_power_draining_topic",
+                "ignored",
+                "recharging; the topics that start and stop draining",
+            ),
+        ),
+    ),
+    # third-party
+    PluginDoc(
+        ("realsense_gazebo_plugin",),
+        "model",
+        "realsense_gazebo_plugin (PAL Robotics, ROS 1 melodic-devel 49ab134f): "
+        "src/RealSensePlugin.cpp:52-120 (each tag by name; any other one throws), "
+        "src/gazebo_ros_realsense.cpp",
+        'not supported: give the robot\'s `<sensor type="depth">` and `<sensor type="camera">` with '
+        "gazebo_ros_camera (or the scenario's `depth_camera` and `camera` plugins)",
+        (
+            _p("prefix robotNamespace", "ignored", "the cameras' sensor name prefix; its namespace"),
+            _p(
+                "depthUpdateRate colorUpdateRate infraredUpdateRate",
+                "ignored",
+                "the rates of the depth, colour and infrared cameras (sensors of its model)",
+            ),
+            _p(
+                "depthTopicName depthCameraInfoTopicName colorTopicName colorCameraInfoTopicName "
+                "infrared1TopicName infrared1CameraInfoTopicName infrared2TopicName "
+                "infrared2CameraInfoTopicName",
+                "ignored",
+                "the image and CameraInfo topics of each camera",
+            ),
+            _p(
+                "colorOpticalframeName depthOpticalframeName infrared1OpticalframeName "
+                "infrared2OpticalframeName",
+                "ignored",
+                "each image's frame",
+            ),
+            _p(
+                "rangeMinDepth rangeMaxDepth pointCloud pointCloudTopicName pointCloudCutoff "
+                "pointCloudCutoffMax",
+                "ignored",
+                "the depth's limits; the coloured PointCloud2 it publishes and its cut-offs",
+            ),
+        ),
+    ),
 )
 
 
@@ -531,6 +1353,17 @@ def entry(base: str) -> PluginDoc | None:
 
 
 _BY_BASE = {b: e for e in CATALOGUE for b in e.bases}
+UNSUPPORTED = (
+    "not supported"  # how `becomes` starts for a plugin we do not map: "not supported: why; instead"
+)
+
+
+def unsupported_reason(base: str) -> str:
+    """Why the plugin is not supported and what serves instead ('' when it is mapped or not catalogued)."""
+    doc = _BY_BASE.get(base)
+    if doc is None or not doc.becomes.startswith(UNSUPPORTED):
+        return ""
+    return doc.becomes.removeprefix(UNSUPPORTED).lstrip(":; ").strip()
 
 
 def render() -> str:
