@@ -77,3 +77,24 @@ def test_an_unsupported_plugin_is_said_with_the_catalogues_reason(tmp_path: Path
     assert reason
     assert f"plugin 'libgazebo_ros_vacuum_gripper.so' is not supported and is ignored: {reason}" in notices
     assert "model plugins we map:" in notices  # the hint it always had
+
+
+def test_the_systems_of_the_sensors_we_read_are_not_said_as_unsupported(tmp_path: Path) -> None:
+    """gz-sim's magnetometer, air pressure and altimeter systems only switch on sensors the field-sensor
+    reader maps: a description that loads them is told nothing about them."""
+    from tests.helpers import compile_with_notices, robot_scenario
+
+    systems = "".join(
+        f'<plugin filename="gz-sim-{s}-system" name="gz::sim::systems::X"/>'
+        for s in ("magnetometer", "air-pressure", "altimeter")
+    )
+    urdf = f"""<?xml version="1.0"?>
+<robot name="u">
+  <link name="base_link">
+    <inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+  </link>
+  <gazebo>{systems}</gazebo>
+</robot>
+"""
+    _, notices = compile_with_notices(robot_scenario(tmp_path, urdf))
+    assert "not supported" not in notices, notices

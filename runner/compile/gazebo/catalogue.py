@@ -801,6 +801,27 @@ CATALOGUE: tuple[PluginDoc, ...] = (
         "ForceTorque.cc (no options of their own: each sensor's are in its `<sensor>`)",
         "nothing: our world always runs these sensors",
     ),
+    PluginDoc(
+        ("gz-sim-magnetometer-system", "gz-sim-air-pressure-system", "gz-sim-altimeter-system"),
+        "model",
+        "gz-sim: src/systems/magnetometer/Magnetometer.cc:252-271 (the air pressure and altimeter systems "
+        "read no options: each sensor's are in its `<sensor>`)",
+        "nothing: our world always runs these sensors (runner.compile.gazebo.field_sensors)",
+        (
+            _p(
+                "use_units_gauss use_earth_frame_ned",
+                "ignored",
+                "the units and axes of gz-sim's field table at the world's <spherical_coordinates>, which is "
+                "not read here (the field is SDF's default)",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-navsat-system",),
+        "model",
+        "gz-sim: src/systems/navsat/NavSat.cc (no options: the sensor's are in its `<sensor type='navsat'>`)",
+        "not supported: a navsat sensor is not read here; use the scenario's `gps` plugin",
+    ),
     # gazebo_plugins we do not map (ROS 1 Noetic, ROS 2 Humble/Jazzy)
     PluginDoc(
         ("gazebo_ros_tricycle_drive",),
