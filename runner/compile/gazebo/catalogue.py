@@ -1365,6 +1365,160 @@ CATALOGUE: tuple[PluginDoc, ...] = (
             ),
         ),
     ),
+    PluginDoc(
+        ("gazebo_ros_gps_sensor",),
+        "sensor",
+        "gazebo_plugins (ROS 2 Humble/Jazzy): src/gazebo_ros_gps_sensor.cpp:66-89 (NavSatFix on `~/out`, the "
+        "velocity on `~/vel`; frame_name through gazebo_ros::SensorFrameID)",
+        "gps (Gazebo's GPS sensor: its `<gps>` noise, velocity east-north-up)",
+        (
+            _p(
+                "ros",
+                "approx",
+                "`<remapping>` (`~/out`, `~/vel`) kept; `<namespace>` replaced by the robot's",
+            ),
+            _p("frame_name", "same", "default: the sensor's link"),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_projector",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_projector.cpp:93-110; ROS 2 Humble/Jazzy: "
+        "src/gazebo_ros_projector.cpp:80-81)",
+        "not supported: no counterpart (nothing is rendered from projectors here)",
+        (
+            _p("robotNamespace ros", "ignored", "the namespace of its topics"),
+            _p(
+                "projector projector_link projector_name",
+                "ignored",
+                "the `<projector>` of a link it switches",
+            ),
+            _p(
+                "textureTopicName projectorTopicName",
+                "ignored",
+                "ROS 1: the topics that set the texture, switch",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_video",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_video.cpp:139-188; ROS 2 Humble/Jazzy: "
+        "src/gazebo_ros_video.cpp:209-214, a visual plugin)",
+        "not supported: no counterpart (images from a topic are not shown on a visual)",
+        (
+            _p("robotNamespace ros", "ignored", "the namespace of its topic"),
+            _p("topicName", "ignored", "ROS 1: the sensor_msgs/Image topic it shows"),
+            _p("height width name", "ignored", "the texture's size; the visual's name"),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_elevator",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_elevator.cpp:44-61; ROS 2 Humble/Jazzy: "
+        "src/gazebo_ros_elevator.cpp:55-67; the lift itself is Gazebo's ElevatorPlugin)",
+        "not supported: no counterpart (an elevator's lift and doors on a String command)",
+        (
+            _p("robotNamespace ros", "ignored", "the namespace of its topic"),
+            _p("topic", "ignored", "ROS 1: the String topic with the floor to go to"),
+            _p("bottom_floor top_floor", "ignored", "ROS 2: the floors it accepts"),
+        ),
+    ),
+    # hector_gazebo_plugins' drives (ROS 1 melodic-devel), PAL's, gz-sim's trajectory follower
+    PluginDoc(
+        ("diffdrive_plugin_multi_wheel",),
+        "model",
+        "hector_gazebo_plugins (ROS 1 melodic-devel): src/diffdrive_plugin_multi_wheel.cpp:120-230",
+        "not supported: use the scenario's `skid_steer` plugin (every wheel of a side at one speed)",
+        (
+            _p("robotNamespace", "ignored", "the namespace of its topics"),
+            _p("leftJoints rightJoints", "ignored", "each side's wheel joints, space-separated"),
+            _p("wheelSeparation wheelDiameter torque", "ignored", "the kinematics; the wheels' force limit"),
+            _p(
+                "commandTopic odometryTopic odometryFrame robotBaseFrame updateRate publishOdometryTf "
+                "publishOdometryMsg",
+                "ignored",
+                "the Twist it subscribes and the odometry (from the world pose) it publishes",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("diffdrive_plugin_6w",),
+        "model",
+        "hector_gazebo_plugins (ROS 1 melodic-devel): src/diffdrive_plugin_6w.cpp:94-137",
+        "not supported: use the scenario's `skid_steer` plugin (three wheels a side)",
+        (
+            _p("robotNamespace topicName bodyName", "ignored", "the Twist topic; the base link"),
+            _p(
+                "frontLeftJoint frontRightJoint midLeftJoint midRightJoint rearLeftJoint rearRightJoint",
+                "ignored",
+                "the six wheel joints",
+            ),
+            _p("wheelSeparation wheelDiameter torque", "ignored", "the kinematics; the wheels' force limit"),
+        ),
+    ),
+    PluginDoc(
+        ("hector_servo_plugin",),
+        "model",
+        "hector_gazebo_plugins (ROS 1 melodic-devel): src/servo_plugin.cpp:93-120",
+        "not supported: use the scenario's `joint_controller` plugin (mode position) on each joint",
+        (
+            _p("robotNamespace topicName jointStateName", "ignored", "the command and joint-state topics"),
+            _p(
+                "firstServoName firstServoAxis secondServoName secondServoAxis thirdServoName thirdServoAxis",
+                "ignored",
+                "up to three joints turned to a commanded orientation",
+            ),
+            _p(
+                "proportionalControllerGain derivativeControllerGain maxVelocity torque controlRate",
+                "ignored",
+                "the PD servo that drives them; its limits and rate",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_underactuated_finger",),
+        "model",
+        "pal_gazebo_plugins (ROS 2 humble-devel 6575bb12): src/gazebo_underactuated_finger.cpp:58-125",
+        "not supported: declare the finger's joints `<mimic>` of the actuated one in the URDF (mimic joints "
+        "are held by an equality constraint here)",
+        (
+            _p("namespace", "ignored", "its namespace"),
+            _p("actuatedJoint", "ignored", "the joint the hand's controller drives"),
+            _p(
+                "virtualJoint",
+                "ignored",
+                "each joint that follows it: `<name>`, `<scale_factor>`, `<pid_gains>` (p i d i_max i_min)",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("pal_gazebo_collisions",),
+        "model",
+        "pal_gazebo_plugins (ROS 2 humble-devel 6575bb12): src/pal_gazebo_collisions.cpp:35-40",
+        "not supported: no counterpart (the model's self-collisions are not published)",
+        (_p("updateRate", "ignored", "the rate at which it publishes the contacts"),),
+    ),
+    PluginDoc(
+        ("gz-sim-trajectory-follower-system",),
+        "model",
+        "gz-sim: src/systems/trajectory_follower/TrajectoryFollower.cc:123-265",
+        "not supported: no counterpart (use the scenario's timeline of velocity commands to a drive)",
+        (
+            _p("link_name", "ignored", "the link it pushes (default: the model's canonical link)"),
+            _p(
+                "waypoints waypoint circle radius line direction length loop",
+                "ignored",
+                "the path: waypoints, a circle or a line, once or in a loop",
+            ),
+            _p(
+                "force torque range_tolerance bearing_tolerance zero_vel_on_bearing_reached",
+                "ignored",
+                "the force and torque it pushes with; when a waypoint or bearing counts as reached",
+            ),
+            _p("topic", "ignored", "the Boolean topic that pauses and resumes it"),
+        ),
+    ),
 )
 
 
