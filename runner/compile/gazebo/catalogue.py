@@ -538,7 +538,8 @@ CATALOGUE: tuple[PluginDoc, ...] = (
             _p(
                 "odometryRate publish_rate update_rate",
                 "approx",
-                "the odometry's rate (the pose is set every step)",
+                "the odometry's rate; ROS 2's `update_rate` (its control rate) stands in when `publish_rate` "
+                "is absent; the velocity is set at every step",
             ),
             _p("cmdTimeout cmd_timeout", "same", "ROS 1 Noetic: no command for that long stops the base"),
             _p("publish_odom publish_odom_tf"),
@@ -582,7 +583,11 @@ CATALOGUE: tuple[PluginDoc, ...] = (
         (
             _p("robotNamespace", "approx", "the robot's namespace is the scenario's (said when it differs)"),
             _p("robotParam", "same", "the description is the robot's"),
-            _p("legacyModeNS", "same", "the controllers' namespace"),
+            _p(
+                "legacyModeNS",
+                "ignored",
+                "kinetic/melodic only (namespaced controllers); Noetic does not read it, nor do we",
+            ),
             _p("controlPeriod", "approx", "controllers act at every physics step (said)"),
             _p("robotSimType", "approx", "DefaultRobotHWSim's interfaces; a custom one is said"),
             _p("eStopTopic", "ignored", "Gazebo stops the controllers on it; not subscribed (said)"),
