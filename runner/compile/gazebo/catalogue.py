@@ -1617,6 +1617,40 @@ CATALOGUE: tuple[PluginDoc, ...] = (
             _p("min_temp max_temp", "ignored", "the texture's temperature range"),
         ),
     ),
+    PluginDoc(
+        ("gazebo_ros_triggered_camera", "gazebo_ros_triggered_multicamera"),
+        "sensor",
+        "gazebo_plugins (ROS 1 Noetic): src/gazebo_ros_triggered_camera.cpp:50-82, "
+        "src/gazebo_ros_triggered_multicamera.cpp:87-88, src/gazebo_ros_camera_utils.cpp:125-254",
+        "not supported: use gazebo_ros_camera (or gazebo_ros_multicamera), which publish at the sensor's "
+        "rate; a frame per message on the trigger topic is not reproduced",
+        (
+            _p("robotNamespace", "ignored", "the namespace of its topics"),
+            _p(
+                "cameraName imageTopicName cameraInfoTopicName frameName updateRate triggerTopicName",
+                "ignored",
+                "the image and CameraInfo topics; the trigger topic that makes it publish one frame",
+            ),
+            _p(
+                "Cx Cy CxPrime focalLength hackBaseline borderCrop autoDistortion distortionK1 distortionK2 "
+                "distortionK3 distortionT1 distortionT2",
+                "ignored",
+                "the CameraInfo's intrinsics and distortion",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gazebo_ros_harness",),
+        "model",
+        "gazebo_plugins (ROS 1 Noetic: src/gazebo_ros_harness.cpp:56-57; ROS 2 Humble/Jazzy: "
+        "src/gazebo_ros_harness.cpp:77-89; the harness itself is Gazebo's HarnessPlugin)",
+        "not supported: no counterpart (a model held by a winched joint until detached); start the robot "
+        "where it should stand",
+        (
+            _p("robotNamespace ros", "ignored", "the namespace of its velocity and detach topics"),
+            _p("init_vel", "ignored", "ROS 2: the winch's initial velocity"),
+        ),
+    ),
 )
 
 
