@@ -194,4 +194,36 @@ ENTRIES: tuple[PluginDoc, ...] = (
         "not supported: no counterpart (the model's self-collisions are not published)",
         (p("updateRate", "ignored", "the rate at which it publishes the contacts"),),
     ),
+    PluginDoc(
+        ("roboticsgroup_upatras_gazebo_mimic_joint_plugin", "roboticsgroup_gazebo_mimic_joint_plugin"),
+        "model",
+        "roboticsgroup_upatras_gazebo_plugins (ROS 1 master 15187abc): src/mimic_joint_plugin.cpp:62-128; "
+        "its origin roboticsgroup_gazebo_plugins (509a32ea): src/mimic_joint_plugin.cpp:63-129, the same",
+        "not supported: declare the joint `<mimic joint=... multiplier=... offset=...>` in the URDF (held "
+        "by an equality constraint here)",
+        (
+            p("robotNamespace", "ignored", "the namespace of its PID's parameters"),
+            p("joint mimicJoint", "ignored", "the joint followed; the joint that follows it"),
+            p("multiplier offset", "ignored", "mimic = multiplier × joint + offset (1, 0)"),
+            p(
+                "sensitiveness",
+                "ignored",
+                "below this difference the follower is not moved (0)",
+            ),
+            p(
+                "hasPID maxEffort",
+                "ignored",
+                "a PID (gains from the parameter server) with maxEffort; without, the position is set with "
+                "fmax maxEffort (default: the joint's effort limit)",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("roboticsgroup_upatras_gazebo_disable_link_plugin", "roboticsgroup_gazebo_disable_link_plugin"),
+        "model",
+        "roboticsgroup_upatras_gazebo_plugins (ROS 1 master 15187abc): src/disable_link_plugin.cpp:42-52; "
+        "roboticsgroup_gazebo_plugins (509a32ea), the same",
+        "not supported: no counterpart (a link is not disabled; remove it from the description instead)",
+        (p("link", "ignored", "the link switched off (Link::SetEnabled(false)): not simulated"),),
+    ),
 )
