@@ -11,7 +11,7 @@ import render; print(render(), end='')" > docs/plugin_catalogue.md` writes it).
 
 from __future__ import annotations
 
-from runner.compile.gazebo import catalogue_3p, catalogue_gz, catalogue_ros
+from runner.compile.gazebo import catalogue_3p, catalogue_gz, catalogue_ros, catalogue_sdf
 from runner.compile.gazebo.plugin_doc import COMMON as _COMMON
 from runner.compile.gazebo.plugin_doc import Param, PluginDoc, Status
 from runner.compile.gazebo.plugin_doc import p as _p
@@ -498,7 +498,8 @@ CATALOGUE: tuple[PluginDoc, ...] = (
         ),
     ),
     *catalogue_ros.ENTRIES,  # gazebo_plugins (ROS 1, ROS 2), ros_control
-    *catalogue_gz.ENTRIES,  # gz-sim systems, SDF 1.10 sensor types
+    *catalogue_gz.ENTRIES,  # gz-sim systems
+    *catalogue_sdf.ENTRIES,  # SDF 1.10 sensor types no reader maps
     *catalogue_3p.ENTRIES,  # hector, velodyne, PAL, realsense
 )
 

@@ -1,7 +1,7 @@
 """The plugin catalogue's entries of gz-sim's systems found in robot descriptions (gazebosim/gz-sim at
-93bbf3ed; Fortress's `ignition-gazebo-` names read the same) and of SDF 1.10's sensor types no reader maps
-(gazebosim/sdformat at 2ace5362), each read from its source (file:lines in `origin`). An entry whose `becomes`
-starts "not supported" is one no reader maps: its parameters are all ignored."""
+93bbf3ed; Fortress's `ignition-gazebo-` names read the same), each read from its source (file:lines in
+`origin`). An entry whose `becomes` starts "not supported" is one no reader maps: its parameters are all
+ignored."""
 
 from __future__ import annotations
 
@@ -451,88 +451,6 @@ ENTRIES: tuple[PluginDoc, ...] = (
         ),
     ),
     PluginDoc(
-        ("sensor:navsat",),
-        "sensor",
-        "sdformat: sdf/1.10/navsat.sdf (SDF: the same sensor as `gps`); gz-sim: src/systems/navsat/NavSat.cc",
-        'not supported: the reader maps the legacy name `<sensor type="gps">` (Gazebo\'s GPS sensor), not '
-        "`navsat`; rename the type or use the scenario's `gps` plugin",
-        (
-            p(
-                "navsat.position_sensing navsat.velocity_sensing",
-                "ignored",
-                "`<horizontal>`/`<vertical>` `<noise>` on the fix and the velocity (NavSat on `.../navsat`)",
-            ),
-        ),
-    ),
-    PluginDoc(
-        ("sensor:logical_camera",),
-        "sensor",
-        "sdformat: sdf/1.10/logical_camera.sdf",
-        "not supported: no counterpart (the models in a frustum, by name and pose)",
-        (
-            p(
-                "logical_camera.near logical_camera.far logical_camera.aspect_ratio "
-                "logical_camera.horizontal_fov",
-                "ignored",
-                "the frustum in which models are reported",
-            ),
-        ),
-    ),
-    PluginDoc(
-        ("sensor:sonar",),
-        "sensor",
-        "sdformat: sdf/1.10/sonar.sdf (Gazebo classic's SonarSensor)",
-        "not supported: a `ray` sensor with gazebo_ros_range (ROS 1) or gazebo_ros_ray_sensor's "
-        "sensor_msgs/Range (ROS 2) is read as a Range",
-        (
-            p("sonar.geometry sonar.radius", "ignored", "a cone (default) or sphere, its base's radius"),
-            p("sonar.min sonar.max", "ignored", "the range's limits"),
-        ),
-    ),
-    PluginDoc(
-        ("sensor:air_speed",),
-        "sensor",
-        "sdformat: sdf/1.10/air_speed.sdf; gz-sim: src/systems/air_speed",
-        "not supported: no counterpart (no air here)",
-        (p("air_speed.pressure", "ignored", "the differential pressure's `<noise>`"),),
-    ),
-    PluginDoc(
-        ("sensor:thermal_camera", "sensor:thermal"),
-        "sensor",
-        "sdformat: sdf/1.10/sensor.sdf, camera.sdf; gz-sim: src/systems/thermal/ThermalSensor.cc:56-58 (the "
-        "thermal-sensor system's `<resolution>`, `<min_temp>`, `<max_temp>`)",
-        "not supported: no counterpart (no temperatures here)",
-        (p("camera", "ignored", "the image's size and field of view; temperatures come from visuals"),),
-    ),
-    PluginDoc(
-        ("sensor:segmentation_camera", "sensor:segmentation"),
-        "sensor",
-        "sdformat: sdf/1.10/camera.sdf:80 (`<segmentation_type>`)",
-        "not supported: no counterpart (no segmentation images here)",
-        (p("camera.segmentation_type", "ignored", "semantic (default) or panoptic labels per pixel"),),
-    ),
-    PluginDoc(
-        ("sensor:boundingbox_camera", "sensor:boundingbox"),
-        "sensor",
-        "sdformat: sdf/1.10/camera.sdf:94 (`<box_type>`)",
-        "not supported: no counterpart (no bounding boxes here)",
-        (p("camera.box_type", "ignored", "2d (default), visible_2d or 3d boxes of labelled visuals"),),
-    ),
-    PluginDoc(
-        ("sensor:wide_angle_camera",),
-        "sensor",
-        "sdformat: sdf/1.10/camera.sdf:142-179 (`<lens>`)",
-        "not supported: no counterpart; a `camera` sensor (a pinhole of `<horizontal_fov>`) is read",
-        (
-            p(
-                "camera.lens",
-                "ignored",
-                "the lens' projection (`<type>`, `<custom_function>` c1 c2 c3 f fun, `<scale_to_hfov>`, "
-                "`<cutoff_angle>`, `<env_texture_size>`, `<intrinsics>`)",
-            ),
-        ),
-    ),
-    PluginDoc(
         ("gz-sim-thermal-system",),
         "model",
         "gz-sim: src/systems/thermal/Thermal.cc:58-105 (in a `<visual>` or a model)",
@@ -541,5 +459,72 @@ ENTRIES: tuple[PluginDoc, ...] = (
             p("temperature heat_signature", "ignored", "a uniform temperature or a heat-signature texture"),
             p("min_temp max_temp", "ignored", "the texture's temperature range"),
         ),
+    ),
+    PluginDoc(
+        ("gz-sim-advanced-lift-drag-system",),
+        "model",
+        "gz-sim: src/systems/advanced_lift_drag/AdvancedLiftDrag.cc:301-434 (PX4's fixed-wing models)",
+        "not supported: no counterpart (no aerodynamics here)",
+        (
+            p(
+                "CL0 CD0 Cem0 CLa CYa Cella Cema Cena CLb CYb Cellb Cemb Cenb alpha_stall Cema_stall CDp CYp "
+                "CLp Cellp Cemp Cenp CDq CYq CLq Cellq Cemq Cenq CDr CYr CLr Cellr Cemr Cenr",
+                "ignored",
+                "the stability derivatives: forces and moments from the angles of attack and sideslip "
+                "and the body rates",
+            ),
+            p(
+                "AR mac eff air_density radial_symmetry area forward cp",
+                "ignored",
+                "the wing's geometry, the air",
+            ),
+            p("link_name", "ignored", "the link the forces act on"),
+            p(
+                "control_surface",
+                "ignored",
+                "each control surface's joint (`<name>`, `<direction>`) and its CD/CY/CL/Cell/Cem/Cen "
+                "`_ctrl` derivatives",
+            ),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-buoyancy-engine-system",),
+        "model",
+        "gz-sim: src/systems/buoyancy_engine/BuoyancyEngine.cc:133-199",
+        "not supported: no counterpart (no fluid here)",
+        (
+            p("link_name namespace", "ignored", "the bladder's link; its command topic's namespace"),
+            p(
+                "min_volume max_volume default_volume neutral_volume max_inflation_rate",
+                "ignored",
+                "the bladder's volumes and how fast it fills",
+            ),
+            p("fluid_density surface", "ignored", "the fluid's density; the surface's height"),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-drive-to-pose-controller-system",),
+        "model",
+        "gz-sim: src/systems/drive_to_pose_controller/DriveToPoseController.cc:118-160",
+        "not supported: no counterpart (a base driven to a commanded pose); command a drive from the "
+        "scenario's timeline",
+        (
+            p("linear_p_gain angular_p_gain", "ignored", "the P gains of the Twist it publishes"),
+            p("linear_deviation angular_deviation", "ignored", "when the pose counts as reached"),
+        ),
+    ),
+    PluginDoc(
+        ("gz-sim-kinetic-energy-monitor-system",),
+        "model",
+        "gz-sim: src/systems/kinetic_energy_monitor/KineticEnergyMonitor.cc:106-133",
+        "not supported: no counterpart (a link's kinetic energy is not published)",
+        (p("link_name topic", "ignored", "the link; the Double topic of its kinetic energy"),),
+    ),
+    PluginDoc(
+        ("gz-sim-logical-camera-system", "gz-sim-air-speed-system"),
+        "model",
+        "gz-sim: src/systems/logical_camera/LogicalCamera.cc, src/systems/air_speed/AirSpeed.cc (no options "
+        "of their own: each sensor's are in its `<sensor>`)",
+        "not supported: their sensors (`logical_camera`, `air_speed`) are not read here",
     ),
 )
