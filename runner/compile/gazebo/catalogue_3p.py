@@ -29,11 +29,6 @@ ENTRIES: tuple[PluginDoc, ...] = (
                 "the yaw model's spellings before hector 0.3.6",
             ),
             p("headingGaussianNoise", "ignored", "only fills hector's orientation covariance (said)"),
-            p(
-                "randomEngineSeed",
-                "ignored",
-                "the noise's seed; noise is drawn from the scenario's `seed` (said)",
-            ),
             p("yawGaussianNoise", "ignored", "only fills hector's orientation covariance (said)"),
             p("gaussianNoise", "same", "the older spelling of both white noises"),
             p(
