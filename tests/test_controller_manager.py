@@ -294,8 +294,8 @@ def test_a_file_without_controllers_and_an_unknown_type_are_said_where_they_are(
     assert "'enforce_command_limits' is not used" in said
     assert f"controllers file {str(tmp_path / 'empty.yaml')!r} yields no controller" in said, said
     assert "broadcaster" not in said.split("yields no controller")[1].split("\n")[0]
-    # the control plugin's own tags: known ones read, any other said
-    assert "<no_such_tag> in <plugin filename='gz_ros2_control-system'> is ignored" in said, said
+    # the control plugin's own tags: known ones read, any other said as no parameter of it (its catalogue entry)
+    assert "<no_such_tag> is not a parameter of 'gz_ros2_control-system': Gazebo ignores it too" in said, said
     assert "hold_joints" not in said
 
 

@@ -11,46 +11,21 @@ import render; print(render(), end='')" > docs/plugin_catalogue.md` writes it).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Literal
+from runner.compile.gazebo import catalogue_3p, catalogue_gz, catalogue_ros, catalogue_sdf
+from runner.compile.gazebo.plugin_doc import COMMON as _COMMON
+from runner.compile.gazebo.plugin_doc import Param, PluginDoc, Status
+from runner.compile.gazebo.plugin_doc import p as _p
 
-Status = Literal["same", "approx", "ignored"]
-
-
-@dataclass(frozen=True)
-class Param:
-    names: tuple[str, ...]  # every spelling the plugin reads (ROS 1 camelCase, ROS 2 snake_case)
-    status: Status
-    how: str = ""  # approx: how; ignored: what Gazebo does with it and why we do not
-
-
-@dataclass(frozen=True)
-class PluginDoc:
-    bases: tuple[
-        str, ...
-    ]  # `plugin_base()` of its filenames (`gazebo_ros_diff_drive`, `gz-sim-diff-drive-system`)
-    kind: Literal["model", "sensor"]
-    origin: str  # the package and distribution, and the source file it is read from
-    becomes: str  # what it is here (our plugin type, or why nothing)
-    params: tuple[Param, ...] = field(default_factory=tuple)
-
-    def names(self) -> set[str]:
-        return {n for p in self.params for n in p.names}
-
-    def ignored(self) -> dict[str, str]:
-        return {n: p.how for p in self.params if p.status == "ignored" for n in p.names}
-
-
-def _p(names: str, status: Status = "same", how: str = "") -> Param:
-    return Param(tuple(names.split()), status, how)
-
-
-_COMMON = (
-    _p("alwaysOn always_on", "ignored", "sensors and plugins are always on"),
-    _p("robotNamespace", "approx", "the robot's namespace is the scenario's (said when it differs)"),
-    _p("ros", "approx", "`<remapping>` kept; `<namespace>` replaced by the robot's (said)"),
-    _p("rosDebugLevel", "ignored", "ROS debug level"),
-)
+__all__ = [
+    "CATALOGUE",
+    "UNSUPPORTED",
+    "Param",
+    "PluginDoc",
+    "Status",
+    "entry",
+    "render",
+    "unsupported_reason",
+]
 
 CATALOGUE: tuple[PluginDoc, ...] = (
     PluginDoc(
@@ -522,6 +497,10 @@ CATALOGUE: tuple[PluginDoc, ...] = (
             ),
         ),
     ),
+    *catalogue_ros.ENTRIES,  # gazebo_plugins (ROS 1, ROS 2), ros_control
+    *catalogue_gz.ENTRIES,  # gz-sim systems
+    *catalogue_sdf.ENTRIES,  # SDF 1.10 sensor types no reader maps
+    *catalogue_3p.ENTRIES,  # hector, velodyne, PAL, realsense
 )
 
 
@@ -531,6 +510,17 @@ def entry(base: str) -> PluginDoc | None:
 
 
 _BY_BASE = {b: e for e in CATALOGUE for b in e.bases}
+UNSUPPORTED = (
+    "not supported"  # how `becomes` starts for a plugin we do not map: "not supported: why; instead"
+)
+
+
+def unsupported_reason(base: str) -> str:
+    """Why the plugin is not supported and what serves instead ('' when it is mapped or not catalogued)."""
+    doc = _BY_BASE.get(base)
+    if doc is None or not doc.becomes.startswith(UNSUPPORTED):
+        return ""
+    return doc.becomes.removeprefix(UNSUPPORTED).lstrip(":; ").strip()
 
 
 def render() -> str:

@@ -35,9 +35,12 @@ def read_model_plugin(g: ReaderBase, p: Any, link: str | None) -> None:
     if handler is None:
         if base in NOOP_PLUGINS:
             return
+        # the catalogue says why, and what serves instead, where it knows the plugin
+        why = catalogue.unsupported_reason(base)
+        why = f": {why}" if why else ""
         g.note(
             p,
-            f"plugin {filename!r} is not supported and is ignored",
+            f"plugin {filename!r} is not supported and is ignored{why}",
             hint="model plugins we map: " + ", ".join(sorted(_MODEL_PLUGINS)) + ". Add a plugin of ours "
             "under the robot's `plugins:` in the scenario instead.",
             kind=PLUGIN_UNSUPPORTED,

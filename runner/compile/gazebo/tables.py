@@ -131,4 +131,8 @@ NOOP_PLUGINS = {
     "gz-sim-scene-broadcaster-system",
     "gz-sim-contact-system",
     "gz-sim-forcetorque-system",
+    # the systems of the field sensors read by runner.compile.gazebo.field_sensors (issue 38's catalogue)
+    "gz-sim-magnetometer-system",
+    "gz-sim-air-pressure-system",
+    "gz-sim-altimeter-system",
 }
