@@ -147,7 +147,7 @@ BLOCKS: dict[str, El] = {
         ),
     ),
 }
-UNSUPPORTED = {"air_speed", "navsat", "logical_camera", "rfid", "rfidtag", "sonar", "wireless_transceiver"}
+UNSUPPORTED = {"air_speed", "logical_camera", "rfid", "rfidtag", "sonar", "wireless_transceiver"}
 
 
 def _lines(el: El, indent: str) -> list[str]:

@@ -451,6 +451,21 @@ def test_hector_gps_heading_noise_and_velocity(tmp_path: Path):
     assert np.allclose(v.mean(axis=0), [0.0, -1.0, 0.0], atol=0.05)  # east is -west
 
 
+def test_a_navsat_sensor_is_the_gps_sensor_under_sdfs_newer_name(tmp_path: Path):
+    """sdf/1.10/navsat.sdf: `<sensor type="navsat">` with a `<navsat>` block is the GPS sensor (gz-sensors'
+    NavSat); it was said as not supported and left out."""
+    navsat = GPS_SENSOR.replace('type="gps"', 'type="navsat"').replace("<gps>", "<navsat>")
+    path = _write(tmp_path, navsat.replace("</gps>", "</navsat>"), duration=1.0, xyz=(50.0, 200.0, 0.05))
+    plan, notices = compile_with_notices(path)
+    assert "not supported" not in notices and "left out" not in notices, notices
+    assert _topics(plan)["gps/fix"] == "sensor_msgs/msg/NavSatFix"
+    _, bus = simulate(path)
+    fixes = messages(bus, "bot/gps/fix")
+    r_north, _r_east = earth_radii(0.0)
+    north = np.array([math.radians(m.latitude) * r_north for _, m in fixes])
+    assert len(fixes) >= 19 and abs(north.mean() - 200) < 0.3
+
+
 def test_gazebo_gps_sensor_with_the_ros2_plugin(tmp_path: Path):
     """Gazebo's reference (0°, 0°, 0 m), x east and y north; the robot 50 m east and 200 m north."""
     path = _write(tmp_path, GPS_SENSOR, duration=5.0, xyz=(50.0, 200.0, 0.05))

@@ -78,7 +78,8 @@ ENTRIES: tuple[PluginDoc, ...] = (
         ("gz-sim-navsat-system",),
         "model",
         "gz-sim: src/systems/navsat/NavSat.cc (no options: the sensor's are in its `<sensor type='navsat'>`)",
-        "not supported: a navsat sensor is not read here; use the scenario's `gps` plugin",
+        "nothing: our world always runs navsat sensors (read as the gps sensor they are, "
+        "runner.compile.gazebo.thirdparty)",
     ),
     PluginDoc(
         ("gz-sim-joint-position-controller-system",),

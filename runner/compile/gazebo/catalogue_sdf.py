@@ -8,20 +8,6 @@ from runner.compile.gazebo.plugin_doc import PluginDoc, p
 
 ENTRIES: tuple[PluginDoc, ...] = (
     PluginDoc(
-        ("sensor:navsat",),
-        "sensor",
-        "sdformat: sdf/1.10/navsat.sdf (SDF: the same sensor as `gps`); gz-sim: src/systems/navsat/NavSat.cc",
-        'not supported: the reader maps the legacy name `<sensor type="gps">` (Gazebo\'s GPS sensor), not '
-        "`navsat`; rename the type or use the scenario's `gps` plugin",
-        (
-            p(
-                "navsat.position_sensing navsat.velocity_sensing",
-                "ignored",
-                "`<horizontal>`/`<vertical>` `<noise>` on the fix and the velocity (NavSat on `.../navsat`)",
-            ),
-        ),
-    ),
-    PluginDoc(
         ("sensor:logical_camera",),
         "sensor",
         "sdformat: sdf/1.10/logical_camera.sdf",

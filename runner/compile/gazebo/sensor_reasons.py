@@ -39,8 +39,6 @@ UNSUPPORTED = {
     "air_speed": "gz-sensors publishes the airspeed, gz.msgs.AirSpeed, from the wind and the link's velocity",
     "logical_camera": "Gazebo publishes the names and poses of the models in its frustum as "
     "gz.msgs.LogicalCameraImage",
-    "navsat": "gz-sensors publishes a NavSatFix from the world's spherical coordinates; type 'gps' "
-    "with libgazebo_ros_gps_sensor.so is read",
     "rfid": "Gazebo Classic's RFID reader reports the tags within its range on Gazebo transport only",
     "rfidtag": "Gazebo Classic's RFID tag is only seen by an RFID reader",
     "sonar": "Gazebo Classic's sonar cone publishes the nearest range on Gazebo transport only; a ray "

@@ -90,6 +90,7 @@ def read_sensor(g: ReaderBase, el: Any, link: str | None) -> None:
 _NO_POSE = {
     "contact": "the sensor reports every contact of its link, wherever it sits (in Gazebo too)",
     "gps": "the fix is the link origin's (Gazebo's is at the sensor's pose)",
+    "navsat": "the fix is the link origin's (Gazebo's is at the sensor's pose)",
 }
 
 

@@ -135,4 +135,5 @@ NOOP_PLUGINS = {
     "gz-sim-magnetometer-system",
     "gz-sim-air-pressure-system",
     "gz-sim-altimeter-system",
+    "gz-sim-navsat-system",  # (navsat sensors: read as gps, runner.compile.gazebo.thirdparty)
 }

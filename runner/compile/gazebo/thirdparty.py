@@ -40,7 +40,7 @@ _VELODYNE_ROS2 = ("frame_name", "gaussian_noise", "tf_prefix")
 
 # sensor plugins (in a <sensor>) and sensor types handled here
 SENSOR_PLUGINS = {*_VELODYNE, "hector_gazebo_ros_sonar"}
-SENSOR_KINDS = {"gps"}
+SENSOR_KINDS = {"gps", "navsat"}  # (SDF 1.10: navsat is the gps sensor's preferred name)
 
 
 def _root_link(g: ReaderBase) -> str | None:
@@ -521,7 +521,8 @@ def sensor(
     | status FIX, service GPS | status 0, service 1 |
     """
     params: dict[str, Any] = {**common, "reference_heading": 90.0, "velocity_axes": "ENU"}
-    gps = r.child("gps")
+    # `<navsat>`: the same block under the name sdformat prefers (sdf/1.10/navsat.sdf; gz-sensors' NavSat)
+    gps = r.child("gps", "navsat")
     if gps is not None:
         gr = TagReader(gps)
         for block, key in (("position_sensing", "position"), ("velocity_sensing", "velocity")):
@@ -535,7 +536,7 @@ def sensor(
             for spec in (h, v):
                 if spec is not None and (spec.bias_mean or spec.bias_stddev):
                     g.note(spec.el, "a GPS noise bias (<bias_mean>, <bias_stddev>) is not modelled")
-        g.ignored(gr, f"{context} <gps>")
+        g.ignored(gr, f"{context} <{gps.tag}>")
     found = False
     topic, velocity = base_topic or "fix", None
     for p in plugins:
