@@ -44,6 +44,12 @@ class PlanarMoveParams(BaseDriveParams):
         description="Torque limit of the rotation, N·m (default: `max_force` times the robot's horizontal "
         "reach from its base origin).",
     )
+    pose_covariance_diagonal: list[float] | None = Field(
+        None, min_length=6, max_length=6, description="Odometry pose covariance diagonal (default: zeros)."
+    )
+    twist_covariance_diagonal: list[float] | None = Field(
+        None, min_length=6, max_length=6, description="Odometry twist covariance diagonal (default: zeros)."
+    )
 
 
 class PlanarMove(Plugin):
@@ -91,7 +97,17 @@ class PlanarMove(Plugin):
         self.ctx.subscribe(p.cmd_topic, "geometry_msgs/msg/Twist", self._on_cmd)
         odom_pub = self.ctx.publisher(p.odom_topic, "nav_msgs/msg/Odometry") if p.publish_odom else None
         tf_pub = self.ctx.publisher(p.tf_topic, "tf2_msgs/msg/TFMessage") if p.publish_tf else None
-        self.odom_out = OdometryWriter(odom_pub, self.odom_frame, self.base_frame) if odom_pub else None
+        self.odom_out = (
+            OdometryWriter(
+                odom_pub,
+                self.odom_frame,
+                self.base_frame,
+                p.pose_covariance_diagonal,
+                p.twist_covariance_diagonal,
+            )
+            if odom_pub
+            else None
+        )
         self.tf_out = TransformWriter(tf_pub, self.odom_frame, self.base_frame) if tf_pub else None
 
     def _on_cmd(self, msg: Any, stamp_ns: int) -> None:

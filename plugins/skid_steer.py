@@ -12,16 +12,16 @@ odometry over-reports every turn.
 
 from __future__ import annotations
 
-from typing import Literal
-
 from pydantic import Field
 
-from plugins.diff_drive import WheelDrive, WheelDriveParams
+from plugins.diff_drive import OdometrySource, WheelDrive, WheelDriveParams
 
 
 class SkidSteerParams(WheelDriveParams):
-    odometry_source: Literal["encoders", "world"] = Field(
-        "world", description="The true pose (default, like gazebo_ros_skid_steer_drive), or wheel encoders."
+    odometry_source: OdometrySource = Field(
+        "world",
+        description="The true pose (default, like gazebo_ros_skid_steer_drive), wheel encoders, the wheels' "
+        "velocities or the commands (diff_drive_controller's position_feedback: false, open_loop: true).",
     )
     left_joints: list[str] = Field(
         ["front_left_wheel_joint", "rear_left_wheel_joint"],

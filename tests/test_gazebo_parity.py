@@ -685,3 +685,21 @@ def test_a_plugin_parameter_that_is_not_a_number_is_said_at_its_line(tmp_path: P
     assert "robot.urdf:" in text and "write a plain number" in text
     skid = next(p for p in declared(plan.robots[0]) if p.type == "skid_steer")
     assert skid.params.get("wheel_separation") is None  # its default: measured from the model
+
+
+def test_the_drives_odometry_covariance_is_gazebos(tmp_path: Path):
+    """gazebo_ros_diff_drive (ROS 2: gazebo_ros_diff_drive.cpp:404-406, 651-664) publishes covariance_x,
+    covariance_y and covariance_yaw (defaults 1e-5, 1e-5, 1e-3) in the pose's and the twist's diagonal,
+    1e12 for z, roll and pitch; it was read and dropped without a word (zeros published)."""
+    from tests.helpers import compile_with_notices, declared
+
+    default = [1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3]
+    given = CLASSIC_DRIVE.replace(
+        "<update_rate>50</update_rate>", "<update_rate>50</update_rate><covariance_x>0.5</covariance_x>"
+    )
+    for drive, diagonal in ((CLASSIC_DRIVE, default), (given, [0.5, *default[1:]])):
+        path = _write(tmp_path, diffbot(drive), 0.1)
+        plan, said = compile_with_notices(path)
+        (plugin,) = [p for p in declared(plan.robots[0]) if p.type == "diff_drive"]
+        assert plugin.params["pose_covariance_diagonal"] == diagonal, said
+        assert plugin.params["twist_covariance_diagonal"] == diagonal

@@ -466,3 +466,19 @@ def test_husarions_mecanum_controller_of_the_same_type_name_is_told_apart_by_its
     moved = at(t, pose, 5.5) - pose[0]
     assert abs(moved[1] - 0.88) < 0.06 and abs(moved[0]) < 0.03 and abs(moved[2]) < 0.05, moved
     assert messages(bus, "r1/base_controller/odom")
+
+
+def test_a_four_wheel_diff_drive_controller_with_velocity_or_command_odometry_compiles(tmp_path: Path):
+    """diff_drive_controller with two wheels a side becomes our skid_steer, which takes its odometry from
+    the wheels' velocities (`position_feedback: false`) or the commands (`open_loop: true`) as the 2-wheel
+    diff_drive does (a public robot's valid Humble file failed to validate)."""
+    from bench.mobile import SKID_CONTROLLERS, skid_steer
+
+    for extra, source in (
+        ("      position_feedback: false\n", "velocity"),
+        ("      open_loop: true\n", "command"),
+    ):
+        plugin, said = _compiled(
+            tmp_path, skid_steer(control("CONTROL_YAML"), effort=None), SKID_CONTROLLERS + extra
+        )
+        assert plugin["type"] == "skid_steer" and plugin["odometry_source"] == source, (plugin, said)

@@ -455,7 +455,8 @@ def test_a_navsat_sensor_is_the_gps_sensor_under_sdfs_newer_name(tmp_path: Path)
     """sdf/1.10/navsat.sdf: `<sensor type="navsat">` with a `<navsat>` block is the GPS sensor (gz-sensors'
     NavSat); it was said as not supported and left out."""
     navsat = GPS_SENSOR.replace('type="gps"', 'type="navsat"').replace("<gps>", "<navsat>")
-    path = _write(tmp_path, navsat.replace("</gps>", "</navsat>"), duration=1.0, xyz=(50.0, 200.0, 0.05))
+    navsat = navsat.replace("</gps>", "</navsat>")
+    path = _write(tmp_path, navsat, duration=1.0, xyz=(50.0, 200.0, 0.05))
     plan, notices = compile_with_notices(path)
     assert "not supported" not in notices and "left out" not in notices, notices
     assert _topics(plan)["gps/fix"] == "sensor_msgs/msg/NavSatFix"
@@ -464,6 +465,10 @@ def test_a_navsat_sensor_is_the_gps_sensor_under_sdfs_newer_name(tmp_path: Path)
     r_north, _r_east = earth_radii(0.0)
     north = np.array([math.radians(m.latitude) * r_north for _, m in fixes])
     assert len(fixes) >= 19 and abs(north.mean() - 200) < 0.3
+    # without a ROS plugin: gz-sensors' one topic, no separate velocity topic
+    bare = navsat.split("<plugin")[0] + "</sensor>\n  </gazebo>"
+    plan, _said = compile_with_notices(_write(tmp_path, bare, duration=1.0))
+    assert [t for t in _topics(plan) if "vel" in t] == [], _topics(plan)
 
 
 def test_gazebo_gps_sensor_with_the_ros2_plugin(tmp_path: Path):

@@ -27,7 +27,11 @@ ENTRIES: tuple[PluginDoc, ...] = (
             ),
             p("cmdTimeout cmd_timeout", "same", "ROS 1 Noetic: no command for that long stops the base"),
             p("publish_odom publish_odom_tf"),
-            p("covariance_x covariance_y covariance_yaw", "ignored", "the odometry's fixed covariances"),
+            p(
+                "covariance_x covariance_y covariance_yaw",
+                "same",
+                "ROS 2: the pose's and twist's diagonal (1e12 for z, roll, pitch); ROS 1: fixed pose values",
+            ),
         ),
     ),
     PluginDoc(

@@ -65,6 +65,22 @@ def read_model_plugin(g: ReaderBase, p: Any, link: str | None) -> None:
     g.ignored(r, context)
 
 
+# What gazebo_plugins put in the odometry's covariance: x, y and yaw given (or their defaults), z, roll and
+# pitch 1e12 ("unknown")
+_UNKNOWN = 1e12
+
+
+def _covariance(r: TagReader, defaults: tuple[float, float, float]) -> list[float]:
+    """`[cov_x, cov_y, 1e12, 1e12, 1e12, cov_yaw]` from `<covariance_x/y/yaw>` (ros2 branch:
+    gazebo_ros_diff_drive.cpp:404-406 and 651-664, gazebo_ros_planar_move.cpp:193-210; noetic:
+    gazebo_ros_skid_steer_drive.cpp:208-229 and 460-486)."""
+    x = r.float("covariance_x")
+    y = r.float("covariance_y")
+    yaw = r.float("covariance_yaw")
+    cx, cy, cyaw = (v if v is not None else d for v, d in zip((x, y, yaw), defaults, strict=True))
+    return [cx, cy, _UNKNOWN, _UNKNOWN, _UNKNOWN, cyaw]
+
+
 def _odom_source(text: str | None) -> str | None:
     if text is None:
         return None
@@ -121,7 +137,15 @@ def _diff_drive_classic(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> t
             "wheel_joint_states",
             {"joints": lefts + rights, "rate": params["rate"]},
         )
-    r.mark("covariance_x", "covariance_y", "covariance_yaw", "publishOdomTF")
+    r.mark("publishOdomTF")
+    if r.el.find("leftJoint") is not None or r.el.find("rightJoint") is not None:
+        # ROS 1 (noetic gazebo_ros_diff_drive.cpp:461-467): the pose's covariance fixed, the twist's zero;
+        # <covariance_*> are not read there (said as not its parameters)
+        params["pose_covariance_diagonal"] = [1e-5, 1e-5, _UNKNOWN, _UNKNOWN, _UNKNOWN, 1e-3]
+    else:
+        params["pose_covariance_diagonal"] = params["twist_covariance_diagonal"] = _covariance(
+            r, (1e-5, 1e-5, 1e-3)
+        )
     if len(lefts) > 1 or len(rights) > 1:
         params["left_joints"], params["right_joints"] = lefts, rights
         n = max(len(lefts), len(rights))
@@ -184,7 +208,9 @@ def _skid_steer(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> tuple[str
     tf = r.bool("broadcastTF", "publish_odom_tf")
     if tf is not None:
         params["publish_tf"] = tf
-    r.mark("covariance_x", "covariance_y", "covariance_yaw")
+    params["pose_covariance_diagonal"] = params["twist_covariance_diagonal"] = _covariance(
+        r, (1e-4, 1e-4, 1e-2)
+    )
     return "skid_steer", params
 
 
@@ -205,7 +231,14 @@ def _planar_move(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> tuple[st
     timeout = r.float("cmdTimeout", "cmd_timeout")
     if timeout and timeout > 0:
         params["cmd_timeout"] = timeout
-    r.mark("covariance_x", "covariance_y", "covariance_yaw")
+    ros1 = ("commandTopic", "odometryTopic", "odometryFrame", "odometryRate", "robotBaseFrame")
+    if any(r.el.find(t) is not None for t in ros1):
+        # ROS 1 (noetic gazebo_ros_planar_move.cpp:292-297): the pose's covariance fixed, the twist's zero
+        params["pose_covariance_diagonal"] = [1e-5, 1e-5, _UNKNOWN, _UNKNOWN, _UNKNOWN, 1e-3]
+    else:
+        params["pose_covariance_diagonal"] = params["twist_covariance_diagonal"] = _covariance(
+            r, (1e-5, 1e-5, 1e-3)
+        )
     return "planar_move", params
 
 

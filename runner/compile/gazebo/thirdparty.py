@@ -560,6 +560,10 @@ def sensor(
             frame = g.frame(frame_name)
         pr.mark("alwaysOn", "always_on", "robotNamespace")
         g.ignored(pr, f"<plugin filename={filename!r}>")
+    if not found:
+        # no ROS plugin: the sensor's own topic (gz-sensors' NavSat: the fix, its velocity in the same
+        # message), not gazebo_ros_gps_sensor's `~/vel` ("" is none; a None would be the plugin's default)
+        velocity = ""
     params.update(topic=topic, velocity_topic=velocity, frame_id=frame)
     g.add(el, "gps", name, params, implicit=not (found or base_topic))
 
