@@ -102,3 +102,17 @@ def test_the_systems_of_the_sensors_we_read_are_not_said_as_unsupported(tmp_path
 """
     _, notices = compile_with_notices(robot_scenario(tmp_path, urdf))
     assert "not supported" not in notices, notices
+
+
+def test_what_noetics_ros_control_plugin_does_not_read_is_said(tmp_path: Path) -> None:
+    """`<legacyModeNS>` (kinetic's gazebo_ros_control) was accepted without a word; Noetic reads no such tag."""
+    from tests.helpers import compile_with_notices, robot_scenario
+
+    urdf = (
+        '<robot name="b"><link name="base"><inertial><mass value="1"/>'
+        '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+        '<gazebo><plugin name="gazebo_ros_control" filename="libgazebo_ros_control.so">'
+        "<legacyModeNS>true</legacyModeNS></plugin></gazebo></robot>"
+    )
+    _plan, said = compile_with_notices(robot_scenario(tmp_path, urdf))
+    assert "<legacyModeNS> is ignored" in said, said
