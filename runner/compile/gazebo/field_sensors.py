@@ -18,7 +18,7 @@ from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.noise import NoiseSpec, noise_spec
 from runner.compile.gazebo.sensor_plugins import read_sensor_plugins
 from runner.compile.gazebo.sensor_reasons import NOT_SDF
-from runner.compile.gazebo.tags import TagReader, ros_topic
+from runner.compile.gazebo.tags import SdfReader, TagReader, ros_topic
 from runner.errors import NO_PUBLISHER, PLUGIN_UNSUPPORTED
 
 # `s`: runner.compile.gazebo.sensors' `_Sensor` (one <sensor> as every kind reads it), which imports this
@@ -31,7 +31,7 @@ def _noise(g: ReaderBase, block: TagReader, tag: str, what: str, context: str) -
     el = block.child(tag)
     if el is None:
         return None
-    r = TagReader(el)
+    r = SdfReader(el)
     where = f"{context} <{block.el.tag}><{tag}>"
     spec = noise_spec(g, r, where)
     g.ignored(r, where, NOT_SDF)
@@ -77,7 +77,7 @@ def magnetometer(g: ReaderBase, s: _Sensor) -> bool:
     params: dict[str, Any] = {**s.common, "link": _link_of(g, s)}
     block = s.r.child("magnetometer")
     if block is not None:
-        br = TagReader(block)
+        br = SdfReader(block)
         specs = [_noise(g, br, axis, "a magnetometer", s.context) for axis in ("x", "y", "z")]
         if any(specs):
             params["noise_stddev"] = [sp.stddev if sp else 0.0 for sp in specs]
@@ -96,7 +96,7 @@ def air_pressure(g: ReaderBase, s: _Sensor) -> bool:
     params: dict[str, Any] = {**s.common, "link": _link_of(g, s)}
     block = s.r.child("air_pressure")
     if block is not None:
-        br = TagReader(block)
+        br = SdfReader(block)
         ref = br.float("reference_altitude")
         if ref is not None:
             params["reference_altitude"] = ref
@@ -118,7 +118,7 @@ def altimeter(g: ReaderBase, s: _Sensor) -> bool:
     params: dict[str, Any] = {**s.common, "link": _link_of(g, s)}
     block = s.r.child("altimeter")
     if block is not None:
-        br = TagReader(block)
+        br = SdfReader(block)
         for tag, key in (("vertical_position", "position"), ("vertical_velocity", "velocity")):
             spec = _noise(g, br, tag, "an altimeter", s.context)
             if spec is not None:
@@ -156,7 +156,7 @@ def force_torque(g: ReaderBase, s: _Sensor) -> bool:
     params: dict[str, Any] = {**s.common, "link": _child_of(g, joint)}
     block = s.r.child("force_torque")
     if block is not None:
-        br = TagReader(block)
+        br = SdfReader(block)
         frame = (br.text("frame") or "child").strip().lower()
         direction = (br.text("measure_direction") or "child_to_parent").strip().lower()
         if frame not in _FT_FRAMES:

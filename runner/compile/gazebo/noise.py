@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from runner.compile.gazebo.base import ReaderBase
-from runner.compile.gazebo.tags import TagReader
+from runner.compile.gazebo.tags import SdfReader, TagReader
 
 # What a `<noise>` has that we do not model, said when it is not zero (sdf/1.10/noise.sdf; gz-sensors'
 # GaussianNoiseModel applies them, Gazebo Classic's only the first four)
@@ -62,7 +62,7 @@ def noise_spec(g: ReaderBase, parent: TagReader | None, context: str = "a sensor
     noise = parent.child("noise") if parent is not None else None
     if noise is None:
         return None
-    r = TagReader(noise)
+    r = SdfReader(noise)
     where = f"{context} <noise>"
     kind = (noise.get("type") or r.text("type") or "gaussian").strip()
     spec = _numbers(r)
@@ -86,7 +86,7 @@ def classic_noise_spec(g: ReaderBase, noise: TagReader, block: str, context: str
     el = noise.child(block)
     if el is None:
         return None
-    r = TagReader(el)
+    r = SdfReader(el)
     spec = _numbers(r)
     g.ignored(r, f"{context} <noise><{block}>")
     kind = (noise.text("type") or "gaussian").strip().lower()

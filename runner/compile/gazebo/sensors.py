@@ -17,7 +17,7 @@ from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.noise import NoiseSpec, classic_noise_spec, noise_spec, noise_stddev
 from runner.compile.gazebo.sensor_plugins import read_sensor_plugins
 from runner.compile.gazebo.tables import FORMATS
-from runner.compile.gazebo.tags import TagReader, floats, join_topic, ros_topic, sibling_topic
+from runner.compile.gazebo.tags import SdfReader, TagReader, floats, join_topic, ros_topic, sibling_topic
 from runner.errors import PLUGIN_UNSUPPORTED
 
 
@@ -42,7 +42,7 @@ def read_sensor(g: ReaderBase, el: Any, link: str | None) -> None:
     """A `<sensor>` of the link `link` (None: in a `<gazebo>` block without a reference) -> a plugin."""
     kind = (el.get("type") or "").strip()
     name = el.get("name") or kind or "sensor"
-    r = TagReader(el)
+    r = SdfReader(el)
     context = f"<sensor name={name!r} type={kind!r}>"
     rate = r.float("update_rate", "updateRate")
     pose = floats(r.text("pose"), 6)
@@ -199,7 +199,7 @@ def _contact_sensor(g: ReaderBase, s: _Sensor) -> bool:
         return False
     block = s.r.child("contact")
     if block is not None:
-        cr = TagReader(block)
+        cr = SdfReader(block)
         # <collision> names the link's collision that senses (a URDF link's become <link>_collision,
         # <link>_collision_1, ...): we report every contact of the link, of any of its collisions
         cr.children("collision")
@@ -260,13 +260,13 @@ def _lidar(g: ReaderBase, r: TagReader, el: Any, context: str) -> dict[str, Any]
     if ray is None:
         return out
     where = f"{context} <{ray.tag}>"
-    rr = TagReader(ray)
+    rr = SdfReader(ray)
     scan = rr.child("scan")
     if scan is not None:
-        sr = TagReader(scan)
+        sr = SdfReader(scan)
         h = sr.child("horizontal")
         if h is not None:
-            hr = TagReader(h)
+            hr = SdfReader(h)
             samples = hr.float("samples")
             resolution = hr.float("resolution")
             n = int(samples) if samples is not None else 640
@@ -280,11 +280,11 @@ def _lidar(g: ReaderBase, r: TagReader, el: Any, context: str) -> dict[str, Any]
             g.ignored(hr, f"{where} <horizontal>")
         v = sr.child("vertical")
         if v is not None:
-            _vertical(g, TagReader(v), out, where)
+            _vertical(g, SdfReader(v), out, where)
         g.ignored(sr, f"{where} <scan>")
     rng = rr.child("range")
     if rng is not None:
-        nr = TagReader(rng)
+        nr = SdfReader(rng)
         for tag, key in (("min", "range_min"), ("max", "range_max"), ("resolution", "resolution")):
             value = nr.float(tag)
             if value is not None:
@@ -331,13 +331,13 @@ def _camera(g: ReaderBase, r: TagReader, el: Any, context: str) -> tuple[dict[st
     if cam is None:
         return out, None
     where = f"{context} <camera>"
-    cr = TagReader(cam)
+    cr = SdfReader(cam)
     fov = cr.float("horizontal_fov")
     if fov is not None:
         out["fov"] = fov
     image = cr.child("image")
     if image is not None:
-        ir = TagReader(image)
+        ir = SdfReader(image)
         w, h = ir.float("width"), ir.float("height")
         if w is not None:
             out["width"] = int(w)
@@ -353,7 +353,7 @@ def _camera(g: ReaderBase, r: TagReader, el: Any, context: str) -> tuple[dict[st
         g.ignored(ir, f"{where} <image>", sensor_reasons.IMAGE)
     clip = cr.child("clip")
     if clip is not None:
-        clr = TagReader(clip)
+        clr = SdfReader(clip)
         for tag in ("near", "far"):
             value = clr.float(tag)
             if value is not None:
@@ -372,7 +372,7 @@ def _camera(g: ReaderBase, r: TagReader, el: Any, context: str) -> tuple[dict[st
     cr.child("trigger_topic")  # read only when <triggered>, said above
     depth = cr.child("depth_camera")
     if depth is not None:
-        dr = TagReader(depth)
+        dr = SdfReader(depth)
         output = (dr.text("output") or "depths").strip()
         if output != "depths":
             g.note(
@@ -408,16 +408,16 @@ def _imu(g: ReaderBase, r: TagReader, el: Any, context: str) -> dict[str, Any]:
     if imu is None:
         return out
     where = f"{context} <imu>"
-    ir = TagReader(imu)
+    ir = SdfReader(imu)
     for key in ("angular_velocity", "linear_acceleration"):
         block = ir.child(key)
         if block is None:
             continue
-        br = TagReader(block)
+        br = SdfReader(block)
         specs = []
         for axis in ("x", "y", "z"):
             axis_el = br.child(axis)
-            ar = TagReader(axis_el) if axis_el is not None else None
+            ar = SdfReader(axis_el) if axis_el is not None else None
             specs.append(noise_spec(g, ar, f"{where} <{key}><{axis}>"))
             if ar is not None:
                 g.ignored(ar, f"{where} <{key}><{axis}>")
@@ -426,7 +426,7 @@ def _imu(g: ReaderBase, r: TagReader, el: Any, context: str) -> dict[str, Any]:
     # classic (SDF 1.4) style: <imu><noise><type/><rate>..</rate><accel>..</accel></noise>, for all axes
     n = ir.child("noise")
     if n is not None:
-        nr = TagReader(n)
+        nr = SdfReader(n)
         for block_name, key in (("rate", "angular_velocity"), ("accel", "linear_acceleration")):
             spec = classic_noise_spec(g, nr, block_name, where)
             if spec is not None:
@@ -434,7 +434,7 @@ def _imu(g: ReaderBase, r: TagReader, el: Any, context: str) -> dict[str, Any]:
         g.ignored(nr, f"{where} <noise>")
     frame = ir.child("orientation_reference_frame")
     if frame is not None:
-        fr = TagReader(frame)
+        fr = SdfReader(frame)
         localization = (fr.text("localization") or "").strip()
         if localization.upper() not in ("", "ENU"):
             g.note(

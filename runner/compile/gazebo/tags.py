@@ -106,6 +106,16 @@ class TagReader:
         ]
 
 
+class SdfReader(TagReader):
+    """A TagReader of an SDF element sdformat itself parses (a `<sensor>` and its blocks): a value that is
+    not a number is an error there (sdformat refuses the description), not a default as a plugin's
+    parameter is: `float` raises ValueError, which the Gazebo reader turns into an error at the tag."""
+
+    def float(self, *names: str) -> float | None:
+        t = self.text(*names)
+        return float(t) if t is not None else None
+
+
 def floats(text: str | None, n: int) -> list[float] | None:
     if not text:
         return None

@@ -28,7 +28,15 @@ from typing import Any
 
 from runner.compile.gazebo.base import ReaderBase
 from runner.compile.gazebo.noise import NoiseSpec, noise_spec
-from runner.compile.gazebo.tags import TagReader, floats, is_zero, join_topic, plugin_base, ros_topic
+from runner.compile.gazebo.tags import (
+    SdfReader,
+    TagReader,
+    floats,
+    is_zero,
+    join_topic,
+    plugin_base,
+    ros_topic,
+)
 from runner.errors import NO_PUBLISHER, PLUGIN_UNSUPPORTED
 
 # hector's defaults (hector_gazebo_plugins/src/gazebo_ros_gps.cpp, sensor_model.h)
@@ -524,7 +532,7 @@ def sensor(
     # `<navsat>`: the same block under the name sdformat prefers (sdf/1.10/navsat.sdf; gz-sensors' NavSat)
     gps = r.child("gps", "navsat")
     if gps is not None:
-        gr = TagReader(gps)
+        gr = SdfReader(gps)
         for block, key in (("position_sensing", "position"), ("velocity_sensing", "velocity")):
             h, v = _gps_axes(g, gr, block, context)
             sd = [h.stddev if h else 0.0] * 2 + [v.stddev if v else 0.0]
@@ -573,11 +581,11 @@ def _gps_axes(g: ReaderBase, gps: TagReader, block: str, context: str) -> list[N
     el = gps.child(block)
     if el is None:
         return [None, None]
-    br = TagReader(el)
+    br = SdfReader(el)
     out = []
     for axis in ("horizontal", "vertical"):
         axis_el = br.child(axis)
-        ar = TagReader(axis_el) if axis_el is not None else None
+        ar = SdfReader(axis_el) if axis_el is not None else None
         where = f"{context} <gps><{block}><{axis}>"
         out.append(noise_spec(g, ar, where))
         if ar is not None:
