@@ -115,4 +115,5 @@ def test_what_noetics_ros_control_plugin_does_not_read_is_said(tmp_path: Path) -
         "<legacyModeNS>true</legacyModeNS></plugin></gazebo></robot>"
     )
     _plan, said = compile_with_notices(robot_scenario(tmp_path, urdf))
-    assert "<legacyModeNS> is ignored" in said, said
+    (line,) = [x for x in said.splitlines() if "<legacyModeNS>" in x]
+    assert "is ignored" in line, said

@@ -559,13 +559,7 @@ def ros_control(g: ReaderBase, r: TagReader, remap: dict[str, str]) -> None:
     # something; any other tag is said by the caller (`ignored`)
     r.mark("parameters", "ros", "controller_manager_name", "robot_param", "robot_param_node", "robotParam")
     r.mark("hold_joints", "position_proportional_gain", "controller_manager_prefix_node_name")
-    r.mark("robotNamespace")
-    legacy = r.child("legacyModeNS")
-    if legacy is not None:  # (kinetic's; noetic's gazebo_ros_control_plugin.cpp:85-160 reads no such tag)
-        g.note(
-            legacy,
-            "<legacyModeNS> is ignored: Noetic's gazebo_ros_control no longer reads it (nor does Gazebo)",
-        )
+    r.mark("robotNamespace")  # (<legacyModeNS>: Noetic reads none; the catalogue's reason says so)
     period = r.child("controlPeriod")
     if period is not None:
         g.note(
