@@ -256,13 +256,8 @@ class Control:
         lin = None if linear is None else np.asarray(linear, float)
         ang = None if angular is None else np.asarray(angular, float)
         if frame is not None:  # gazebo_ros_state.cpp:268-275: pose + frame, velocities out of the frame
-            fpos, frot, _, _ = frame
-            fq = np.zeros(4)
-            mujoco.mju_mat2Quat(fq, frot.ravel())
-            pos = fpos + frot @ pos
-            q = np.zeros(4)
-            mujoco.mju_mulQuat(q, fq, quat)
-            quat = q
+            frot = frame[1]
+            pos, quat = out_of_frame(frame, pos, quat)
             lin = None if lin is None else frot @ lin
             ang = None if ang is None else frot @ ang
         mocap = int(m.body_mocapid[b])
@@ -422,6 +417,18 @@ class Control:
     def _said(self, text: str) -> None:
         """A refused request, on stderr (as gazebo_ros logs RCLCPP_ERROR), at its sim time."""
         print(f"world: t = {self.now_ns / 1e9:.3f} s: {text}", file=sys.stderr)
+
+
+def out_of_frame(
+    frame: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], pos: np.ndarray, quat: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """A pose given in `frame` (`Control._frame`'s: position, rotation, ...) in the world: the frame's pose
+    composed with it (gazebo_ros_state.cpp:268-275, gazebo_ros_factory.cpp:174-188)."""
+    fpos, frot = frame[0], frame[1]
+    fq, q = np.zeros(4), np.zeros(4)
+    mujoco.mju_mat2Quat(fq, frot.ravel())
+    mujoco.mju_mulQuat(q, fq, quat)
+    return fpos + frot @ pos, q
 
 
 def restore_model(m: mujoco.MjModel, m0: mujoco.MjModel) -> None:

@@ -6,12 +6,11 @@ from __future__ import annotations
 
 from typing import Any
 
-import mujoco
 import numpy as np
 
 from runner.compile.spawn import SpawnError
 from runner.plan import RunPlan
-from runner.sim.control import EntityError, Reply
+from runner.sim.control import EntityError, Reply, out_of_frame
 from runner.wire import msgs
 
 
@@ -35,12 +34,7 @@ class SpawnServices:
         quat = np.array([1.0, 0, 0, 0]) if norm < 1e-12 else quat / norm
         frame = w._frame(reference)
         if frame is not None:
-            fpos, frot, _, _ = frame
-            fq = np.zeros(4)
-            mujoco.mju_mat2Quat(fq, frot.ravel())
-            q = np.zeros(4)
-            mujoco.mju_mulQuat(q, fq, quat)
-            pos, quat = fpos + frot @ pos, q
+            pos, quat = out_of_frame(frame, pos, quat)
         return (float(pos[0]), float(pos[1]), float(pos[2])), (
             float(quat[0]),
             float(quat[1]),
