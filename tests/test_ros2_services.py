@@ -158,6 +158,23 @@ SCRIPT: list[dict[str, Any]] = [
 ]
 
 
+def run_client(port: int, domain: int, script: list[dict[str, Any]], tmp_path: Path, timeout: float) -> Path:
+    """The zenoh-ros2-sdk client (its own process) run through `script`: the JSON file of its log."""
+    path = tmp_path / "script.json"
+    path.write_text(json.dumps(script))
+    out = tmp_path / "out.json"
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[1])}
+    client = subprocess.run(
+        [sys.executable, str(CLIENT), str(port), str(domain), str(path), str(out)],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env=env,
+    )
+    assert client.returncode == 0, client.stderr[-3000:]
+    return out
+
+
 def _raw_checks(port: int) -> dict[str, Any]:
     """rmw_zenoh's service wire, by hand: the SS token, and a query's reply attachment."""
     session = zenoh.open(make_config("client", connect=[f"tcp/127.0.0.1:{port}"]))
@@ -199,19 +216,8 @@ def test_ros2_clients_call_services_and_send_goals(tmp_path: Path) -> None:
     port = free_port()
     mcap = tmp_path / "svc.mcap"
     run = start_run(_scenario(tmp_path), "--listen", f"tcp/127.0.0.1:{port}", "--record", str(mcap))
-    script = tmp_path / "script.json"
-    script.write_text(json.dumps(SCRIPT))
-    out = tmp_path / "out.json"
     try:
-        env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[1])}
-        client = subprocess.run(
-            [sys.executable, str(CLIENT), str(port), str(DOMAIN), str(script), str(out)],
-            capture_output=True,
-            text=True,
-            timeout=180,
-            env=env,
-        )
-        assert client.returncode == 0, client.stderr[-3000:]
+        out = run_client(port, DOMAIN, SCRIPT, tmp_path, timeout=180)
         raw = _raw_checks(port)
     finally:
         run.send_signal(2)

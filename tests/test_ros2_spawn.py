@@ -7,9 +7,6 @@ world through gazebo_ros's `/spawn_entity`, sees its topics appear in `ros2 topi
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +16,7 @@ from runner.wire.transport import free_port
 from tests.conftest import read_mcap
 from tests.test_bridges import start_run
 from tests.test_gazebo_parity import diffbot
+from tests.test_ros2_services import run_client
 from tests.test_sim_control import BOX
 
 CLIENT = Path(__file__).parent / "clients" / "ros2_sdk_services.py"
@@ -93,19 +91,8 @@ def test_a_ros2_client_spawns_drives_and_deletes_a_robot(tmp_path: Path) -> None
     port = free_port()
     mcap = tmp_path / "sp.mcap"
     run = start_run(_scenario(tmp_path), "--listen", f"tcp/127.0.0.1:{port}", "--record", str(mcap))
-    script = tmp_path / "script.json"
-    script.write_text(json.dumps(_script()))
-    out = tmp_path / "out.json"
     try:
-        env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[1])}
-        client = subprocess.run(
-            [sys.executable, str(CLIENT), str(port), str(DOMAIN), str(script), str(out)],
-            capture_output=True,
-            text=True,
-            timeout=240,
-            env=env,
-        )
-        assert client.returncode == 0, client.stderr[-3000:]
+        out = run_client(port, DOMAIN, _script(), tmp_path, timeout=240)
     finally:
         run.send_signal(2)
         _o, err = run.communicate(timeout=60)
